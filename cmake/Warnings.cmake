@@ -1,0 +1,23 @@
+# Compile policy for every atonlab target (after pbrt's pbrt_warnings).
+add_library(atonlab_warnings INTERFACE)
+target_compile_options(atonlab_warnings INTERFACE
+  -Wall -Wextra -Wpedantic
+  -Wshadow                 # a shadowed name in numeric code is a bug waiting to happen
+  -Wconversion             # silent double -> float narrowing changes photometric results
+  -Wno-sign-conversion     # size_t/int mixing in loops is noise, -Wconversion covers the real cases
+  -Wnon-virtual-dtor
+  -Wold-style-cast
+  -Wimplicit-fallthrough)
+if(ATONLAB_WERROR)
+  target_compile_options(atonlab_warnings INTERFACE -Werror)
+endif()
+
+add_library(atonlab_sanitize INTERFACE)
+if(ATONLAB_SANITIZE)
+  target_compile_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined)
+endif()
+
+# Every atonlab library and executable links this.
+add_library(atonlab_policy INTERFACE)
+target_link_libraries(atonlab_policy INTERFACE atonlab_warnings atonlab_sanitize)

@@ -1,0 +1,37 @@
+#pragma once
+// The atmosphere between light and eye: Allard's law (K2012 eq 2.1, IALA
+// E200-2) and Bouguer's law of extinction (K2012 eq 4.14).
+
+namespace atonlab::stimuli {
+
+inline constexpr double metres_per_nautical_mile = 1852.0;
+
+/// Illuminance thresholds E_t at the eye (lux) of IALA E200-2.
+inline constexpr double allard_threshold_night_lux = 2e-7;
+inline constexpr double allard_threshold_day_lux = 1e-3;
+
+/// Allard's law, K2012 eq 2.1 / IALA E200-2: the luminous intensity (cd) needed
+/// for a light to be seen at range_nmi given the threshold E_t (lux) and the
+/// meteorological visibility V (nmi). background_factor multiplies E_t for
+/// background lighting (1 none, 10 minor, 100 substantial: IALA E200-2).
+/// I = 3.43e6 * E_t * f * d^2 * 0.05^(-d/V), d and V in nmi.
+double allard_intensity_cd(double range_nmi, double threshold_lux, double visibility_nmi,
+                           double background_factor = 1.0);
+
+/// Inverse of allard_intensity_cd: the range in nmi at which intensity_cd
+/// reaches the threshold (monotonic; solved by bracketing + Newton in double).
+double allard_range_nmi(double intensity_cd, double threshold_lux, double visibility_nmi,
+                        double background_factor = 1.0);
+
+/// Nominal range (night, V = 10 nmi, E_t = 2e-7 lux) rounded down to whole nmi
+/// the way IALA E200-2 tabulates it (e.g. 108..203 cd -> 6 nmi, 204..364 cd -> 7 nmi).
+int nominal_range_nmi(double intensity_cd);
+
+/// Extinction coefficient (1/m) for meteorological visibility V (metres) with
+/// the 5% contrast threshold that Allard's law uses: sigma = -ln(0.05) / V.
+double extinction_per_m_from_visibility_m(double visibility_m);
+
+/// Bouguer's law, K2012 eq 4.14: transmittance T = exp(-sigma * d). sigma in 1/m, d in m.
+double bouguer_transmittance(double extinction_per_m, double distance_m);
+
+}  // namespace atonlab::stimuli

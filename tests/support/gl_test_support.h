@@ -1,0 +1,25 @@
+#pragma once
+// A GoogleTest environment that owns one headless GL 4.5 context for a test
+// executable. GL tests skip (with the context error as the reason) only where
+// no GL 4.5 core context can be made; on llvmpipe they run.
+#include <memory>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "atonlab/stimuli/gl/context.h"
+
+namespace atonlab::test {
+
+/// The shared context, created on first use; nullptr if unavailable.
+gl::Context* gl_context();
+/// Why the context is unavailable (empty if it is available).
+const std::string& gl_unavailable_reason();
+
+/// Base fixture: makes the shared context current or skips the test.
+class GLTest : public ::testing::Test {
+protected:
+    void SetUp() override;
+};
+
+}  // namespace atonlab::test
