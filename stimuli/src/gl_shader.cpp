@@ -152,6 +152,7 @@ int Program::uniform_location(std::string_view name) const {
 }
 
 void Program::set(std::string_view n, float v) const { glProgramUniform1f(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, double v) const { glProgramUniform1d(id(), uniform_location(n), v); }
 void Program::set(std::string_view n, int v) const { glProgramUniform1i(id(), uniform_location(n), v); }
 void Program::set(std::string_view n, unsigned v) const { glProgramUniform1ui(id(), uniform_location(n), v); }
 void Program::set(std::string_view n, float x, float y) const { glProgramUniform2f(id(), uniform_location(n), x, y); }

@@ -144,6 +144,7 @@ public:
     void use() const;
     int uniform_location(std::string_view name) const;  ///< -1 if absent (optimised out)
     void set(std::string_view name, float v) const;
+    void set(std::string_view name, double v) const;  ///< a `double` uniform (GL 4.0+)
     void set(std::string_view name, int v) const;
     void set(std::string_view name, unsigned v) const;
     void set(std::string_view name, float x, float y) const;

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Renders every scene in scenes/ to out/NAME.exr (cd/m²) and out/NAME.png.
+# The flashing buoy is sampled at several times through its period.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+atonlab="${ATONLAB_BUILD_DIR:-build}/runner/atonlab"
+mkdir -p out
+for scene in scenes/*.toml; do
+  name="$(basename "$scene" .toml)"
+  case "$name" in
+    flashing-buoy)
+      for t in 0.0 0.25 1.0 1.75 2.0 5.0; do
+        "$atonlab" render "$scene" --time "$t" -o "out/${name}-t${t}s.exr" --png "out/${name}-t${t}s.png"
+      done ;;
+    sectored-lighthouse)
+      # Seen from 3 km along several true bearings from seaward (observer -> light).
+      for b in 080 088 090 092 100; do
+        pos=$(awk -v b="$b" 'BEGIN { r = b * atan2(0, -1) / 180; printf "[%.3f, 3.0, %.3f]", -3000 * sin(r), 3000 * cos(r) }')
+        "$atonlab" render "$scene" --set "camera.position_m=$pos" --set "camera.yaw_deg=$b" \
+          -o "out/${name}-bearing${b}.exr" --png "out/${name}-bearing${b}.png"
+      done ;;
+    *)
+      "$atonlab" render "$scene" -o "out/${name}.exr" --png "out/${name}.png" ;;
+  esac
+done
+echo "Rendered $(ls out/*.exr | wc -l) frames: EXR (linear Rec.709, cd/m²) and PNG previews are in $(pwd)/out/"

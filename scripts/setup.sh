@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian packages atonlab needs (only those missing; as root or
+# via sudo), then configures and builds into build/ (or $ATONLAB_BUILD_DIR).
+# Extra CMake arguments can be given in $ATONLAB_CMAKE_ARGS.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Build tools, libraries (DESIGN.md "Dependencies"), and the Mesa EGL/llvmpipe
+# driver that the headless GL tests run on.
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev
+  libopenexr-dev libimath-dev libpng-dev libsqlite3-dev libfftw3-dev
+  libtomlplusplus-dev libcli11-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libboost-math-dev libnlopt-cxx-dev libstb-dev fonts-dejavu-core
+  xvfb xauth
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+  "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+build_dir="${ATONLAB_BUILD_DIR:-build}"
+# shellcheck disable=SC2086
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo ${ATONLAB_CMAKE_ARGS:-}
+cmake --build "$build_dir" --parallel "$(nproc)"

@@ -1,0 +1,23 @@
+// Radiance of one pixel of a light's direct image: L = E · c / (max(A, 1) · Ω_pixel)
+// (footprint.h), so that Σ L·Ω over the image equals the illuminance E at the
+// eye; a generalisation of K2012 eq 4.5. Additively blended into the HDR target.
+#include "footprint.glsl"
+
+flat in vec2 v_centre;
+flat in float v_area;
+flat in vec3 v_illuminance;
+
+uniform vec2 image_size;
+uniform float focal_px;
+
+layout(location = 0) out vec4 radiance;
+
+void main() {
+    vec2 p0 = floor(gl_FragCoord.xy);
+    float c = v_area >= 1.0 ? disc_pixel_coverage(v_centre, sqrt(v_area / 3.14159265358979), p0)
+                            : box_pixel_coverage(v_centre, p0);
+    if (c <= 0.0) discard;
+    float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);
+    // The footprint holds max(A, 1) px² in all: A for a disc, 1 for the box.
+    radiance = vec4(v_illuminance * (c / (max(v_area, 1.0) * omega)), 0.0);
+}
