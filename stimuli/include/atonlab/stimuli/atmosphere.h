@@ -19,12 +19,16 @@ double allard_intensity_cd(double range_nmi, double threshold_lux, double visibi
                            double background_factor = 1.0);
 
 /// Inverse of allard_intensity_cd: the range in nmi at which intensity_cd
-/// reaches the threshold (monotonic; solved by bracketing + Newton in double).
+/// reaches the threshold (monotonic; solved by bracketing + Newton in double,
+/// relative error ~1e-15, finite for every finite positive intensity).
+/// Returns 0 for intensity_cd <= 0 (or NaN) and +inf for +inf.
 double allard_range_nmi(double intensity_cd, double threshold_lux, double visibility_nmi,
                         double background_factor = 1.0);
 
-/// Nominal range (night, V = 10 nmi, E_t = 2e-7 lux) rounded down to whole nmi
-/// the way IALA E200-2 tabulates it (e.g. 108..203 cd -> 6 nmi, 204..364 cd -> 7 nmi).
+/// Nominal range (night, V = 10 nmi, E_t = 2e-7 lux) rounded to the NEAREST whole
+/// nmi, which is how IALA E200-2 tabulates it: n nmi covers I(n - 0.5) .. I(n + 0.5),
+/// e.g. 108..203 cd -> 6 nmi (I(5.5) = 107.8, I(6.5) = 203.2), 204..364 cd -> 7 nmi.
+/// 0 for intensity_cd <= 0.
 int nominal_range_nmi(double intensity_cd);
 
 /// Extinction coefficient (1/m) for meteorological visibility V (metres) with

@@ -56,10 +56,25 @@ struct HorizontalProfile {
     double at_bearing_deg(double bearing_deg) const;
 };
 
+/// Builtin vertical profile of the Sabik VP LED buoy lantern that K2012 §2.3 uses
+/// as its reference: "50% peak intensity at 10° and 10% peak intensity at 20°"
+/// (the thesis says "horizontal", meaning the spread away from the horizontal
+/// plane: the lantern is all-round). Fit: a generalised Gaussian in elevation
+/// e (degrees), B(e) = exp(-ln2 * (|e| / 10)^k), k = log2(log2 10) = 1.7320...,
+/// which passes exactly through 1 at 0°, 0.5 at ±10° and 0.1 at ±20° (an
+/// ordinary Gaussian through 0.5 at 10° gives 0.0625 at 20°). Symmetric, no
+/// data beyond 20°: it is an extrapolation there (0.0096 at 30°).
+double sabik_vp_relative_intensity(double elevation_deg);
+/// sabik_vp_relative_intensity tabulated at n points uniform in p (eq 4.1).
+/// With n = 256 the linear lookup is within 1e-3 of the fit everywhere (the
+/// worst error is at the peak), within 1e-4 at ±10° and ±20°.
+VerticalProfile sabik_vp_vertical_profile(int n = 256);
+
 /// Light-space bearing (degrees in [0, 360)) of a light-space direction towards
 /// the eye: atan2(x, -z), clockwise from -z. K2012 eq 4.4 uses atan2(x, z) + π;
 /// ours is the same parameterisation rotated by 180° so sector limits read as
 /// bearings on a chart.
+/// The zero vector (x = z = 0: straight up or down) gives 0.
 double bearing_deg_of_direction(double x, double z);
 
 }  // namespace atonlab::stimuli

@@ -33,6 +33,11 @@ struct Rhythm {
     std::string text;      ///< the normalised chart text, e.g. "Fl(2) 10s"
     double period_s = 0;   ///< 0 for a fixed light
     std::vector<RhythmChannel> channels;  ///< one per colour (one unless "Al.")
+    /// Colour letters written on the chart after a non-alternating character
+    /// ("R" in "Fl(2) R 10s", "WRG" for a sectored "Fl.WRG.10s"); informational
+    /// only: the light's colour comes from the scene. Empty for "Al." characters,
+    /// whose colours are in channels[i].colour.
+    std::string chart_colours;
 
     /// B(t) of channel c at time t_s (seconds, any real; taken modulo the period).
     double level(double t_s, std::size_t channel = 0) const;
