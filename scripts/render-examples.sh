@@ -16,7 +16,7 @@ for scene in scenes/*.toml; do
       # Seen from 3 km along several true bearings from seaward (observer -> light).
       for b in 080 088 090 092 100; do
         pos=$(awk -v b="$b" 'BEGIN { r = b * atan2(0, -1) / 180; printf "[%.3f, 3.0, %.3f]", -3000 * sin(r), 3000 * cos(r) }')
-        "$atonlab" render "$scene" --set "camera.position_m=$pos" --set "camera.yaw_deg=$b" \
+        "$atonlab" render "$scene" --set "camera.position_m=$pos" --set "camera.yaw_deg=$((10#$b))" \
           -o "out/${name}-bearing${b}.exr" --png "out/${name}-bearing${b}.png"
       done ;;
     *)

@@ -1,0 +1,1134 @@
+// The scene file (scene_file.h; every key documented in docs/scene-file.md).
+//
+// Three steps: parse the TOML text (syntax errors keep the parser's line),
+// apply the --set overrides to the parsed tree, then validate the tree against
+// the schema while building the Scene. Every value's error names the file,
+// line and dotted key; a value that came from --set names "--set KEY" instead
+// (override values are parsed with the source path "--set KEY", and toml++
+// keeps a node's source when it is moved into the scene's tree).
+#include "atonlab/stimuli/scene_file.h"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <optional>
+#include <set>
+#include <span>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "atonlab/stimuli/atmosphere.h"
+#include "atonlab/stimuli/colour.h"
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/light_model.h"  // orientation_from_yaw_pitch_roll: the camera's convention
+#include "atonlab/stimuli/profile.h"
+#include "atonlab/stimuli/rhythm.h"
+
+namespace atonlab::stimuli {
+namespace {
+
+constexpr std::string_view kSetFile = "--set";
+constexpr std::string_view kSetPrefix = "--set ";  // source path of an override's value: "--set KEY"
+
+// ---------------------------------------------------------------------------
+// The schema: the keys each table takes. Unknown keys are errors, so a typo
+// ("intensity_cdd") is reported instead of silently taking a default.
+
+using KeyList = std::span<const std::string_view>;
+
+constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "profiles", "light"};
+constexpr std::string_view kDisplayKeys[] = {"width_px", "height_px", "width_m", "viewing_distance_m"};
+constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
+constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
+                                                 "sea_reflectance"};
+constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare"};
+constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
+constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
+constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};
+constexpr std::string_view kSectorKeys[] = {"from_deg", "to_deg", "level", "edge_deg"};
+constexpr std::string_view kLightKeys[] = {
+    "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
+    "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
+    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s"};
+
+/// Keys of which a table may hold at most one. An override that sets one of
+/// them removes the others from its table, so "--set light.buoy.colour=red"
+/// works on a light whose file gives xy.
+const std::vector<std::vector<std::string_view>>& exclusive_groups() {
+    static const std::vector<std::vector<std::string_view>> groups = {
+        {"visibility_nmi", "extinction_per_km"},
+        {"colour", "xy", "spd"},
+        {"horizontal_profile", "sectors"},
+    };
+    return groups;
+}
+
+constexpr std::string_view kBuiltinVertical[] = {"uniform", "sabik-vp"};
+constexpr std::string_view kBuiltinHorizontal[] = {"uniform"};
+// DESIGN.md sketches a [tonemap] table; it arrives with the tone-mapping stage.
+constexpr std::string_view kLaterTonemap = "tonemap";
+const std::string kTonemapNotYet =
+    "the [tonemap] table is not available yet: tone mapping comes with the tone-mapping stage; remove it.";
+constexpr std::string_view kLaterGlare[] = {"wave-optics", "gaussian-bloom", "spencer", "kakimoto"};
+
+bool contains(KeyList list, std::string_view key) {
+    return std::find(list.begin(), list.end(), key) != list.end();
+}
+
+template <typename Range>
+std::string join(const Range& items, std::string_view quote = "'") {
+    std::string s;
+    for (const auto& item : items) {
+        if (!s.empty()) s += ", ";
+        s += fmt::format("{}{}{}", quote, item, quote);
+    }
+    return s;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t above = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+/// " Did you mean 'x'?" for the nearest allowed key within two edits, or the
+/// key with its unit suffix ("yaw" -> "yaw_deg"), else "".
+std::string suggestion(std::string_view key, KeyList allowed) {
+    if (key.size() >= 2)
+        for (std::string_view candidate : allowed)
+            if (candidate.starts_with(key) && candidate.size() > key.size() && candidate[key.size()] == '_')
+                return fmt::format(" Did you mean '{}'?", candidate);
+    std::string_view best;
+    std::size_t best_distance = 3;
+    for (std::string_view candidate : allowed) {
+        const std::size_t d = edit_distance(key, candidate);
+        if (d < best_distance) {
+            best = candidate;
+            best_distance = d;
+        }
+    }
+    return best.empty() ? std::string() : fmt::format(" Did you mean '{}'?", best);
+}
+
+std::string_view type_phrase(toml::node_type type) {
+    switch (type) {
+        case toml::node_type::string:
+            return "a string";
+        case toml::node_type::integer:
+            return "an integer";
+        case toml::node_type::floating_point:
+            return "a floating-point number";
+        case toml::node_type::boolean:
+            return "a boolean";
+        case toml::node_type::array:
+            return "an array";
+        case toml::node_type::table:
+            return "a table";
+        case toml::node_type::date:
+            return "a date";
+        case toml::node_type::time:
+            return "a time";
+        case toml::node_type::date_time:
+            return "a date-time";
+        case toml::node_type::none:
+            break;
+    }
+    return "nothing";
+}
+
+std::string number_text(double v) {
+    return fmt::format("{}", v);
+}
+
+// ---------------------------------------------------------------------------
+// Where a node came from.
+
+class Document {
+public:
+    explicit Document(std::string file) : file_(std::move(file)) {}
+
+    const std::string& file() const { return file_; }
+
+    /// Location of a node with its dotted schema key ("light[2].intensity_cd").
+    SourceLocation where(const toml::node* node, const std::string& key) const {
+        if (node != nullptr) {
+            const auto& path = node->source().path;
+            if (path && path->starts_with(kSetPrefix)) return override_location(path->substr(kSetPrefix.size()), key);
+            if (auto it = made_for_override_.find(node); it != made_for_override_.end())
+                return override_location(it->second, key);
+            if (node->source().begin.line > 0)
+                return {file_, static_cast<int>(node->source().begin.line),
+                        static_cast<int>(node->source().begin.column), key};
+        }
+        return {file_, 0, 0, key};
+    }
+    SourceLocation where(const toml::key& k, const std::string& key) const {
+        const auto& path = k.source().path;
+        if (path && path->starts_with(kSetPrefix)) return override_location(path->substr(kSetPrefix.size()), key);
+        return {file_, static_cast<int>(k.source().begin.line), static_cast<int>(k.source().begin.column), key};
+    }
+
+    [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& message) const {
+        SourceLocation w = where(node, key);
+        // A type error in an override that was not valid TOML says so.
+        if (w.file == kSetFile && message.ends_with("got a string."))
+            if (auto it = string_fallbacks_.find(w.key); it != string_fallbacks_.end())
+                throw InputError(std::move(w), message.substr(0, message.size() - 1) + it->second + ".");
+        throw InputError(std::move(w), message);
+    }
+
+    /// Records an applied override: its key as typed and its schema key
+    /// ("light.buoy.intensity_cd" -> "light[0].intensity_cd").
+    void note_override(const std::string& typed, const std::string& schema_key) { override_keys_[typed] = schema_key; }
+    /// A table created to hold an override's value (it has no source of its own).
+    void note_made_for_override(const toml::node* table, const std::string& typed) {
+        made_for_override_[table] = typed;
+    }
+    /// An override whose value was not valid TOML and was read as a string.
+    void note_string_fallback(const std::string& typed, const std::string& note) {
+        if (note.empty())
+            string_fallbacks_.erase(typed);
+        else
+            string_fallbacks_[typed] = note;
+    }
+
+private:
+    // Errors in an overridden value name the override as typed; an error in an
+    // element of it keeps the element's suffix ("light.buoy.sectors[1].from_deg").
+    SourceLocation override_location(const std::string& typed, const std::string& schema_key) const {
+        std::string key = typed;
+        if (auto it = override_keys_.find(typed); it != override_keys_.end() && schema_key.starts_with(it->second))
+            key += schema_key.substr(it->second.size());
+        return {std::string(kSetFile), 0, 0, key};
+    }
+
+    std::string file_;
+    std::map<std::string, std::string> override_keys_;
+    std::map<const toml::node*, std::string> made_for_override_;
+    std::map<std::string, std::string> string_fallbacks_;
+};
+
+// ---------------------------------------------------------------------------
+// Reading one table of the schema.
+
+class Section {
+public:
+    /// path: dotted key of the table ("display", "light[2]"); title: how a
+    /// sentence names it ("the [display] table", "[[light]] \"buoy\"").
+    Section(const Document& doc, const toml::table& table, std::string path, std::string title)
+        : doc_(doc), table_(table), path_(std::move(path)), title_(std::move(title)) {}
+
+    const toml::table& table() const { return table_; }
+    const std::string& path() const { return path_; }
+    const std::string& title() const { return title_; }
+    /// Prefix for value errors, e.g. "in light \"buoy\", ".
+    void set_context(std::string context) { context_ = std::move(context); }
+    void set_title(std::string title) { title_ = std::move(title); }
+
+    std::string key_path(std::string_view key) const {
+        return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+    }
+
+    [[noreturn]] void fail(const toml::node* node, std::string_view key, const std::string& message) const {
+        doc_.fail(node, key_path(key), context_ + message);
+    }
+    [[noreturn]] void fail_table(const std::string& message) const { doc_.fail(&table_, path_, context_ + message); }
+
+    /// Every key must be in the allowed list.
+    void allow(KeyList allowed) const {
+        for (auto&& [k, v] : table_) {
+            if (contains(allowed, k.str())) continue;
+            throw InputError(doc_.where(k, key_path(k.str())),
+                             fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
+                                         suggestion(k.str(), allowed), join(allowed)));
+        }
+    }
+
+    const toml::node* get(std::string_view key) const { return table_.get(key); }
+    bool has(std::string_view key) const { return table_.contains(key); }
+
+    [[noreturn]] void missing(std::string_view key, std::string_view what) const {
+        const SourceLocation w = doc_.where(&table_, path_);
+        const std::string at_line =
+            w.file != kSetFile && w.line > 0 ? fmt::format(" (line {})", w.line) : std::string();
+        doc_.fail(&table_, key_path(key),
+                  fmt::format("{}{} has no '{}', which is required ({}).", title_, at_line, key, what));
+    }
+
+    // Values, type-checked and finite. Integers are accepted as numbers.
+    std::optional<double> number(std::string_view key) const {
+        const toml::node* n = get(key);
+        if (n == nullptr) return std::nullopt;
+        return number_of(n, key_path(key), std::string(key));
+    }
+    double number_or(std::string_view key, double fallback) const { return number(key).value_or(fallback); }
+    double required_number(std::string_view key, std::string_view what) const {
+        if (auto v = number(key)) return *v;
+        missing(key, what);
+    }
+
+    std::optional<int> integer(std::string_view key, int min, int max) const {
+        const toml::node* n = get(key);
+        if (n == nullptr) return std::nullopt;
+        if (!n->is_integer()) fail(n, key, fmt::format("expected an integer, got {}.", type_phrase(n->type())));
+        const std::int64_t v = n->as_integer()->get();
+        if (v < min || v > max) fail(n, key, fmt::format("{} must be between {} and {}, got {}.", key, min, max, v));
+        return static_cast<int>(v);
+    }
+
+    std::optional<std::string> string(std::string_view key) const {
+        const toml::node* n = get(key);
+        if (n == nullptr) return std::nullopt;
+        if (!n->is_string()) fail(n, key, fmt::format("expected a string, got {}.", type_phrase(n->type())));
+        return n->as_string()->get();
+    }
+
+    /// A numeric array; size_required 0 = any length of at least min_size.
+    std::optional<std::vector<double>> numbers(std::string_view key, std::size_t size_required,
+                                               std::size_t min_size = 0) const {
+        const toml::node* n = get(key);
+        if (n == nullptr) return std::nullopt;
+        const std::string shape = size_required == 3   ? "an array of 3 numbers [x, y, z]"
+                                  : size_required == 2 ? "an array of 2 numbers"
+                                                       : "an array of numbers";
+        if (!n->is_array()) fail(n, key, fmt::format("expected {}, got {}.", shape, type_phrase(n->type())));
+        const toml::array& a = *n->as_array();
+        if (size_required != 0 && a.size() != size_required)
+            fail(n, key, fmt::format("expected {}, got {} element{}.", shape, a.size(), a.size() == 1 ? "" : "s"));
+        if (a.size() < min_size) fail(n, key, fmt::format("expected at least {} numbers, got {}.", min_size, a.size()));
+        std::vector<double> out;
+        out.reserve(a.size());
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            const std::string element = fmt::format("{}[{}]", key, i);
+            out.push_back(number_of(a.get(i), key_path(element), element));
+        }
+        return out;
+    }
+
+    std::optional<glm::dvec3> vec3(std::string_view key) const {
+        auto v = numbers(key, 3);
+        if (!v) return std::nullopt;
+        return glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
+    }
+
+    // Range checks with one sentence each.
+    void at_least(std::string_view key, double v, double min) const {
+        if (!(v >= min))
+            fail(get(key), key, fmt::format("{} must be at least {}, got {}.", key, number_text(min), number_text(v)));
+    }
+    void greater_than(std::string_view key, double v, double min) const {
+        if (!(v > min))
+            fail(get(key), key,
+                 fmt::format("{} must be greater than {}, got {}.", key, number_text(min), number_text(v)));
+    }
+    void within(std::string_view key, double v, double lo, double hi) const {
+        if (!(v >= lo && v <= hi))
+            fail(get(key), key,
+                 fmt::format("{} must be between {} and {}, got {}.", key, number_text(lo), number_text(hi),
+                             number_text(v)));
+    }
+
+private:
+    double number_of(const toml::node* n, const std::string& full_key, const std::string& short_key) const {
+        double v = 0.0;
+        if (n->is_integer()) {
+            v = static_cast<double>(n->as_integer()->get());
+        } else if (n->is_floating_point()) {
+            v = n->as_floating_point()->get();
+        } else {
+            doc_.fail(n, full_key, context_ + fmt::format("expected a number, got {}.", type_phrase(n->type())));
+        }
+        if (!std::isfinite(v))
+            doc_.fail(n, full_key,
+                      context_ + fmt::format("{} must be a finite number, got {}.", short_key, number_text(v)));
+        return v;
+    }
+
+    const Document& doc_;
+    const toml::table& table_;
+    std::string path_;
+    std::string title_;
+    std::string context_;
+};
+
+/// The sub-table `key` of `parent`, or nullptr when absent; an error when it is not a table.
+const toml::table* sub_table(const Section& parent, std::string_view key, std::string_view as_written) {
+    const toml::node* n = parent.get(key);
+    if (n == nullptr) return nullptr;
+    if (!n->is_table())
+        parent.fail(n, key, fmt::format("expected a table {}, got {}.", as_written, type_phrase(n->type())));
+    return n->as_table();
+}
+
+double wrap_degrees(double deg) {
+    double r = std::fmod(deg, 360.0);
+    if (r < 0) r += 360.0;
+    return r;
+}
+
+// ---------------------------------------------------------------------------
+// Profiles: parsed from [profiles.*], deduplicated into Scene::profiles by
+// table content (index 0 of each list is the uniform profile).
+
+template <typename Profile>
+int intern(std::vector<Profile>& list, Profile profile) {
+    for (std::size_t i = 0; i < list.size(); ++i)
+        if (list[i].table == profile.table) return static_cast<int>(i);
+    list.push_back(std::move(profile));
+    return static_cast<int>(list.size() - 1);
+}
+
+/// Chart sector limits are bearings *from seaward*: the bearing on which an
+/// observer sees the light. profile.h's Sector takes bearings from the light
+/// towards the observer, which are the reciprocal: add 180°. Clockwise order
+/// is kept, so "from 090 to 180" becomes "from 270 to 360".
+Sector sector_from_seaward(double from_deg, double to_deg, double level, double edge_deg) {
+    double span = to_deg - from_deg;
+    if (span < 0) span += 360.0;  // the sector runs clockwise through north
+    Sector s;
+    s.level = level;
+    s.edge_deg = edge_deg;
+    if (span >= 360.0) {
+        s.from_deg = 0.0;
+        s.to_deg = 360.0;
+        return s;
+    }
+    s.from_deg = wrap_degrees(from_deg + 180.0);
+    s.to_deg = s.from_deg + span;  // from_sectors takes to > 360 as running on through 0°
+    return s;
+}
+
+/// profile.h's checks throw InputError without a location; the file's checks
+/// come first, so these only fire for what they missed.
+HorizontalProfile horizontal_from_sectors(const Section& s, const std::vector<Sector>& sectors) {
+    try {
+        return HorizontalProfile::from_sectors(sectors);
+    } catch (const InputError& e) {
+        s.fail(s.get("sectors"), "sectors", e.message());
+    }
+}
+
+std::vector<Sector> read_sectors(const Document& doc, const Section& owner, std::string_view key) {
+    const toml::node* n = owner.get(key);
+    if (!n->is_array() || n->as_array()->empty())
+        owner.fail(n, key,
+                   fmt::format("expected an array of sector tables like [{{ from_deg = 90, to_deg = 180 }}], got {}.",
+                               n->is_array() ? "an empty array" : type_phrase(n->type())));
+    std::vector<Sector> sectors;
+    const toml::array& a = *n->as_array();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string element = fmt::format("{}[{}]", key, i);
+        const toml::node* e = a.get(i);
+        if (!e->is_table())
+            owner.fail(e, element,
+                       fmt::format("expected a sector table like {{ from_deg = 90, to_deg = 180 }}, got {}.",
+                                   type_phrase(e->type())));
+        Section s(doc, *e->as_table(), owner.key_path(element), fmt::format("sector {}", owner.key_path(element)));
+        s.allow(kSectorKeys);
+        const double from = s.required_number("from_deg", "bearing from seaward where the sector starts, degrees");
+        const double to = s.required_number("to_deg", "bearing from seaward where the sector ends, clockwise, degrees");
+        s.within("from_deg", from, 0.0, 360.0);
+        s.within("to_deg", to, 0.0, 360.0);
+        if (from == to)
+            s.fail(s.get("to_deg"), "to_deg",
+                   "to_deg equals from_deg: the sector is empty (use 0 and 360 for all round).");
+        const double level = s.number_or("level", 1.0);
+        s.at_least("level", level, 0.0);
+        const double edge = s.number_or("edge_deg", 0.0);
+        s.within("edge_deg", edge, 0.0, 90.0);
+        sectors.push_back(sector_from_seaward(from, to, level, edge));
+    }
+    return sectors;
+}
+
+/// Two equal-length arrays: the first strictly increasing within [lo, hi), the second >= 0.
+std::pair<std::vector<double>, std::vector<double>> read_table_pair(const Section& s, std::string_view angle_key,
+                                                                    double lo, double hi, bool hi_inclusive,
+                                                                    std::string_view what) {
+    if (!s.has(angle_key)) s.missing(angle_key, what);
+    if (!s.has("relative")) s.missing("relative", "relative intensities, one per angle, each >= 0");
+    std::vector<double> angles = *s.numbers(angle_key, 0, 2);
+    std::vector<double> relative = *s.numbers("relative", 0, 2);
+    if (angles.size() != relative.size())
+        s.fail(s.get("relative"), "relative",
+               fmt::format("relative has {} values but {} has {}; they must have the same length.", relative.size(),
+                           angle_key, angles.size()));
+    const toml::array& angle_nodes = *s.get(angle_key)->as_array();
+    const toml::array& relative_nodes = *s.get("relative")->as_array();
+    for (std::size_t i = 0; i < angles.size(); ++i) {
+        const std::string ak = fmt::format("{}[{}]", angle_key, i);
+        if (angles[i] < lo || angles[i] > hi || (!hi_inclusive && angles[i] == hi))
+            s.fail(angle_nodes.get(i), ak,
+                   fmt::format("{} must be in [{}, {}{}, got {}.", ak, number_text(lo), number_text(hi),
+                               hi_inclusive ? "]" : ")", number_text(angles[i])));
+        if (i > 0 && !(angles[i] > angles[i - 1]))
+            s.fail(angle_nodes.get(i), ak,
+                   fmt::format("{} must be sorted in increasing order, but {} follows {}.", angle_key,
+                               number_text(angles[i]), number_text(angles[i - 1])));
+        const std::string rk = fmt::format("relative[{}]", i);
+        if (relative[i] < 0)
+            s.fail(relative_nodes.get(i), rk,
+                   fmt::format("{} must be at least 0, got {}.", rk, number_text(relative[i])));
+    }
+    return {std::move(angles), std::move(relative)};
+}
+
+VerticalProfile read_vertical_profile(const Section& s) {
+    s.allow(kVerticalKeys);
+    auto [elevation, relative] = read_table_pair(s, "elevation_deg", -90.0, 90.0, true,
+                                                 "elevations in degrees, -90 (down) to 90 (up), increasing");
+    try {
+        return VerticalProfile::from_elevation_table(elevation, relative);
+    } catch (const InputError& e) {
+        s.fail_table(e.message());
+    }
+}
+
+HorizontalProfile read_horizontal_profile(const Document& doc, const Section& s) {
+    s.allow(kHorizontalKeys);
+    const bool has_sectors = s.has("sectors");
+    const bool has_table = s.has("bearing_deg") || s.has("relative");
+    if (has_sectors && has_table)
+        s.fail(s.get("sectors"), "sectors", "give either sectors or bearing_deg and relative, not both.");
+    if (has_sectors) {
+        return horizontal_from_sectors(s, read_sectors(doc, s, "sectors"));
+    }
+    if (!has_table) s.fail_table(fmt::format("{} needs either sectors or bearing_deg and relative.", s.title()));
+    auto [bearing, relative] =
+        read_table_pair(s, "bearing_deg", 0.0, 360.0, false, "bearings from seaward in degrees, 0 to 360, increasing");
+    // Bearings from seaward -> bearings from the light (+180°), re-sorted so the
+    // periodic table still starts at its smallest bearing.
+    std::vector<std::pair<double, double>> rows;
+    for (std::size_t i = 0; i < bearing.size(); ++i) rows.emplace_back(wrap_degrees(bearing[i] + 180.0), relative[i]);
+    std::sort(rows.begin(), rows.end());
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        bearing[i] = rows[i].first;
+        relative[i] = rows[i].second;
+    }
+    try {
+        return HorizontalProfile::from_bearing_table(bearing, relative);
+    } catch (const InputError& e) {
+        s.fail_table(e.message());
+    }
+}
+
+VerticalProfile builtin_vertical(std::string_view name) {
+    if (name == "sabik-vp") return sabik_vp_vertical_profile();
+    return VerticalProfile::uniform();
+}
+
+struct Profiles {
+    std::map<std::string, VerticalProfile, std::less<>> vertical;
+    std::map<std::string, HorizontalProfile, std::less<>> horizontal;
+};
+
+Profiles read_profiles(const Document& doc, const Section& root) {
+    Profiles out;
+    const toml::table* t = sub_table(root, "profiles", "[profiles]");
+    if (t == nullptr) return out;
+    Section profiles(doc, *t, "profiles", "the [profiles] table");
+    profiles.allow(kProfileKinds);
+    for (std::string_view kind : kProfileKinds) {
+        const toml::table* kt = sub_table(profiles, kind, fmt::format("[profiles.{}.NAME]", kind));
+        if (kt == nullptr) continue;
+        const bool vertical = kind == "vertical";
+        for (auto&& [k, v] : *kt) {
+            const std::string path = fmt::format("profiles.{}.{}", kind, k.str());
+            if (contains(vertical ? KeyList(kBuiltinVertical) : KeyList(kBuiltinHorizontal), k.str()))
+                throw InputError(
+                    doc.where(k, path),
+                    fmt::format("'{}' is the name of a builtin {} profile; choose another name.", k.str(), kind));
+            if (!v.is_table())
+                doc.fail(
+                    &v, path,
+                    fmt::format("expected a table [profiles.{}.{}], got {}.", kind, k.str(), type_phrase(v.type())));
+            Section s(doc, *v.as_table(), path, fmt::format("[profiles.{}.{}]", kind, k.str()));
+            if (vertical)
+                out.vertical.emplace(std::string(k.str()), read_vertical_profile(s));
+            else
+                out.horizontal.emplace(std::string(k.str()), read_horizontal_profile(doc, s));
+        }
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// Sections.
+
+DisplayGeometry read_display(const Document& doc, const Section& root) {
+    const toml::table* t = sub_table(root, "display", "[display]");
+    if (t == nullptr)
+        doc.fail(
+            nullptr, "display",
+            "the scene has no [display] table; it is required (width_px, height_px, width_m, viewing_distance_m).");
+    Section s(doc, *t, "display", "the [display] table");
+    s.allow(kDisplayKeys);
+    DisplayGeometry d;
+    constexpr int max_px = 65536;
+    auto w = s.integer("width_px", 1, max_px);
+    if (!w) s.missing("width_px", "the display's width in pixels");
+    auto h = s.integer("height_px", 1, max_px);
+    if (!h) s.missing("height_px", "the display's height in pixels");
+    d.width_px = *w;
+    d.height_px = *h;
+    d.width_m = s.required_number("width_m", "the picture's visible width in metres");
+    s.greater_than("width_m", d.width_m, 0.0);
+    d.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen distance in metres");
+    s.greater_than("viewing_distance_m", d.viewing_distance_m, 0.0);
+    return d;
+}
+
+Camera read_camera(const Document& doc, const Section& root) {
+    Camera c;
+    const toml::table* t = sub_table(root, "camera", "[camera]");
+    if (t == nullptr) return c;
+    Section s(doc, *t, "camera", "the [camera] table");
+    s.allow(kCameraKeys);
+    if (auto p = s.vec3("position_m")) c.position_m = *p;
+    c.yaw_deg = s.number_or("yaw_deg", 0.0);
+    c.pitch_deg = s.number_or("pitch_deg", 0.0);
+    c.roll_deg = s.number_or("roll_deg", 0.0);
+    if (auto fov = s.number("fov_deg")) {
+        if (!(*fov > 0.0 && *fov < 180.0))
+            s.fail(s.get("fov_deg"), "fov_deg",
+                   fmt::format("fov_deg must be greater than 0 and less than 180, got {}.", number_text(*fov)));
+        c.fov_y_deg = *fov;
+    }
+    return c;
+}
+
+Environment read_environment(const Document& doc, const Section& root) {
+    Environment e;
+    const toml::table* t = sub_table(root, "environment", "[environment]");
+    if (t == nullptr) return e;
+    Section s(doc, *t, "environment", "the [environment] table");
+    s.allow(kEnvironmentKeys);
+    if (auto bg = s.string("background")) {
+        if (*bg == "uniform")
+            e.background = Background::uniform;
+        else if (*bg == "sky-sea")
+            e.background = Background::sky_sea;
+        else
+            s.fail(s.get("background"), "background",
+                   fmt::format("unknown background \"{}\"; it must be \"uniform\" or \"sky-sea\".", *bg));
+    }
+    e.luminance_cd_m2 = s.number_or("luminance_cd_m2", e.luminance_cd_m2);
+    s.at_least("luminance_cd_m2", e.luminance_cd_m2, 0.0);
+    const auto visibility = s.number("visibility_nmi");
+    const auto extinction = s.number("extinction_per_km");
+    if (visibility && extinction)
+        s.fail(s.get("extinction_per_km"), "extinction_per_km",
+               "give either visibility_nmi or extinction_per_km, not both.");
+    if (visibility) {
+        s.greater_than("visibility_nmi", *visibility, 0.0);
+        e.extinction_per_m = extinction_per_m_from_visibility_m(*visibility * metres_per_nautical_mile);
+    }
+    if (extinction) {
+        s.at_least("extinction_per_km", *extinction, 0.0);
+        e.extinction_per_m = *extinction / 1000.0;
+    }
+    e.sea_reflectance_f0 = s.number_or("sea_reflectance", e.sea_reflectance_f0);
+    s.within("sea_reflectance", e.sea_reflectance_f0, 0.0, 1.0);
+    return e;
+}
+
+/// Returns Scene::adaptation_cd_m2.
+double read_eye(const Document& doc, const Section& root, const Environment& environment) {
+    const double fallback = environment.luminance_cd_m2 > 0.0 ? environment.luminance_cd_m2 : 0.001;
+    const toml::table* t = sub_table(root, "eye", "[eye]");
+    if (t == nullptr) return fallback;
+    Section s(doc, *t, "eye", "the [eye] table");
+    s.allow(kEyeKeys);
+    if (auto a = s.string("adaptation")) {
+        if (*a == "dynamic")
+            s.fail(s.get("adaptation"), "adaptation",
+                   "adaptation = \"dynamic\" is not available yet: log-average and temporal adaptation come with tone "
+                   "mapping; use \"fixed\".");
+        if (*a != "fixed")
+            s.fail(s.get("adaptation"), "adaptation",
+                   fmt::format("unknown adaptation \"{}\"; it must be \"fixed\".", *a));
+    }
+    const double adaptation = s.number_or("adaptation_cd_m2", fallback);
+    s.greater_than("adaptation_cd_m2", adaptation, 0.0);
+    if (auto g = s.string("glare")) {
+        if (contains(kLaterGlare, *g))
+            s.fail(
+                s.get("glare"), "glare",
+                fmt::format(
+                    "glare = \"{}\" is not available yet: glare models come with the glare stage; use \"none\".", *g));
+        if (*g != "none")
+            s.fail(s.get("glare"), "glare", fmt::format("unknown glare model \"{}\"; it must be \"none\".", *g));
+    }
+    return adaptation;
+}
+
+// ---------------------------------------------------------------------------
+// Lights.
+
+/// The colour key of a light: IALA name, xy or SPD name (at most one; default white).
+glm::dvec3 read_colour(const Section& s) {
+    if (auto name = s.string("colour")) {
+        if (auto rgb = iala_colour_rgb(*name)) return *rgb;
+        s.fail(s.get("colour"), "colour",
+               fmt::format("unknown colour \"{}\"; IALA colours are {} (or give xy or spd).", *name,
+                           join(iala_colour_names(), "\"")));
+    }
+    if (auto xy = s.numbers("xy", 2)) {
+        const double x = (*xy)[0];
+        const double y = (*xy)[1];
+        if (!(x >= 0.0 && y > 0.0 && x + y <= 1.0))
+            s.fail(s.get("xy"), "xy",
+                   fmt::format("xy = [{}, {}] is not a chromaticity: it needs x >= 0, y > 0 and x + y <= 1.",
+                               number_text(x), number_text(y)));
+        return normalised_rgb_from_xy(glm::dvec2(x, y), /*clip_to_gamut=*/true);
+    }
+    if (auto spd = s.string("spd")) {
+        if (auto spectrum = named_spectrum(*spd)) return normalised_rgb_from_spectrum(*spectrum);
+        s.fail(s.get("spd"), "spd",
+               fmt::format("unknown spectrum \"{}\"; named spectra are {}.", *spd, join(spectrum_names(), "\"")));
+    }
+    return *iala_colour_rgb("white");
+}
+
+struct SceneBuilder {
+    const Document& doc;
+    Scene& scene;
+    const Profiles& profiles;
+    std::map<std::string, std::string> names;  // light name -> key of the light that took it
+
+    int vertical_index(const Section& s, const std::string& name) {
+        if (auto it = profiles.vertical.find(name); it != profiles.vertical.end())
+            return intern(scene.profiles.vertical, it->second);
+        if (contains(kBuiltinVertical, name)) return intern(scene.profiles.vertical, builtin_vertical(name));
+        std::vector<std::string> known(std::begin(kBuiltinVertical), std::end(kBuiltinVertical));
+        for (const auto& [n, p] : profiles.vertical) known.push_back(n);
+        s.fail(s.get("vertical_profile"), "vertical_profile",
+               fmt::format("unknown vertical profile \"{}\"; known profiles are {}.", name, join(known, "\"")));
+    }
+
+    int horizontal_index(const Section& s, const std::string& name) {
+        if (auto it = profiles.horizontal.find(name); it != profiles.horizontal.end())
+            return intern(scene.profiles.horizontal, it->second);
+        if (name == "uniform") return intern(scene.profiles.horizontal, HorizontalProfile::uniform());
+        std::vector<std::string> known(std::begin(kBuiltinHorizontal), std::end(kBuiltinHorizontal));
+        for (const auto& [n, p] : profiles.horizontal) known.push_back(n);
+        s.fail(s.get("horizontal_profile"), "horizontal_profile",
+               fmt::format("unknown horizontal profile \"{}\"; known profiles are {}.", name, join(known, "\"")));
+    }
+
+    void claim_name(const Section& s, const std::string& name) {
+        const toml::node* at = s.has("name") ? s.get("name") : &s.table();
+        if (auto it = names.find(name); it != names.end())
+            s.fail(at, "name",
+                   fmt::format("the light name \"{}\" is already used by {}; names must be unique.", name, it->second));
+        names.emplace(name, s.path());
+    }
+
+    void read_light(const toml::node& node, std::size_t index) {
+        const std::string path = fmt::format("light[{}]", index);
+        if (!node.is_table())
+            doc.fail(&node, path,
+                     fmt::format("each light must be a [[light]] table, got {}.", type_phrase(node.type())));
+        Section s(doc, *node.as_table(), path, fmt::format("[[light]] number {} ({})", index + 1, path));
+        s.allow(kLightKeys);
+
+        Light light;
+        light.name = s.string("name").value_or(fmt::format("light{}", index));
+        if (light.name.empty()) s.fail(s.get("name"), "name", "a light's name must not be empty.");
+        s.set_context(fmt::format("in light \"{}\", ", light.name));
+        s.set_title(fmt::format("[[light]] \"{}\" ({})", light.name, path));
+
+        auto position = s.vec3("position_m");
+        if (!position) s.missing("position_m", "the light's position [x, y, z] in metres");
+        light.position_m = *position;
+        light.intensity_cd = s.required_number("intensity_cd", "the light's peak luminous intensity in cd");
+        s.at_least("intensity_cd", light.intensity_cd, 0.0);
+        light.radius_m = s.number_or("radius_m", light.radius_m);
+        s.greater_than("radius_m", light.radius_m, 0.0);
+
+        const std::vector<std::string_view> colour_keys = {"colour", "xy", "spd"};
+        std::vector<std::string_view> given;
+        for (auto k : colour_keys)
+            if (s.has(k)) given.push_back(k);
+        if (given.size() > 1)
+            s.fail(s.get(given[1]), given[1],
+                   fmt::format("give only one of colour, xy and spd; this light has {}.", join(given)));
+        light.rgb_per_cd = read_colour(s);
+
+        light.orientation = orientation_from_yaw_pitch_roll(s.number_or("yaw_deg", 0.0), s.number_or("pitch_deg", 0.0),
+                                                            s.number_or("roll_deg", 0.0));
+
+        light.vertical_profile = vertical_index(s, s.string("vertical_profile").value_or("uniform"));
+        if (s.has("sectors") && s.has("horizontal_profile"))
+            s.fail(s.get("sectors"), "sectors", "give either horizontal_profile or sectors, not both.");
+        if (s.has("sectors"))
+            light.horizontal_profile =
+                intern(scene.profiles.horizontal, horizontal_from_sectors(s, read_sectors(doc, s, "sectors")));
+        else
+            light.horizontal_profile = horizontal_index(s, s.string("horizontal_profile").value_or("uniform"));
+
+        RhythmTiming timing;
+        timing.ramp_s = s.number_or("ramp_s", timing.ramp_s);
+        s.at_least("ramp_s", timing.ramp_s, 0.0);
+        light.rhythm_phase_s = s.number_or("rhythm_phase_s", 0.0);
+        const std::string rhythm_text = s.string("rhythm").value_or("F");
+        Rhythm rhythm;
+        try {
+            rhythm = parse_rhythm(rhythm_text, timing);
+        } catch (const InputError& e) {
+            // The parser's sentence starts "rhythm 'TEXT': "; ours already names it.
+            std::string why = e.message();
+            for (const std::string& prefix :
+                 {fmt::format("rhythm '{}': ", rhythm_text), fmt::format("rhythm \"{}\": ", rhythm_text)})
+                if (why.starts_with(prefix)) why.erase(0, prefix.size());
+            if (!why.empty() && why.back() != '.') why += '.';
+            s.fail(s.has("rhythm") ? s.get("rhythm") : &s.table(), "rhythm",
+                   fmt::format("invalid rhythm \"{}\": {}", rhythm_text, why));
+        }
+        if (rhythm.channels.empty())
+            s.fail(s.get("rhythm"), "rhythm", fmt::format("the rhythm \"{}\" has no channel.", rhythm_text));
+        light.rhythm_period_s = rhythm.period_s;
+
+        // A character that names its colours (Al.WR) gives each channel the
+        // colour of its chart letter; the light's own colour keys would conflict.
+        const bool chart_colours = std::any_of(rhythm.channels.begin(), rhythm.channels.end(),
+                                               [](const RhythmChannel& c) { return !c.colour.empty(); });
+        if (chart_colours && !given.empty())
+            s.fail(s.get(given[0]), given[0],
+                   fmt::format("the rhythm \"{}\" gives the colours itself; remove {}.", rhythm_text, given[0]));
+
+        const toml::node* name_node = s.has("name") ? s.get("name") : &s.table();
+        if (rhythm.channels.size() == 1) {
+            const RhythmChannel& channel = rhythm.channels.front();
+            if (!channel.colour.empty()) light.rgb_per_cd = chart_letter_rgb(s, channel.colour, rhythm_text);
+            light.rhythm = channel.knots;
+            claim_name(s, light.name);
+            scene.lights.push_back(std::move(light));
+            return;
+        }
+        // Alternating: one light per channel, "NAME/W", "NAME/R", ...
+        claim_name(s, light.name);
+        for (const RhythmChannel& channel : rhythm.channels) {
+            Light l = light;
+            l.name = fmt::format("{}/{}", light.name, channel.colour);
+            l.rgb_per_cd = chart_letter_rgb(s, channel.colour, rhythm_text);
+            l.rhythm = channel.knots;
+            if (auto it = names.find(l.name); it != names.end())
+                s.fail(name_node, "name",
+                       fmt::format("the alternating rhythm makes a light \"{}\", a name already used by {}.", l.name,
+                                   it->second));
+            names.emplace(l.name, s.path());
+            scene.lights.push_back(std::move(l));
+        }
+    }
+
+    glm::dvec3 chart_letter_rgb(const Section& s, const std::string& letter, const std::string& rhythm_text) {
+        if (auto name = iala_colour_from_chart_letter(letter))
+            if (auto rgb = iala_colour_rgb(*name)) return *rgb;
+        s.fail(s.get("rhythm"), "rhythm",
+               fmt::format("the rhythm \"{}\" names the colour letter \"{}\", which is not an IALA colour.",
+                           rhythm_text, letter));
+    }
+};
+
+Scene build_scene(const Document& doc, const toml::table& root_table) {
+    Section root(doc, root_table, "", "the scene");
+    {
+        // Unknown top-level tables are reported with the list of sections.
+        for (auto&& [k, v] : root_table) {
+            if (contains(kSections, k.str())) continue;
+            if (k.str() == kLaterTonemap) throw InputError(doc.where(k, std::string(k.str())), kTonemapNotYet);
+            throw InputError(
+                doc.where(k, std::string(k.str())),
+                fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key", k.str(),
+                            suggestion(k.str(), kSections), join(kSections)));
+        }
+    }
+    Scene scene;
+    scene.display = read_display(doc, root);
+    scene.camera = read_camera(doc, root);
+    scene.environment = read_environment(doc, root);
+    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment);
+    const Profiles profiles = read_profiles(doc, root);
+
+    if (const toml::node* lights = root.get("light")) {
+        if (!lights->is_array())
+            root.fail(lights, "light",
+                      fmt::format("expected an array of [[light]] tables, got {}; write [[light]], not [light].",
+                                  type_phrase(lights->type())));
+        SceneBuilder builder{doc, scene, profiles, {}};
+        const toml::array& a = *lights->as_array();
+        for (std::size_t i = 0; i < a.size(); ++i) builder.read_light(*a.get(i), i);
+    }
+    return scene;
+}
+
+// ---------------------------------------------------------------------------
+// Overrides.
+
+[[noreturn]] void override_error(const std::string& key, const std::string& message) {
+    throw InputError(SourceLocation{std::string(kSetFile), 0, 0, key}, message);
+}
+
+/// A TOML basic string holding `text`, for values that are not valid TOML.
+std::string toml_quoted(std::string_view text) {
+    std::string q = "\"";
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (ch == '"' || ch == '\\') {
+            q += '\\';
+            q += ch;
+        } else if (c < 0x20 || c == 0x7f) {
+            q += fmt::format("\\u{:04X}", static_cast<unsigned>(c));
+        } else {
+            q += ch;
+        }
+    }
+    return q + "\"";
+}
+
+/// The parsed value of an override, with source path "--set KEY". A value that
+/// is not valid TOML is taken as a string (so `colour=red` needs no quotes);
+/// `note` then says so, for the type error that usually follows a typo.
+toml::table parse_override_value(const SceneOverride& o, std::string& note) {
+    const std::string source = std::string(kSetPrefix) + o.key;
+    try {
+        return toml::parse("v = " + o.value, std::string_view(source));
+    } catch (const toml::parse_error& e) {
+        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", o.value,
+                           std::string(e.description()));
+    }
+    try {
+        return toml::parse("v = " + toml_quoted(o.value), std::string_view(source));
+    } catch (const toml::parse_error& e) {
+        override_error(o.key,
+                       fmt::format("the value \"{}\" cannot be read: {}.", o.value, std::string(e.description())));
+    }
+}
+
+bool is_number(const toml::node& n) {
+    return n.is_integer() || n.is_floating_point();
+}
+
+/// The table that holds the overridden key, created if absent (and remembered
+/// so that errors about it name the override).
+toml::table& table_for_override(Document& doc, toml::table& parent, std::string_view name, const std::string& typed,
+                                const std::string& shown) {
+    toml::node* n = parent.get(name);
+    if (n == nullptr) {
+        auto [it, inserted] = parent.insert(name, toml::table{});
+        doc.note_made_for_override(&it->second, typed);
+        return *it->second.as_table();
+    }
+    if (!n->is_table()) {
+        const SourceLocation w = doc.where(n, shown);
+        override_error(typed, fmt::format("cannot set {}: {} is {} in {}:{}, not a table.", typed, shown,
+                                          type_phrase(n->type()), w.file, w.line));
+    }
+    return *n->as_table();
+}
+
+/// The [[light]] table an override addresses: "light[INDEX].key" or
+/// "light.NAME.key" (NAME may contain dots; the key after the last dot never does).
+std::pair<toml::table*, std::string> light_for_override(const Document& doc, toml::table& root, const SceneOverride& o,
+                                                        std::string& key) {
+    toml::node* node = root.get("light");
+    if (node == nullptr || !node->is_array() || node->as_array()->empty())
+        override_error(o.key, "the scene has no [[light]] tables to override.");
+    toml::array& lights = *node->as_array();
+    const std::string& k = o.key;
+    const auto last_dot = k.rfind('.');
+    if (last_dot == std::string::npos || last_dot == k.size() - 1)
+        override_error(o.key, "a light key is written light.NAME.KEY or light[INDEX].KEY.");
+    key = k.substr(last_dot + 1);
+
+    std::size_t index = 0;
+    if (k.starts_with("light[")) {
+        const auto close = k.find(']');
+        const std::string digits = k.substr(6, close == std::string::npos ? 0 : close - 6);
+        if (close == std::string::npos || close + 1 != last_dot || digits.empty() ||
+            !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+            digits.size() > 6)
+            override_error(o.key, "a light key is written light.NAME.KEY or light[INDEX].KEY.");
+        index = static_cast<std::size_t>(std::stoul(digits));
+        if (index >= lights.size())
+            override_error(
+                o.key, fmt::format("there is no light[{}]: the scene has {} light{} (light[0] to light[{}]).", index,
+                                   lights.size(), lights.size() == 1 ? "" : "s", lights.size() - 1));
+    } else {
+        const std::string name = k.substr(6, last_dot - 6);  // after "light."
+        std::vector<std::string> known;
+        bool found = false;
+        for (std::size_t i = 0; i < lights.size(); ++i) {
+            std::string light_name = fmt::format("light{}", i);
+            if (const toml::table* t = lights.get(i)->as_table())
+                if (const toml::node* n = t->get("name"); n != nullptr && n->is_string())
+                    light_name = n->as_string()->get();
+            if (light_name == name && !found) {
+                index = i;
+                found = true;
+            }
+            known.push_back(light_name);
+        }
+        if (!found)
+            override_error(o.key, fmt::format("no light is named \"{}\"; the lights are {}.", name, join(known, "\"")));
+    }
+    toml::node* light = lights.get(index);
+    if (!light->is_table()) {
+        const SourceLocation w = doc.where(light, fmt::format("light[{}]", index));
+        override_error(o.key, fmt::format("light[{}] in {}:{} is not a table.", index, w.file, w.line));
+    }
+    return {light->as_table(), fmt::format("light[{}]", index)};
+}
+
+void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
+    const std::string& k = o.key;
+    toml::table* target = nullptr;
+    std::string key;         // the key inside *target
+    std::string schema_key;  // canonical dotted path, e.g. "light[0].intensity_cd"
+
+    const auto unknown = [&](std::string_view section, KeyList allowed, std::string_view leaf) {
+        override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", leaf, section,
+                                      suggestion(leaf, allowed), join(allowed)));
+    };
+
+    if (k == "light" || k.starts_with("light.") || k.starts_with("light[")) {
+        auto [table, path] = light_for_override(doc, root, o, key);
+        if (!contains(kLightKeys, key)) unknown("[light]", kLightKeys, key);
+        target = table;
+        schema_key = path + "." + key;
+    } else if (k.starts_with("profiles.")) {
+        // profiles.KIND.NAME.KEY (NAME may contain dots)
+        const std::string rest = k.substr(9);
+        const auto kind_end = rest.find('.');
+        const auto last_dot = rest.rfind('.');
+        if (kind_end == std::string::npos || last_dot == kind_end)
+            override_error(k, "a profile key is written profiles.vertical.NAME.KEY or profiles.horizontal.NAME.KEY.");
+        const std::string kind = rest.substr(0, kind_end);
+        const std::string name = rest.substr(kind_end + 1, last_dot - kind_end - 1);
+        key = rest.substr(last_dot + 1);
+        if (!contains(kProfileKinds, kind))
+            override_error(k, fmt::format("unknown profile kind '{}'; it must be 'vertical' or 'horizontal'.", kind));
+        const KeyList allowed = kind == "vertical" ? KeyList(kVerticalKeys) : KeyList(kHorizontalKeys);
+        if (!contains(allowed, key)) unknown(fmt::format("profiles.{}.{}", kind, name), allowed, key);
+        toml::table& profiles = table_for_override(doc, root, "profiles", k, "profiles");
+        toml::table& kinds = table_for_override(doc, profiles, kind, k, "profiles." + kind);
+        target = &table_for_override(doc, kinds, name, k, fmt::format("profiles.{}.{}", kind, name));
+        schema_key = fmt::format("profiles.{}.{}.{}", kind, name, key);
+    } else {
+        const auto dot = k.find('.');
+        const std::string section = k.substr(0, dot);
+        if (section == kLaterTonemap) override_error(k, kTonemapNotYet);
+        if (!contains(kSections, section))
+            override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", k, join(kSections)));
+        if (dot == std::string::npos || dot + 1 == k.size())
+            override_error(k, fmt::format("--set takes a key inside [{}], e.g. {}.{}.", section, section,
+                                          section == "display" ? "width_px" : "yaw_deg"));
+        key = k.substr(dot + 1);
+        const KeyList allowed = section == "display"       ? KeyList(kDisplayKeys)
+                                : section == "camera"      ? KeyList(kCameraKeys)
+                                : section == "environment" ? KeyList(kEnvironmentKeys)
+                                                           : KeyList(kEyeKeys);
+        if (!contains(allowed, key)) unknown(section, allowed, key);
+        target = &table_for_override(doc, root, section, k, section);
+        schema_key = k;
+    }
+
+    std::string note;
+    toml::table parsed = parse_override_value(o, note);
+    toml::node* value = parsed.get("v");
+
+    // The new value must have the type of the one it replaces (integers and
+    // floats are interchangeable); values the file leaves at their default are
+    // type-checked by the schema afterwards.
+    if (const toml::node* old = target->get(key)) {
+        const bool same = old->type() == value->type() || (is_number(*old) && is_number(*value));
+        if (!same) {
+            const SourceLocation w = doc.where(old, schema_key);
+            const std::string from =
+                w.file == kSetFile ? std::string("an earlier --set") : fmt::format("{}:{}", w.file, w.line);
+            override_error(k, fmt::format("expected {} like the value it replaces ({}), got {}{}.",
+                                          is_number(*old) ? std::string_view("a number") : type_phrase(old->type()),
+                                          from, type_phrase(value->type()), note));
+        }
+    }
+    for (const auto& group : exclusive_groups()) {
+        if (std::find(group.begin(), group.end(), key) == group.end()) continue;
+        for (std::string_view other : group)
+            if (other != key) target->erase(other);
+    }
+    doc.note_override(k, schema_key);
+    doc.note_string_fallback(k, note);
+    value->visit([&](auto& concrete) { target->insert_or_assign(key, std::move(concrete)); });
+}
+
+}  // namespace
+
+SceneOverride SceneOverride::parse(std::string_view text) {
+    const auto trim = [](std::string_view s) {
+        while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+        while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+        return s;
+    };
+    const auto eq = text.find('=');
+    if (eq == std::string_view::npos)
+        throw InputError(SourceLocation{std::string(kSetFile), 0, 0, std::string(trim(text))},
+                         fmt::format("expected KEY=VALUE, e.g. camera.yaw_deg=45, got \"{}\".", text));
+    SceneOverride o;
+    o.key = std::string(trim(text.substr(0, eq)));
+    o.value = std::string(trim(text.substr(eq + 1)));
+    if (o.key.empty())
+        throw InputError(SourceLocation{std::string(kSetFile), 0, 0, ""},
+                         fmt::format("the key before '=' is empty in \"{}\".", text));
+    return o;
+}
+
+Scene parse_scene(std::string_view toml_text, std::string_view file_label,
+                  const std::vector<SceneOverride>& overrides) {
+    Document doc{std::string(file_label)};
+    toml::table root;
+    try {
+        root = toml::parse(toml_text, file_label);
+    } catch (const toml::parse_error& e) {
+        throw InputError(SourceLocation{std::string(file_label), static_cast<int>(e.source().begin.line),
+                                        static_cast<int>(e.source().begin.column), ""},
+                         fmt::format("TOML syntax error: {}.", std::string(e.description())));
+    }
+    for (const SceneOverride& o : overrides) apply_override(doc, root, o);
+    return build_scene(doc, root);
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+    std::FILE* f = std::fopen(file.c_str(), "rb");
+    if (f == nullptr)
+        throw InputError(
+            SourceLocation{file.string(), 0, 0, ""},
+            fmt::format("cannot read the scene file: {}.", std::error_code(errno, std::generic_category()).message()));
+    std::string text;
+    char buffer[65536];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed)
+        throw InputError(SourceLocation{file.string(), 0, 0, ""}, "cannot read the scene file: a read error occurred.");
+    return parse_scene(text, file.string(), overrides);
+}
+
+}  // namespace atonlab::stimuli
