@@ -72,7 +72,27 @@ int run_render(const RenderOptions& o) {
     meta.strings["scene"] = o.scene;
     meta.strings["time_s"] = fmt::format("{}", o.time_s);
     meta.strings["software"] = "atonlab " ATONLAB_VERSION;
-    stimuli::write_exr(o.exr, hdr, meta, o.half ? stimuli::ExrPixelType::half : stimuli::ExrPixelType::float32);
+    if (o.half) {
+        // Half floats end at 65504; the core of a bright light is far above that
+        // (a 250 cd, 0.1 m light is ~8000 cd/m² ... 1e9 cd/m² sub-pixel). Clamp rather
+        // than write +inf, and say so: half EXRs are for viewing, not photometry.
+        constexpr float half_max = 65504.0f;
+        std::size_t clamped = 0;
+        stimuli::ImageRGBA32F h = hdr;
+        for (float& v : h.rgba)
+            if (v > half_max) {
+                v = half_max;
+                ++clamped;
+            }
+        if (clamped > 0)
+            std::fprintf(stderr,
+                         "atonlab: warning: %zu values exceed the half-float range (65504 cd/m2) and were clamped in "
+                         "%s; write a 32-bit EXR (no --half) for photometric work\n",
+                         clamped, o.exr.c_str());
+        stimuli::write_exr(o.exr, h, meta, stimuli::ExrPixelType::half);
+    } else {
+        stimuli::write_exr(o.exr, hdr, meta, stimuli::ExrPixelType::float32);
+    }
     if (!o.png.empty()) {
         try {
             const double white = o.white_cd_m2.value_or(20.0 * scene.adaptation_cd_m2);
