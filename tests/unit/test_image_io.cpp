@@ -1,6 +1,8 @@
 // Image I/O: EXR and PNG round trips, header attributes, and failures that
 // must throw InputError naming the path and leave nothing behind.
 #include <gtest/gtest.h>
+
+#include "input_error.h"
 #include <png.h>
 #include <unistd.h>
 
@@ -62,14 +64,7 @@ ImageRGBA32F test_image(int w, int h) {
     return im;
 }
 
-std::string what_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no InputError thrown)";
-}
+std::string what_of(const std::function<void()>& f) { return atonlab::test::input_error_of(f); }
 
 TEST_F(ImageIo, FloatRoundTripIsExact) {
     const ImageRGBA32F im = test_image(7, 5);

@@ -2,6 +2,8 @@
 // builtin Sabik VP vertical profile, against values worked out by hand.
 #include <gtest/gtest.h>
 
+#include "input_error.h"
+
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -25,12 +27,7 @@ double p_of_elevation(double elevation_deg) {
 
 template <class F>
 std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(accepted)";
+    return atonlab::test::input_error_of(f, "(accepted)");
 }
 
 // ---- Vertical ----------------------------------------------------------------
