@@ -5,6 +5,7 @@
 
 flat in vec2 v_centre;
 flat in float v_area;
+flat in float v_radius;
 flat in vec3 v_illuminance;
 
 uniform vec2 image_size;
@@ -14,7 +15,7 @@ layout(location = 0) out vec4 radiance;
 
 void main() {
     vec2 p0 = floor(gl_FragCoord.xy);
-    float c = v_area >= 1.0 ? disc_pixel_coverage(v_centre, sqrt(v_area / 3.14159265358979), p0)
+    float c = v_area >= 1.0 ? disc_pixel_coverage(v_centre, v_radius, p0)
                             : box_pixel_coverage(v_centre, p0);
     if (c <= 0.0) discard;
     float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);

@@ -11,6 +11,7 @@ uniform vec2 image_size;
 
 flat out vec2 v_centre;
 flat out float v_area;
+flat out float v_radius;  // disc radius (px), for disc footprints
 flat out vec3 v_illuminance;
 
 void main() {
@@ -18,11 +19,12 @@ void main() {
     v_centre = d.centre.xy;
     v_area = d.centre.w;
     v_illuminance = d.illuminance.rgb;
+    v_radius = sqrt(max(d.centre.w, 0.0) / 3.14159265358979);
     if (d.centre.w <= 0.0) {  // not drawn: a degenerate quad outside the clip volume
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
         return;
     }
-    float half_extent = (d.centre.w >= 1.0 ? sqrt(d.centre.w / 3.14159265358979) : 0.5) + 1.0;
+    float half_extent = (d.centre.w >= 1.0 ? v_radius : 0.5) + 1.0;
     vec2 corner = vec2(gl_VertexID & 1, (gl_VertexID >> 1) & 1) * 2.0 - 1.0;
     vec2 p = d.centre.xy + corner * half_extent;
     gl_Position = vec4(p / image_size * 2.0 - 1.0, 0.0, 1.0);

@@ -89,6 +89,18 @@ struct FrameRenderer::Impl {
     }
 };
 
+namespace {
+// Per-frame data: keep the buffer and overwrite it while it is large enough,
+// so a steady scene allocates nothing frame to frame.
+void upload(gl::Buffer& buffer, const void* data, std::size_t bytes, gl::BufferUsage usage) {
+    if (!buffer || buffer.size() < bytes) {
+        buffer = gl::Buffer(bytes, data, usage);
+        return;
+    }
+    if (data) buffer.upload(0, bytes, data);
+}
+}  // namespace
+
 FrameRenderer::FrameRenderer() : impl_(std::make_unique<Impl>()) {}
 FrameRenderer::~FrameRenderer() = default;
 
@@ -123,11 +135,13 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     // 2. Per-light evaluation, projection and occlusion (compute).
     const GpuLightTables tables = pack_lights(scene, P.eye_position_m);
     m.light_count = static_cast<int>(scene.lights.size());
-    m.lights = gl::Buffer::from(std::span<const float>(tables.lights), gl::BufferUsage::stream_draw);
-    m.profiles = gl::Buffer::from(std::span<const float>(tables.profile_values), gl::BufferUsage::stream_draw);
-    m.knots = gl::Buffer::from(std::span<const glm::vec2>(tables.rhythm_knots), gl::BufferUsage::stream_draw);
-    m.draws = gl::Buffer(std::max<std::size_t>(1, scene.lights.size()) * 12 * sizeof(float), nullptr,
-                         gl::BufferUsage::dynamic_read);
+    upload(m.lights, tables.lights.data(), tables.lights.size() * sizeof(float), gl::BufferUsage::stream_draw);
+    upload(m.profiles, tables.profile_values.data(), tables.profile_values.size() * sizeof(float),
+           gl::BufferUsage::stream_draw);
+    upload(m.knots, tables.rhythm_knots.data(), tables.rhythm_knots.size() * sizeof(glm::vec2),
+           gl::BufferUsage::stream_draw);
+    upload(m.draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * 12 * sizeof(float),
+           gl::BufferUsage::dynamic_read);
     m.lights.bind_storage(0);
     m.profiles.bind_storage(1);
     m.knots.bind_storage(2);
