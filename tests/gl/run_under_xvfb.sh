@@ -10,7 +10,9 @@ for n in $(shuf -i 90-140); do
   lock="/tmp/.atonlab-xvfb-$n.lock"
   if [ ! -e "/tmp/.X$n-lock" ] && [ ! -e "/tmp/.X11-unix/X$n" ] && mkdir "$lock" 2>/dev/null; then
     trap 'rm -rf "$lock"' EXIT
-    xvfb-run -n "$n" -s "-screen 0 1280x720x24" "$program"
+    # -noreset: Xvfb otherwise resets when its last client disconnects, and a test
+    # that opens a new connection during that reset fails to open the display.
+    xvfb-run -n "$n" -s "-screen 0 1280x720x24 -noreset" "$program"
     exit $?
   fi
 done
