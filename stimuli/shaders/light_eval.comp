@@ -20,6 +20,7 @@ uniform float focal_px;
 uniform vec2 image_size;
 uniform double time_s;  // s; double, see rhythm_level()
 uniform float extinction_per_m;
+uniform float glare_extent_px;  // billboard half-extent (px) beyond the light's disc; 0 without glare
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -42,7 +43,11 @@ void main() {
         float omega = 2.0 * PI * s * s / (1.0 + sqrt((1.0 - s) * (1.0 + s)));
         float cos_a = depth / ev.distance;
         float area = omega * focal_px * focal_px / (cos_a * cos_a * cos_a);
-        // Occlusion by the scene, tested at the centre pixel (lights off-image are not tested).
+        // Occlusion by the scene, tested at the centre pixel against the linear
+        // view depth offset by the source radius (K2012 §5.3.2). The depth was
+        // written by an earlier pass; this compute pass only reads it. Lights
+        // whose centre is off the image cannot be tested and count as visible
+        // (their glare may still reach in; K2012 §4.3.2 multi-channel note).
         bool hidden = false;
         ivec2 pix = ivec2(floor(c));
         if (all(greaterThanEqual(pix, ivec2(0))) && all(lessThan(pix, ivec2(image_size)))) {
@@ -50,7 +55,7 @@ void main() {
             hidden = scene_depth < depth - radius;
         }
         // Cull what cannot touch the image: the footprint's extent beyond the edges.
-        float extent = (area >= 1.0 ? sqrt(area / PI) : 0.5) + 1.0;
+        float extent = (area >= 1.0 ? sqrt(area / PI) : 0.5) + 1.0 + glare_extent_px;
         bool outside = any(lessThan(c + extent, vec2(0.0))) || any(greaterThan(c - extent, image_size));
         if (!hidden && !outside) d.centre = vec4(c, depth, area);
     }

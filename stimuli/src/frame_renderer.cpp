@@ -12,6 +12,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "atonlab/stimuli/gl/context.h"
+#include "atonlab/stimuli/glare_stage.h"
 
 namespace atonlab::stimuli {
 
@@ -29,7 +30,7 @@ CameraProjection CameraProjection::from_scene(const Scene& scene) {
 
 double CameraProjection::degrees_per_pixel_at_centre() const { return 180.0 / std::numbers::pi / focal_px; }
 
-GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye) {
+GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const unsigned> glare_groups) {
     GpuLightTables t;
     // Profiles: every table once, lights refer to them by offset (K2012 §5.1 ids).
     std::vector<std::pair<std::uint32_t, std::uint32_t>> vert, hor;
@@ -42,7 +43,9 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye) {
         t.profile_values.insert(t.profile_values.end(), h.table.begin(), h.table.end());
     }
     auto bits = [](std::uint32_t u) { return std::bit_cast<float>(u); };
-    for (const Light& L : scene.lights) {
+    for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+        const Light& L = scene.lights[li];
+        const unsigned group = li < glare_groups.size() ? glare_groups[li] : 0u;
         const auto knot_offset = static_cast<std::uint32_t>(t.rhythm_knots.size());
         for (const RhythmKnot& k : L.rhythm)
             t.rhythm_knots.emplace_back(static_cast<float>(k.t_s), static_cast<float>(k.level));
@@ -56,7 +59,7 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye) {
             static_cast<float>(L.orientation.z), static_cast<float>(L.orientation.w),
             static_cast<float>(I.r), static_cast<float>(I.g), static_cast<float>(I.b), static_cast<float>(L.rhythm_phase_s),
             bits(v.first), bits(v.second), bits(h.first), bits(h.second),
-            bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(0), bits(0),
+            bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(group), bits(0),
             static_cast<float>(L.rhythm_period_s), 0.0f, 0.0f, 0.0f};
         t.lights.insert(t.lights.end(), std::begin(rec), std::end(rec));
     }
@@ -76,6 +79,7 @@ struct FrameRenderer::Impl {
     gl::Framebuffer fbo;
     gl::Buffer lights, profiles, knots, draws;
     int light_count = 0;
+    GlareStage glare;
 
     void resize(int w, int h) {
         if (hdr && hdr.width() == w && hdr.height() == h) return;
@@ -133,7 +137,10 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     glDrawArrays(GL_TRIANGLES, 0, 3);
 
     // 2. Per-light evaluation, projection and occlusion (compute).
-    const GpuLightTables tables = pack_lights(scene, P.eye_position_m);
+    // The glare kernels first: the light pass culls with the billboard's extent.
+    const double glare_extent_px = m.glare.prepare(scene, P, time_s);
+    const bool glare = scene.glare.model != GlareModel::none;
+    const GpuLightTables tables = pack_lights(scene, P.eye_position_m, m.glare.light_groups());
     m.light_count = static_cast<int>(scene.lights.size());
     upload(m.lights, tables.lights.data(), tables.lights.size() * sizeof(float), gl::BufferUsage::stream_draw);
     upload(m.profiles, tables.profile_values.data(), tables.profile_values.size() * sizeof(float),
@@ -155,6 +162,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         m.light_eval.set("image_size", w, h);
         m.light_eval.set("time_s", time_s);
         m.light_eval.set("extinction_per_m", static_cast<float>(env.extinction_per_m));
+        m.light_eval.set("glare_extent_px", static_cast<float>(glare_extent_px));
         m.light_eval.use();
         glDispatchCompute(static_cast<unsigned>((m.light_count + 63) / 64), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -166,10 +174,16 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
         glBlendEquation(GL_FUNC_ADD);
-        m.light_direct.set("image_size", w, h);
-        m.light_direct.set("focal_px", f);
-        m.light_direct.use();
-        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
+        if (glare) {
+            // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
+            m.glare.draw(m.light_count, P);
+        } else {
+            m.light_direct.set("image_size", w, h);
+            m.light_direct.set("focal_px", f);
+            m.light_direct.use();
+            m.vao.bind();
+            glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
+        }
         glDisable(GL_BLEND);
         const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
         glNamedFramebufferDrawBuffers(m.fbo.id(), 2, both);
@@ -228,6 +242,8 @@ FrameStats FrameRenderer::stats() const {
     for (const auto& d : read_light_draws()) s.drawn += d.area_px2 > 0 ? 1 : 0;
     return s;
 }
+
+const GlareStage& FrameRenderer::glare() const { return impl_->glare; }
 
 const gl::Texture2D& FrameRenderer::hdr_texture() const { return impl_->hdr; }
 const gl::Texture2D& FrameRenderer::view_depth_texture() const { return impl_->depth; }

@@ -16,6 +16,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -27,6 +29,7 @@
 #include "atonlab/stimuli/atmosphere.h"
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/light_model.h"  // orientation_from_yaw_pitch_roll: the camera's convention
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -43,12 +46,19 @@ constexpr std::string_view kSetPrefix = "--set ";  // source path of an override
 
 using KeyList = std::span<const std::string_view>;
 
-constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "profiles", "light"};
+constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "profiles", "light"};
 constexpr std::string_view kDisplayKeys[] = {"width_px", "height_px", "width_m", "viewing_distance_m"};
 constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
-constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare"};
+constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm"};
+constexpr std::string_view kGlareKeys[] = {
+    "psf_size", "spectral_samples", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
+    "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
+    "fresnel_distance_mm", "supersampling", "clear_pupil", "hippus", "hippus_amplitude", "gratings", "grating_count",
+    "grating_inner_radius_mm", "grating_width_um", "grating_opacity", "lens_particles", "lens_particle_count",
+    "lens_particle_diameter_um", "vitreous_particles", "vitreous_particle_count", "vitreous_particle_diameter_um",
+    "eyelashes", "eyelash_count", "eyelash_width_um", "eyelid", "eyelid_edge_mm"};
 constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
 constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
 constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};
@@ -76,7 +86,6 @@ constexpr std::string_view kBuiltinHorizontal[] = {"uniform"};
 constexpr std::string_view kLaterTonemap = "tonemap";
 const std::string kTonemapNotYet =
     "the [tonemap] table is not available yet: tone mapping comes with the tone-mapping stage; remove it.";
-constexpr std::string_view kLaterGlare[] = {"wave-optics", "gaussian-bloom", "spencer", "kakimoto"};
 
 bool contains(KeyList list, std::string_view key) {
     return std::find(list.begin(), list.end(), key) != list.end();
@@ -290,6 +299,13 @@ public:
         const std::int64_t v = n->as_integer()->get();
         if (v < min || v > max) fail(n, key, fmt::format("{} must be between {} and {}, got {}.", key, min, max, v));
         return static_cast<int>(v);
+    }
+
+    std::optional<bool> boolean(std::string_view key) const {
+        const toml::node* n = get(key);
+        if (n == nullptr) return std::nullopt;
+        if (!n->is_boolean()) fail(n, key, fmt::format("expected true or false, got {}.", type_phrase(n->type())));
+        return n->as_boolean()->get();
     }
 
     std::optional<std::string> string(std::string_view key) const {
@@ -648,8 +664,8 @@ Environment read_environment(const Document& doc, const Section& root) {
     return e;
 }
 
-/// Returns Scene::adaptation_cd_m2.
-double read_eye(const Document& doc, const Section& root, const Environment& environment) {
+/// Returns Scene::adaptation_cd_m2; sets the glare model and pupil.
+double read_eye(const Document& doc, const Section& root, const Environment& environment, GlareSettings& glare) {
     const double fallback = environment.luminance_cd_m2 > 0.0 ? environment.luminance_cd_m2 : 0.001;
     const toml::table* t = sub_table(root, "eye", "[eye]");
     if (t == nullptr) return fallback;
@@ -667,15 +683,107 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
     const double adaptation = s.number_or("adaptation_cd_m2", fallback);
     s.greater_than("adaptation_cd_m2", adaptation, 0.0);
     if (auto g = s.string("glare")) {
-        if (contains(kLaterGlare, *g))
-            s.fail(
-                s.get("glare"), "glare",
-                fmt::format(
-                    "glare = \"{}\" is not available yet: glare models come with the glare stage; use \"none\".", *g));
-        if (*g != "none")
-            s.fail(s.get("glare"), "glare", fmt::format("unknown glare model \"{}\"; it must be \"none\".", *g));
+        auto model = glare_model_from_name(*g);
+        if (!model)
+            s.fail(s.get("glare"), "glare",
+                   fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
+                               "\"spencer\" or \"aperture\".",
+                               *g));
+        glare.model = *model;
+    }
+    if (auto p = s.number("pupil_mm")) {
+        s.greater_than("pupil_mm", *p, 0.0);
+        s.within("pupil_mm", *p, 0.5, 12.0);
+        glare.pupil_mm = *p;
     }
     return adaptation;
+}
+
+/// The [glare] table: the glare stage's settings and the eye model (docs/scene-file.md).
+void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
+    const toml::table* t = sub_table(root, "glare", "[glare]");
+    if (t == nullptr) return;
+    Section s(doc, *t, "glare", "the [glare] table");
+    s.allow(kGlareKeys);
+    EyeModel& e = g.eye;
+    if (s.boolean("clear_pupil").value_or(false)) e = EyeModel::clear_pupil(e.pupil_diameter_mm);
+    g.psf_size = s.integer("psf_size", 16, 2048).value_or(g.psf_size);
+    if (!is_power_of_two(g.psf_size))
+        s.fail(s.get("psf_size"), "psf_size",
+               fmt::format("psf_size must be a power of two (the FFT needs one), got {}.", g.psf_size));
+    g.spectral_samples = s.integer("spectral_samples", 1, 128).value_or(g.spectral_samples);
+    if (auto w = s.string("window")) {
+        try {
+            g.window = glare_window_from_name(*w);
+        } catch (const InputError& err) {
+            s.fail(s.get("window"), "window", err.message());
+        }
+    }
+    if (auto r = s.number("radius_deg")) {
+        s.greater_than("radius_deg", *r, 0.0);
+        s.within("radius_deg", *r, 0.0, 45.0);
+        g.radius_deg = *r;
+    }
+    g.area_layers = s.integer("area_layers", 2, 256).value_or(g.area_layers);
+    g.bloom_sigma_deg = s.number_or("bloom_sigma_deg", g.bloom_sigma_deg);
+    s.greater_than("bloom_sigma_deg", g.bloom_sigma_deg, 0.0);
+    if (auto v = s.string("spencer_vision")) {
+        if (*v == "photopic") g.spencer_vision = SpencerVision::photopic;
+        else if (*v == "mesopic") g.spencer_vision = SpencerVision::mesopic;
+        else if (*v == "scotopic") g.spencer_vision = SpencerVision::scotopic;
+        else if (*v != "auto")
+            s.fail(s.get("spencer_vision"), "spencer_vision",
+                   fmt::format("unknown vision \"{}\"; it must be \"photopic\", \"mesopic\", \"scotopic\" or \"auto\".",
+                               *v));
+    }
+    if (auto img = s.string("aperture_image")) {
+        // Relative to the scene file, like every path in it.
+        std::filesystem::path p(*img);
+        if (p.is_relative() && doc.file() != kSetFile) p = std::filesystem::path(doc.file()).parent_path() / p;
+        if (!std::filesystem::is_regular_file(p))
+            s.fail(s.get("aperture_image"), "aperture_image",
+                   fmt::format("the aperture image {} does not exist or is not a file.", p.string()));
+        g.aperture_image = p.string();
+    }
+    g.aperture_width_mm = s.number_or("aperture_width_mm", g.aperture_width_mm);
+    s.greater_than("aperture_width_mm", g.aperture_width_mm, 0.0);
+    g.aperture_with_pupil = s.boolean("aperture_with_pupil").value_or(g.aperture_with_pupil);
+
+    if (auto seed = s.integer("seed", 0, std::numeric_limits<int>::max())) e.seed = static_cast<std::uint64_t>(*seed);
+    if (auto h = s.number("halo_radius_deg")) {
+        s.at_least("halo_radius_deg", *h, 0.0);
+        e.halo_radius_deg = *h > 0 ? std::optional<double>(*h) : std::nullopt;  // 0: physical scale
+    }
+    e.plane_width_mm = s.number_or("plane_width_mm", e.plane_width_mm);
+    e.fresnel_distance_mm = s.number_or("fresnel_distance_mm", e.fresnel_distance_mm);
+    e.supersampling = s.integer("supersampling", 1, 16).value_or(e.supersampling);
+    e.hippus.enabled = s.boolean("hippus").value_or(e.hippus.enabled);
+    e.hippus.amplitude = s.number_or("hippus_amplitude", e.hippus.amplitude);
+    e.gratings.enabled = s.boolean("gratings").value_or(e.gratings.enabled);
+    e.gratings.count = s.integer("grating_count", 0, 100000).value_or(e.gratings.count);
+    e.gratings.inner_radius_mm = s.number_or("grating_inner_radius_mm", e.gratings.inner_radius_mm);
+    e.gratings.width_um = s.number_or("grating_width_um", e.gratings.width_um);
+    e.gratings.opacity = s.number_or("grating_opacity", e.gratings.opacity);
+    e.lens_particles.enabled = s.boolean("lens_particles").value_or(e.lens_particles.enabled);
+    e.lens_particles.count = s.integer("lens_particle_count", 0, 1000000).value_or(e.lens_particles.count);
+    e.lens_particles.diameter_um = s.number_or("lens_particle_diameter_um", e.lens_particles.diameter_um);
+    e.vitreous_particles.enabled = s.boolean("vitreous_particles").value_or(e.vitreous_particles.enabled);
+    e.vitreous_particles.count = s.integer("vitreous_particle_count", 0, 1000000).value_or(e.vitreous_particles.count);
+    e.vitreous_particles.diameter_um = s.number_or("vitreous_particle_diameter_um", e.vitreous_particles.diameter_um);
+    e.eyelashes.enabled = s.boolean("eyelashes").value_or(e.eyelashes.enabled);
+    e.eyelashes.count = s.integer("eyelash_count", 0, 10000).value_or(e.eyelashes.count);
+    e.eyelashes.width_um = s.number_or("eyelash_width_um", e.eyelashes.width_um);
+    e.eyelid.enabled = s.boolean("eyelid").value_or(e.eyelid.enabled);
+    e.eyelid.edge_mm = s.number_or("eyelid_edge_mm", e.eyelid.edge_mm);
+    // The eye model's own checks (the pupil is checked per frame, where it is known).
+    try {
+        EyeModel probe = e;
+        probe.pupil_diameter_mm = std::min(probe.pupil_diameter_mm, 0.25 * probe.plane_width_mm);
+        probe.validate(g.psf_size);
+    } catch (const InputError& err) {
+        const std::string key = err.where() ? err.where()->key : std::string();
+        s.fail_table(fmt::format("the eye model is invalid ({}): {}", key, err.message()));
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -770,6 +878,7 @@ struct SceneBuilder {
             s.fail(s.get(given[1]), given[1],
                    fmt::format("give only one of colour, xy and spd; this light has {}.", join(given)));
         light.rgb_per_cd = read_colour(s);
+        light.spd = s.string("spd").value_or("");
 
         light.orientation = orientation_from_yaw_pitch_roll(s.number_or("yaw_deg", 0.0), s.number_or("pitch_deg", 0.0),
                                                             s.number_or("roll_deg", 0.0));
@@ -864,7 +973,8 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     scene.display = read_display(doc, root);
     scene.camera = read_camera(doc, root);
     scene.environment = read_environment(doc, root);
-    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment);
+    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare);
+    read_glare(doc, root, scene.glare);
     const Profiles profiles = read_profiles(doc, root);
 
     if (const toml::node* lights = root.get("light")) {
@@ -1044,6 +1154,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
         const KeyList allowed = section == "display"       ? KeyList(kDisplayKeys)
                                 : section == "camera"      ? KeyList(kCameraKeys)
                                 : section == "environment" ? KeyList(kEnvironmentKeys)
+                                : section == "glare"       ? KeyList(kGlareKeys)
                                                            : KeyList(kEyeKeys);
         if (!contains(allowed, key)) unknown(section, allowed, key);
         target = &table_for_override(doc, root, section, k, section);

@@ -33,21 +33,6 @@ Scene black_scene() {
     return s;
 }
 
-// Σ Y·Ω over the image, Ω the exact pinhole solid angle of each pixel (lux).
-double image_illuminance_lux(const ImageRGBA32F& img, double focal_px) {
-    double sum = 0.0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            const float* p = img.pixel(x, y);
-            const double Y = luminance_of_linear_rgb({p[0], p[1], p[2]});
-            if (Y == 0.0) continue;
-            // read_hdr() is top-down; pixel row y covers window rows [H-1-y, H-y].
-            const double x0 = x - 0.5 * img.width, y0 = (img.height - 1 - y) - 0.5 * img.height;
-            sum += Y * pixel_solid_angle_sr(x0, y0, focal_px);
-        }
-    return sum;
-}
-
 class DirectLights : public GLTest {
 protected:
     void SetUp() override {

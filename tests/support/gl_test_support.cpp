@@ -1,5 +1,8 @@
 #include "gl_test_support.h"
 
+#include "atonlab/stimuli/colour.h"
+#include "atonlab/stimuli/footprint.h"
+
 #include <cstdlib>
 
 namespace atonlab::test {
@@ -32,6 +35,23 @@ void GLTest::SetUp() {
     gl::Context* ctx = gl_context();
     if (!ctx) GTEST_SKIP() << "no OpenGL 4.5 core context: " << g_reason;
     ctx->make_current();
+}
+
+glm::dvec3 image_illuminance_rgb_lux(const stimuli::ImageRGBA32F& img, double focal_px) {
+    glm::dvec3 sum{0.0};
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            if (p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f) continue;
+            // Row y of the top-down image covers window rows [H-1-y, H-y].
+            const double x0 = x - 0.5 * img.width, y0 = (img.height - 1 - y) - 0.5 * img.height;
+            sum += glm::dvec3(p[0], p[1], p[2]) * stimuli::pixel_solid_angle_sr(x0, y0, focal_px);
+        }
+    return sum;
+}
+
+double image_illuminance_lux(const stimuli::ImageRGBA32F& img, double focal_px) {
+    return stimuli::luminance_of_linear_rgb(image_illuminance_rgb_lux(img, focal_px));
 }
 
 }  // namespace atonlab::test

@@ -7,7 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/glm.hpp>
+
 #include "atonlab/stimuli/gl/context.h"
+#include "atonlab/stimuli/image_io.h"
 
 namespace atonlab::test {
 
@@ -15,6 +18,12 @@ namespace atonlab::test {
 gl::Context* gl_context();
 /// Why the context is unavailable (empty if it is available).
 const std::string& gl_unavailable_reason();
+
+/// Σ L·Ω over an HDR frame (top row first), per channel (lux), Ω the exact
+/// pinhole solid angle of each pixel for focal length focal_px.
+glm::dvec3 image_illuminance_rgb_lux(const stimuli::ImageRGBA32F& img, double focal_px);
+/// The same for luminance Y (lux): the energy rule's left-hand side.
+double image_illuminance_lux(const stimuli::ImageRGBA32F& img, double focal_px);
 
 /// Base fixture: makes the shared context current or skips the test.
 class GLTest : public ::testing::Test {

@@ -410,10 +410,41 @@ TEST(SceneFileErrors, DuplicateLightNames) {
 TEST(SceneFileErrors, NotYetAvailableChoicesSaySo) {
     const std::string dynamic = std::string(kMinimal) + "[eye]\nadaptation = \"dynamic\"\n";
     expect_error_at(dynamic, 7, "eye.adaptation", "not available yet");
-    const std::string glare = std::string(kMinimal) + "[eye]\nglare = \"wave-optics\"\n";
-    expect_error_at(glare, 7, "eye.glare", "not available yet");
     const std::string bogus = std::string(kMinimal) + "[eye]\nglare = \"sparkle\"\n";
     expect_error_at(bogus, 7, "eye.glare", "unknown glare model");
+}
+
+TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
+    const std::string text = std::string(kMinimal) +
+                             "[eye]\nglare = \"spencer\"\npupil_mm = 5.5\n[glare]\nwindow = \"epanechnikov\"\n"
+                             "psf_size = 256\nradius_deg = 2.5\nspencer_vision = \"mesopic\"\nclear_pupil = true\nseed = 7\n";
+    const Scene scene = parse_scene(text, "glare.toml");
+    EXPECT_EQ(scene.glare.model, GlareModel::spencer);
+    EXPECT_EQ(scene.glare.pupil_mm, 5.5);
+    EXPECT_EQ(scene.glare.window, GlareWindow::epanechnikov);
+    EXPECT_EQ(scene.glare.psf_size, 256);
+    EXPECT_EQ(scene.glare.radius_deg, 2.5);
+    EXPECT_EQ(scene.glare.spencer_vision, SpencerVision::mesopic);
+    EXPECT_FALSE(scene.glare.eye.gratings.enabled);
+    EXPECT_FALSE(scene.glare.eye.halo_radius_deg.has_value());
+    EXPECT_EQ(scene.glare.eye.seed, 7u);
+    // Every model name round-trips; --set switches glare off.
+    for (const char* m : {"none", "wave-optics", "gaussian-bloom", "spencer", "aperture"})
+        EXPECT_EQ(glare_model_name(*glare_model_from_name(m)), m);
+}
+
+TEST(SceneFileGlare, BadGlareInputNamesTheKey) {
+    const std::string eye = std::string(kMinimal) + "[eye]\n";
+    expect_error_at(eye + "pupil_mm = 0\n", 7, "eye.pupil_mm", "greater than 0");
+    expect_error_at(eye + "pupil_mm = -3\n", 7, "eye.pupil_mm", "greater than 0");
+    const std::string glare = std::string(kMinimal) + "[glare]\n";
+    expect_error_at(glare + "psf_size = 300\n", 7, "glare.psf_size", "power of two");
+    expect_error_at(glare + "window = \"box\"\n", 7, "glare.window", "unknown glare window");
+    expect_error_at(glare + "spencer_vision = \"owl\"\n", 7, "glare.spencer_vision", "unknown vision");
+    expect_error_at(glare + "aperture_image = \"no-such-lashes.png\"\n", 7, "glare.aperture_image", "does not exist");
+    expect_error_at(glare + "grating_count = -1\n", 7, "glare.grating_count", "between");
+    expect_error_at(glare + "fresnel_distance_mm = 24\n", 6, "glare", "fresnel_distance_mm");
+    expect_error_at(glare + "sparkle = 1\n", 7, "glare.sparkle", "unknown key");
 }
 
 TEST(SceneFileErrors, ConflictsAndShapes) {

@@ -6,6 +6,7 @@
 // 4.5 context; a simulator that owns its context uses this class directly.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -15,6 +16,8 @@
 #include "atonlab/stimuli/scene.h"
 
 namespace atonlab::stimuli {
+
+class GlareStage;
 
 /// The pinhole camera a scene implies: image size from the display, focal
 /// length from the field of view (the display's visual angle unless the camera
@@ -63,6 +66,8 @@ public:
     std::vector<LightDrawRecord> read_light_draws() const;
     FrameStats stats() const;
 
+    /// The glare stage of the last frame: kernels, layers, what it reported.
+    const GlareStage& glare() const;
     const gl::Texture2D& hdr_texture() const;
     const gl::Texture2D& view_depth_texture() const;
 
@@ -81,6 +86,7 @@ struct GpuLightTables {
 };
 /// Packs lights relative to the eye (positions differenced in double before the
 /// fp32 rounding, so distant lights keep their precision).
-GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye_position_m);
+/// glare_groups: each light's glare SPD group (GlareStage::light_groups()), 0 when empty.
+GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye_position_m, std::span<const unsigned> glare_groups = {});
 
 }  // namespace atonlab::stimuli

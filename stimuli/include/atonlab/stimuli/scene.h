@@ -5,11 +5,14 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "atonlab/stimuli/eye_model.h"
+#include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
 
@@ -72,6 +75,38 @@ struct Light {
     std::vector<RhythmKnot> rhythm{{0.0, 1.0}};  ///< B(t) knots of this light's colour channel
     double rhythm_period_s = 0.0;                ///< 0 = fixed
     double rhythm_phase_s = 0.0;                 ///< added to the time before the rhythm lookup
+    /// The SPD its glare is integrated with (a named_spectrum()); empty: D65,
+    /// for lights given by an IALA colour or xy (K2012 §4.2.4, eq 4.10).
+    std::string spd;
+};
+
+/// The glare stage (DESIGN.md pipeline step 3; K2012 §4.2-4.3). Every model
+/// goes through the same billboards and conserves each light's energy.
+enum class GlareModel : std::uint8_t {
+    none,            ///< each light's direct image only
+    wave_optics,     ///< the eye model's PSF by FFT (K2012 §4.2, Ritschel et al. 2009)
+    gaussian_bloom,  ///< a monochromatic Gaussian blur (K2012 §3.4.1, [Kaw05]/[KMS05])
+    spencer,         ///< the analytic PSF of Spencer et al. 1995
+    aperture,        ///< the FFT of an obstacle image (Kakimoto et al. 2005)
+};
+std::string_view glare_model_name(GlareModel m);
+std::optional<GlareModel> glare_model_from_name(std::string_view name);
+
+struct GlareSettings {
+    GlareModel model = GlareModel::none;
+    /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).
+    std::optional<double> pupil_mm;
+    EyeModel eye;                       ///< wave-optics; its pupil_diameter_mm is set per frame
+    int psf_size = 512;                 ///< N of the PSF (power of two)
+    int spectral_samples = 30;          ///< K2012 §6.1: 30 is the compromise between 15 (steps) and 60
+    GlareWindow window = GlareWindow::silverman;  ///< K2012 §5.3.1: Silverman is safe at 16 bits
+    std::optional<double> radius_deg;   ///< billboard radius; default per model (see glare_stage.h)
+    int area_layers = 16;               ///< at most this many disc layers (K2012 §4.2.6)
+    double bloom_sigma_deg = 0.25;      ///< gaussian-bloom: standard deviation (degrees)
+    std::optional<SpencerVision> spencer_vision;  ///< nullopt: from the adaptation luminance
+    std::string aperture_image;         ///< aperture: PNG or EXR, transmittance = luminance (white = clear)
+    double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
+    bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
 };
 
 struct Scene {
@@ -81,6 +116,7 @@ struct Scene {
     ProfileTables profiles;
     std::vector<Light> lights;
     double adaptation_cd_m2 = 0.001;  ///< recorded in image headers; drives later stages
+    GlareSettings glare;
 };
 
 }  // namespace atonlab::stimuli

@@ -1,0 +1,69 @@
+#pragma once
+// The glare stage of one frame (DESIGN.md pipeline step 3; K2012 §4.2-4.3,
+// §5.3): per SPD, the glare kernel of the scene's model, its area layers up to
+// the largest projected radius the scene needs, and the billboards that draw
+// each visible light's glare in place of its direct image. Caches everything
+// that did not change since the last frame. Needs a current GL 4.5 context.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/psf.h"
+#include "atonlab/stimuli/scene.h"
+
+namespace atonlab::stimuli {
+
+struct CameraProjection;
+
+/// What the glare stage used for one SPD group in the last frame.
+struct GlareGroupReport {
+    std::string spd;               ///< "" = D65
+    double pupil_mm = 0;           ///< the pupil the PSF was computed for (wave-optics)
+    double degrees_per_texel = 0;  ///< the PSF's angular texel (wave-optics, aperture)
+    int kernel_size_px = 0;
+    double radius_deg = 0;
+    glm::dvec3 window_cut{0.0};  ///< energy fraction the window cut (then restored by renormalisation)
+    int area_layers = 1;
+    double area_max_radius_px = 0;
+};
+
+/// Default billboard radius (degrees) of a model: for the FFT models the part
+/// of the PSF's half field that every wavelength covers ((N/2 - 1)·dpt·380/575),
+/// 4σ for the Gaussian bloom, 6° for Spencer's PSF.
+double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_per_texel);
+
+/// Pupil diameter (mm) a scene's glare uses: the given one, or eq 3.15 from the adaptation.
+double glare_pupil_mm(const Scene& scene);
+
+/// Spencer's vision class from the adaptation luminance when not given:
+/// photopic ≥ 3 cd/m², scotopic ≤ 0.001 cd/m², mesopic between (CIE 191 limits).
+SpencerVision spencer_vision_for(const Scene& scene);
+
+class GlareStage {
+public:
+    GlareStage();
+    ~GlareStage();
+    GlareStage(const GlareStage&) = delete;
+    GlareStage& operator=(const GlareStage&) = delete;
+
+    /// Builds (or reuses) kernels and layers for the scene at time_s. Returns
+    /// the billboard half-extent (px) the light pass must cull with.
+    double prepare(const Scene& scene, const CameraProjection& projection, double time_s);
+    /// Draws the billboards additively into the bound framebuffer (colour 0).
+    /// Expects the light SSBOs at bindings 0-3 as FrameRenderer binds them.
+    void draw(int light_count, const CameraProjection& projection);
+
+    const std::vector<GlareGroupReport>& report() const;
+    /// The RGB PSF of group g (wave-optics, aperture), for files and tests.
+    const RgbPsf* psf(std::size_t group) const;
+    const GlareKernel* kernel(std::size_t group) const;
+    /// The SPD group index each light of the last prepared scene uses.
+    const std::vector<unsigned>& light_groups() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace atonlab::stimuli

@@ -1,0 +1,41 @@
+#pragma once
+// The PSF on the GPU (K2012 §4.2, §5.2): pupil-plane field → fp32 FFT →
+// |F|², cyclic shift, unit sum by a double-precision reduction → one mip level
+// → spectral integration → RGB PSF with unit luminance sum. Everything stays in
+// GPU buffers; read_mono()/read_rgb() download for tests, files and the
+// billboard kernel. Needs a current GL 4.5 context for its whole life.
+#include <memory>
+
+#include "atonlab/stimuli/fft.h"
+#include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/psf.h"
+
+namespace atonlab::stimuli {
+
+/// GPU time of the last generate() per stage (ms), from timer queries.
+struct PsfGpuTimings {
+    double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
+};
+
+class GpuPsfGenerator {
+public:
+    /// n: a power of two in [kGpuFftMinSize, kGpuFftMaxSize] (InputError, key "size", otherwise).
+    explicit GpuPsfGenerator(int n, TwiddleSource twiddles = TwiddleSource::table_from_double);
+    ~GpuPsfGenerator();
+    GpuPsfGenerator(GpuPsfGenerator&&) noexcept;
+    GpuPsfGenerator& operator=(GpuPsfGenerator&&) noexcept;
+
+    int size() const;
+    /// The pupil-plane field at λ0 (n×n), the PSF's angular texel (degrees) and
+    /// the spectral samples (at most 128; InputError, key "spectral_samples").
+    void generate(const ComplexImage<double>& pupil_field, double degrees_per_texel, const SpectralSamples& samples);
+    MonoPsf read_mono() const;
+    RgbPsf read_rgb() const;
+    PsfGpuTimings timings() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace atonlab::stimuli

@@ -1,0 +1,348 @@
+#include "atonlab/stimuli/glare_stage.h"
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/footprint.h"
+#include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/psf_generator.h"
+
+namespace atonlab::stimuli {
+
+std::string_view glare_model_name(GlareModel m) {
+    switch (m) {
+        case GlareModel::none:
+            return "none";
+        case GlareModel::wave_optics:
+            return "wave-optics";
+        case GlareModel::gaussian_bloom:
+            return "gaussian-bloom";
+        case GlareModel::spencer:
+            return "spencer";
+        case GlareModel::aperture:
+            return "aperture";
+    }
+    return "none";
+}
+
+std::optional<GlareModel> glare_model_from_name(std::string_view name) {
+    for (GlareModel m : {GlareModel::none, GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer,
+                         GlareModel::aperture})
+        if (glare_model_name(m) == name) return m;
+    return std::nullopt;
+}
+
+double glare_pupil_mm(const Scene& scene) {
+    return scene.glare.pupil_mm ? *scene.glare.pupil_mm : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
+}
+
+SpencerVision spencer_vision_for(const Scene& scene) {
+    if (scene.glare.spencer_vision) return *scene.glare.spencer_vision;
+    if (scene.adaptation_cd_m2 >= 3.0) return SpencerVision::photopic;
+    if (scene.adaptation_cd_m2 <= 0.001) return SpencerVision::scotopic;
+    return SpencerVision::mesopic;
+}
+
+double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_per_texel) {
+    if (glare.radius_deg) return *glare.radius_deg;
+    switch (glare.model) {
+        case GlareModel::gaussian_bloom:
+            return 4.0 * glare.bloom_sigma_deg;
+        case GlareModel::spencer:
+            return 6.0;
+        // The FFT models: the part of the field every wavelength covers. Eq 4.9
+        // shrinks the λ0 grid by λ/λ0 for the shortest wavelength, so beyond
+        // (N/2)·(380/575) texels the blue end of the spectrum is missing.
+        default:
+            return (glare.psf_size / 2 - 1) * psf_degrees_per_texel * SpectralSamples::kFirstNm /
+                   kReferenceWavelengthNm;
+    }
+}
+
+namespace {
+
+Spectrum spd_for(const std::string& name) {
+    if (name.empty()) return d65_spectrum();
+    if (auto s = named_spectrum(name)) return *s;
+    throw InputError(SourceLocation{"", 0, 0, "spd"}, fmt::format("unknown spectrum \"{}\".", name));
+}
+
+// The obstacle image as a pupil-plane field at λ0: transmittance = the image's
+// linear luminance, resampled bilinearly over the plane (image row 0 at the top).
+ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_mm) {
+    const std::filesystem::path path = g.aperture_image;
+    int w = 0, h = 0;
+    std::vector<double> lum;
+    try {
+        const auto ext = path.extension().string();
+        if (ext == ".exr" || ext == ".EXR") {
+            const ExrImage img = read_exr(path);
+            w = img.image.width;
+            h = img.image.height;
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const float* p = img.image.pixel(x, y);
+                    lum.push_back(luminance_of_linear_rgb({p[0], p[1], p[2]}));
+                }
+        } else {
+            const std::vector<float> rgb = read_png_rgb(path, w, h);
+            for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
+                lum.push_back(
+                    luminance_of_linear_rgb({srgb_decode(rgb[i]), srgb_decode(rgb[i + 1]), srgb_decode(rgb[i + 2])}));
+        }
+    } catch (const InputError& e) {
+        throw InputError(SourceLocation{"", 0, 0, "aperture_image"},
+                         fmt::format("cannot read the aperture image: {}", e.what()));
+    }
+    if (w < 2 || h < 2)
+        throw InputError(SourceLocation{"", 0, 0, "aperture_image"},
+                         fmt::format("the aperture image {} must be at least 2×2 pixels.", path.string()));
+    ComplexImage<double> field(n);
+    const double texel_mm = g.aperture_width_mm / n;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            // Plane texel centre → image coordinates (the image spans the whole plane).
+            const double u = (i + 0.5) / n * w - 0.5, v = (1.0 - (j + 0.5) / n) * h - 0.5;
+            const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, w - 1);
+            const int y0 = std::clamp(static_cast<int>(std::floor(v)), 0, h - 1);
+            const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+            const double tx = std::clamp(u - x0, 0.0, 1.0), ty = std::clamp(v - y0, 0.0, 1.0);
+            auto L = [&](int x, int y) { return std::clamp(lum[static_cast<std::size_t>(y) * w + x], 0.0, 1.0); };
+            double t =
+                (1 - ty) * ((1 - tx) * L(x0, y0) + tx * L(x1, y0)) + ty * ((1 - tx) * L(x0, y1) + tx * L(x1, y1));
+            if (g.aperture_with_pupil) {
+                const double x = (i + 0.5 - n / 2.0) * texel_mm, y = (j + 0.5 - n / 2.0) * texel_mm;
+                if (std::hypot(x, y) > 0.5 * pupil_mm) t = 0;
+            }
+            field.at(i, j) = t;
+        }
+    return field;
+}
+
+}  // namespace
+
+struct GlareStage::Impl {
+    struct Group {
+        std::string spd;
+        std::string key;
+        std::optional<RgbPsf> psf;
+        GlareKernel kernel;
+        AreaLayers layers;
+        double layers_radius_px = -1;  // the radius the layers were built for
+        int layers_max = 0;
+        gl::Buffer layer_buffer;
+        GlareGroupReport report;
+    };
+    std::map<std::string, Group> groups;  // by SPD name, kept between frames
+    std::vector<std::string> order;       // this frame's groups, index = group id
+    std::vector<GlareGroupReport> reports;
+    std::vector<unsigned> light_groups;
+    std::unique_ptr<GpuPsfGenerator> generator;
+    gl::Program billboard;
+    gl::VertexArray vao;
+
+    GpuPsfGenerator& generator_for(int n) {
+        if (!generator || generator->size() != n) generator = std::make_unique<GpuPsfGenerator>(n);
+        return *generator;
+    }
+
+    void build_kernel(Group& g, const Scene& scene, double ppd, double time_s, double pupil_mm) {
+        const GlareSettings& gs = scene.glare;
+        const SpectralSamples samples = spectral_samples(spd_for(g.spd), gs.spectral_samples);
+        g.psf.reset();
+        g.report = {};
+        g.report.spd = g.spd;
+        g.report.pupil_mm = pupil_mm;
+        switch (gs.model) {
+            case GlareModel::wave_optics: {
+                EyeModel eye = gs.eye;
+                eye.pupil_diameter_mm = pupil_mm;
+                eye.validate(gs.psf_size);
+                const double dpt = psf_degrees_per_texel(eye);
+                const auto field = pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
+                GpuPsfGenerator& gen = generator_for(gs.psf_size);
+                gen.generate(field, dpt, samples);
+                g.psf = gen.read_rgb();
+                break;
+            }
+            case GlareModel::aperture: {
+                if (!is_power_of_two(gs.psf_size))
+                    throw InputError(SourceLocation{"", 0, 0, "psf_size"},
+                                     fmt::format("the PSF size must be a power of two, not {}.", gs.psf_size));
+                const double dpt = kReferenceWavelengthNm * 1e-6 / gs.aperture_width_mm * 180.0 / std::numbers::pi;
+                GpuPsfGenerator& gen = generator_for(gs.psf_size);
+                gen.generate(aperture_field(gs, gs.psf_size, pupil_mm), dpt, samples);
+                g.psf = gen.read_rgb();
+                break;
+            }
+            default:
+                break;
+        }
+        const double radius = default_glare_radius_deg(gs, g.psf ? g.psf->degrees_per_texel : 0.0);
+        if (g.psf) {
+            g.kernel = glare_kernel_from_psf(*g.psf, ppd, radius, gs.window);
+            g.report.degrees_per_texel = g.psf->degrees_per_texel;
+        } else if (gs.model == GlareModel::gaussian_bloom) {
+            const double s = gs.bloom_sigma_deg;
+            if (!(s > 0))
+                throw InputError(SourceLocation{"", 0, 0, "bloom_sigma_deg"},
+                                 fmt::format("the bloom's standard deviation must be positive, not {} degrees.", s));
+            g.kernel =
+                glare_kernel_from_radial([s](double theta, double) { return std::exp(-0.5 * theta * theta / (s * s)); },
+                                         samples, ppd, radius, gs.window);
+        } else {
+            const SpencerVision vision = spencer_vision_for(scene);
+            g.kernel = glare_kernel_from_radial(
+                [vision](double theta, double lambda) { return spencer_psf(theta, lambda, vision); }, samples, ppd,
+                radius, gs.window);
+        }
+        g.report.kernel_size_px = g.kernel.size;
+        g.report.radius_deg = radius;
+        g.report.window_cut = g.kernel.window_cut;
+        g.layers_radius_px = -1;  // rebuild the layers from the new kernel
+    }
+};
+
+GlareStage::GlareStage() : impl_(std::make_unique<Impl>()) {}
+GlareStage::~GlareStage() = default;
+
+const std::vector<GlareGroupReport>& GlareStage::report() const {
+    return impl_->reports;
+}
+const std::vector<unsigned>& GlareStage::light_groups() const {
+    return impl_->light_groups;
+}
+
+const RgbPsf* GlareStage::psf(std::size_t group) const {
+    if (group >= impl_->order.size()) return nullptr;
+    const auto& g = impl_->groups.at(impl_->order[group]);
+    return g.psf ? &*g.psf : nullptr;
+}
+
+const GlareKernel* GlareStage::kernel(std::size_t group) const {
+    if (group >= impl_->order.size()) return nullptr;
+    return &impl_->groups.at(impl_->order[group]).kernel;
+}
+
+double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double time_s) {
+    Impl& m = *impl_;
+    const GlareSettings& gs = scene.glare;
+    m.order.clear();
+    m.reports.clear();
+    m.light_groups.assign(scene.lights.size(), 0u);
+    if (gs.model == GlareModel::none) return 0.0;
+
+    // SPD groups in order of first appearance.
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const std::string& spd = scene.lights[i].spd;
+        auto it = std::find(m.order.begin(), m.order.end(), spd);
+        if (it == m.order.end()) {
+            m.order.push_back(spd);
+            it = m.order.end() - 1;
+        }
+        m.light_groups[i] = static_cast<unsigned>(it - m.order.begin());
+    }
+
+    // The kernel depends on these, and only these: rebuilt when one changes.
+    const double ppd = scene.display.pixels_per_degree_at_centre();
+    const double pupil = glare_pupil_mm(scene);
+    const bool hippus = gs.model == GlareModel::wave_optics && gs.eye.hippus.enabled;
+    const double pupil_now = gs.model == GlareModel::wave_optics ? [&] {
+        EyeModel eye = gs.eye;
+        eye.pupil_diameter_mm = pupil;
+        return pupil_diameter_mm_at(eye, time_s);
+    }() : pupil;
+    const EyeModel& e = gs.eye;
+    std::string common;
+    auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
+    add(glare_model_name(gs.model), gs.psf_size, gs.spectral_samples, glare_window_name(gs.window),
+        gs.radius_deg.value_or(-1), gs.bloom_sigma_deg, static_cast<int>(spencer_vision_for(scene)));
+    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd, pupil, hippus ? time_s : 0.0);
+    add(e.hippus.enabled, e.hippus.amplitude, e.hippus.max_pupil_mm);
+    add(e.gratings.enabled, e.gratings.count, e.gratings.inner_radius_mm, e.gratings.width_um, e.gratings.opacity,
+        e.gratings.angle_jitter);
+    for (const Particles* p : {&e.lens_particles, &e.vitreous_particles})
+        add(p->enabled, p->count, p->diameter_um, p->diameter_spread, p->opacity, p->spread_radius_mm);
+    add(e.eyelashes.enabled, e.eyelashes.count, e.eyelashes.width_um, e.eyelashes.reach_mm, e.eyelashes.max_tilt_deg);
+    add(e.eyelid.enabled, e.eyelid.edge_mm, e.fresnel_distance_mm, e.plane_width_mm, e.halo_radius_deg.value_or(-1),
+        e.seed, e.supersampling);
+
+    // The largest projected radius each group needs (lights in front whose glare can reach the image).
+    std::vector<double> need(m.order.size(), 0.0);
+    const glm::dmat3 view_from_world = glm::transpose(P.world_from_view);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& L = scene.lights[i];
+        const Footprint fp = light_footprint(view_from_world * (L.position_m - P.eye_position_m), L.radius_m,
+                                             P.focal_px, P.width_px, P.height_px);
+        if (!fp.visible) continue;
+        need[m.light_groups[i]] = std::max(need[m.light_groups[i]], std::sqrt(fp.area_px2 / std::numbers::pi));
+    }
+
+    double extent = 0;
+    for (std::size_t gi = 0; gi < m.order.size(); ++gi) {
+        auto& g = m.groups[m.order[gi]];
+        g.spd = m.order[gi];
+        const std::string key = common + "|" + g.spd;
+        if (g.key != key) {
+            m.build_kernel(g, scene, ppd, time_s, pupil_now);
+            g.key = key;
+        }
+        // Layers only where a light covers more than a pixel; radius rounded up
+        // to a power of two so a light approaching does not rebuild every frame.
+        double r_build = 0;
+        if (need[gi] >= 1.0) {
+            r_build = 1;
+            while (r_build < need[gi]) r_build *= 2;
+            r_build = std::min(r_build, 256.0);  // beyond, the largest layer is used (energy still conserved)
+        }
+        if (r_build > g.layers_radius_px || gs.area_layers != g.layers_max || !g.layer_buffer) {
+            g.layers = build_area_layers(g.kernel, r_build, std::max(2, gs.area_layers));
+            g.layers_radius_px = r_build;
+            g.layers_max = gs.area_layers;
+            g.layer_buffer = gl::Buffer(g.layers.rgba.size() * sizeof(glm::vec4), g.layers.rgba.data(),
+                                        gl::BufferUsage::static_draw);
+        }
+        g.report.area_layers = g.layers.layers;
+        g.report.area_max_radius_px = g.layers.max_radius_px();
+        m.reports.push_back(g.report);
+        extent = std::max(extent, static_cast<double>(g.kernel.half()) + 1.0);
+    }
+    return extent;
+}
+
+void GlareStage::draw(int light_count, const CameraProjection& P) {
+    Impl& m = *impl_;
+    if (m.order.empty() || light_count == 0) return;
+    if (!m.billboard) {
+        m.billboard = gl::Program::build({{gl::ShaderStage::vertex, "glare_billboard.vert"},
+                                          {gl::ShaderStage::geometry, "glare_billboard.geom"},
+                                          {gl::ShaderStage::fragment, "glare_billboard.frag"}});
+        m.vao = gl::VertexArray::create();
+    }
+    const auto w = static_cast<float>(P.width_px), h = static_cast<float>(P.height_px);
+    m.billboard.set("image_size", w, h);
+    m.billboard.set("focal_px", static_cast<float>(P.focal_px));
+    m.billboard.use();
+    m.vao.bind();
+    for (std::size_t gi = 0; gi < m.order.size(); ++gi) {
+        const auto& g = m.groups.at(m.order[gi]);
+        g.layer_buffer.bind_storage(5);
+        m.billboard.set("group", static_cast<unsigned>(gi));
+        m.billboard.set("kernel_half_px", static_cast<float>(g.kernel.half()));
+        m.billboard.set("layer_half_px", static_cast<float>(g.layers.half()));
+        m.billboard.set("layer_step_px", static_cast<float>(g.layers.radius_step_px));
+        m.billboard.set("layer_count", g.layers.layers);
+        m.billboard.set("layer_size", g.layers.size);
+        glDrawArrays(GL_POINTS, 0, light_count);
+    }
+}
+
+}  // namespace atonlab::stimuli

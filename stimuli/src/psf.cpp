@@ -1,0 +1,161 @@
+#include "atonlab/stimuli/psf.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "atonlab/stimuli/error.h"
+
+namespace atonlab::stimuli {
+
+SpectralSamples spectral_samples(const Spectrum& spd, int count) {
+    if (count < 1)
+        throw InputError(SourceLocation{"", 0, 0, "spectral_samples"},
+                         fmt::format("the number of spectral samples must be at least 1, not {}.", count));
+    SpectralSamples s;
+    const double width = (SpectralSamples::kLastNm - SpectralSamples::kFirstNm) / count;
+    double y_total = 0;
+    for (int i = 0; i < count; ++i) {
+        const double lambda = SpectralSamples::kFirstNm + (i + 0.5) * width;
+        const glm::dvec3 w = cie1931_cmf(lambda) * spd.at(lambda) * width;
+        s.wavelength_nm.push_back(lambda);
+        s.xyz_weight.push_back(w);
+        y_total += w.y;
+    }
+    if (!(y_total > 0))
+        throw InputError(SourceLocation{"", 0, 0, "spd"},
+                         "the spectrum has no luminance between 380 and 780 nm, so its glare has no colour.");
+    for (auto& w : s.xyz_weight) w /= y_total;
+    return s;
+}
+
+glm::dvec3 RgbPsf::channel_sums() const {
+    glm::dvec3 s{0.0};
+    for (const auto& v : rgb) s += v;
+    return s;
+}
+
+double RgbPsf::luminance_sum() const {
+    return luminance_of_linear_rgb(channel_sums());
+}
+
+MonoPsf mono_psf_from_spectrum(const ComplexImage<double>& F, double degrees_per_texel, double wavelength_nm) {
+    MonoPsf p;
+    p.n = F.n;
+    p.degrees_per_texel = degrees_per_texel;
+    p.wavelength_nm = wavelength_nm;
+    p.value.resize(F.data.size());
+    const int n = F.n, h = n / 2;
+    double sum = 0;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double v = std::norm(F.at(x, y));  // |F|², eq 4.6
+            // eq 4.8: the zero frequency moves to the centre texel (n/2, n/2).
+            p.value[static_cast<std::size_t>((y + h) % n) * n + (x + h) % n] = v;
+            sum += v;
+        }
+    if (sum > 0)
+        for (double& v : p.value) v /= sum;  // §4.2.3: unit sum
+    return p;
+}
+
+MonoPsf mono_psf_reference(const EyeModel& eye, int n, double wavelength_nm, double time_s) {
+    // The plane scales with λ so that λ/W_λ = λ0/W: every wavelength's FFT
+    // lands on λ0's angular grid (the exact path of §4.2.4's approximation).
+    const double w = eye.plane_width_mm * wavelength_nm / kReferenceWavelengthNm;
+    ComplexImage<double> field = pupil_plane(eye, n, wavelength_nm, w, time_s);
+    fftw_forward(field);
+    return mono_psf_from_spectrum(field, psf_degrees_per_texel(eye), wavelength_nm);
+}
+
+std::vector<double> box_downsample(const std::vector<double>& image, int n) {
+    const int m = n / 2;
+    std::vector<double> out(static_cast<std::size_t>(m) * m);
+    for (int y = 0; y < m; ++y)
+        for (int x = 0; x < m; ++x) {
+            auto at = [&](int xx, int yy) { return image[static_cast<std::size_t>(yy) * n + xx]; };
+            out[static_cast<std::size_t>(y) * m + x] =
+                0.25 * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1));
+        }
+    return out;
+}
+
+double bilinear_zero_border(const std::vector<double>& image, int n, double x, double y) {
+    const double fx = std::floor(x), fy = std::floor(y);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const double tx = x - fx, ty = y - fy;
+    auto at = [&](int xx, int yy) {
+        if (xx < 0 || yy < 0 || xx >= n || yy >= n) return 0.0;
+        return image[static_cast<std::size_t>(yy) * n + xx];
+    };
+    return (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x0 + 1, y0)) +
+           ty * ((1 - tx) * at(x0, y0 + 1) + tx * at(x0 + 1, y0 + 1));
+}
+
+namespace {
+
+// XYZ → linear Rec.709, texels outside the gamut clipped at 0 (a display cannot
+// emit negative light), then normalised to unit luminance sum.
+RgbPsf finish_rgb(int n, double degrees_per_texel, const std::vector<glm::dvec3>& xyz) {
+    RgbPsf out;
+    out.n = n;
+    out.degrees_per_texel = degrees_per_texel;
+    out.rgb.resize(xyz.size());
+    for (std::size_t i = 0; i < xyz.size(); ++i) out.rgb[i] = glm::max(xyz_to_linear_rgb(xyz[i]), glm::dvec3(0.0));
+    const double y = out.luminance_sum();
+    if (y > 0)
+        for (auto& v : out.rgb) v /= y;
+    return out;
+}
+
+}  // namespace
+
+RgbPsf spectral_psf_resampled(const MonoPsf& psf, const SpectralSamples& samples) {
+    const int n = psf.n;
+    const double c = n / 2;
+    const std::vector<double> level1 = box_downsample(psf.value, n);
+    std::vector<glm::dvec3> xyz(psf.value.size(), glm::dvec3(0.0));
+    for (std::size_t s = 0; s < samples.wavelength_nm.size(); ++s) {
+        // eq 4.9: F_λ(x) = F_λ0(x λ0/λ); (λ0/λ)² keeps each wavelength's energy.
+        const double ratio = psf.wavelength_nm / samples.wavelength_nm[s];
+        const double lod = std::max(0.0, std::log2(ratio));  // minification only for λ < λ0
+        const double gain = ratio * ratio;
+        const glm::dvec3 w = samples.xyz_weight[s] * gain;
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double sx = c + (x - c) * ratio, sy = c + (y - c) * ratio;
+                double v = bilinear_zero_border(psf.value, n, sx, sy);
+                if (lod > 0) {
+                    // Level 1 texel k covers level-0 texels 2k, 2k+1: centre at 2k + 0.5.
+                    // Its values are averages, i.e. per-level-0-texel energies, like level 0.
+                    const double v1 = bilinear_zero_border(level1, n / 2, (sx - 0.5) / 2, (sy - 0.5) / 2);
+                    const double t = std::min(lod, 1.0);
+                    v = (1 - t) * v + t * v1;
+                }
+                xyz[static_cast<std::size_t>(y) * n + x] += w * v;
+            }
+    }
+    return finish_rgb(n, psf.degrees_per_texel, xyz);
+}
+
+RgbPsf spectral_psf_exact(const EyeModel& eye, int n, const SpectralSamples& samples, double time_s) {
+    std::vector<glm::dvec3> xyz(static_cast<std::size_t>(n) * n, glm::dvec3(0.0));
+    for (std::size_t s = 0; s < samples.wavelength_nm.size(); ++s) {
+        const MonoPsf p = mono_psf_reference(eye, n, samples.wavelength_nm[s], time_s);
+        for (std::size_t i = 0; i < xyz.size(); ++i) xyz[i] += samples.xyz_weight[s] * p.value[i];
+    }
+    return finish_rgb(n, psf_degrees_per_texel(eye), xyz);
+}
+
+double relative_l2(const RgbPsf& a, const RgbPsf& b) {
+    double num = 0, den = 0;
+    for (std::size_t i = 0; i < b.rgb.size(); ++i) {
+        const glm::dvec3 d = a.rgb[i] - b.rgb[i];
+        num += glm::dot(d, d);
+        den += glm::dot(b.rgb[i], b.rgb[i]);
+    }
+    return den > 0 ? std::sqrt(num / den) : std::sqrt(num);
+}
+
+}  // namespace atonlab::stimuli

@@ -1,0 +1,171 @@
+#include "atonlab/stimuli/psf_generator.h"
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include "atonlab/stimuli/error.h"
+
+namespace atonlab::stimuli {
+
+namespace {
+constexpr int kMaxSpectralSamples = 128;  // psf_spectral.comp MAX_SAMPLES
+
+unsigned groups_for(std::size_t count) {
+    return static_cast<unsigned>((count + 255) / 256);
+}
+}  // namespace
+
+struct GpuPsfGenerator::Impl {
+    int n;
+    GpuFft fft;
+    gl::Program magnitude = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_MAGNITUDE"});
+    gl::Program scale_mono = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_SCALE_MONO"});
+    gl::Program downsample = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_DOWNSAMPLE"});
+    gl::Program scale_rgb = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_SCALE_RGB"});
+    gl::Program reduce_mono = gl::Program::build({{gl::ShaderStage::compute, "psf_reduce.comp"}}, {"REDUCE_MONO"});
+    gl::Program reduce_rgb = gl::Program::build({{gl::ShaderStage::compute, "psf_reduce.comp"}}, {"REDUCE_RGB"});
+    gl::Program spectral = gl::Program::build({{gl::ShaderStage::compute, "psf_spectral.comp"}});
+    gl::Buffer field, mono, level1, rgb, sums;
+    gl::GpuTimer timers[4];
+    PsfGpuTimings last;
+    double degrees_per_texel = 0;
+
+    Impl(int size, TwiddleSource twiddles) : n(size), fft(size, twiddles) {
+        const auto texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+        field = gl::Buffer(texels * 2 * sizeof(float), nullptr, gl::BufferUsage::dynamic_draw);
+        mono = gl::Buffer(texels * sizeof(float), nullptr, gl::BufferUsage::dynamic_read);
+        level1 = gl::Buffer(texels / 4 * sizeof(float), nullptr, gl::BufferUsage::dynamic_draw);
+        rgb = gl::Buffer(texels * 4 * sizeof(float), nullptr, gl::BufferUsage::dynamic_read);
+        sums = gl::Buffer(4 * sizeof(double), nullptr, gl::BufferUsage::dynamic_read);
+        for (auto& t : timers) t = gl::GpuTimer::create();
+    }
+    void bind_all() const {
+        field.bind_storage(0);
+        mono.bind_storage(1);
+        level1.bind_storage(2);
+        rgb.bind_storage(3);
+        sums.bind_storage(4);
+    }
+    static void barrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT); }
+};
+
+GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles) : impl_(std::make_unique<Impl>(n, twiddles)) {}
+GpuPsfGenerator::~GpuPsfGenerator() = default;
+GpuPsfGenerator::GpuPsfGenerator(GpuPsfGenerator&&) noexcept = default;
+GpuPsfGenerator& GpuPsfGenerator::operator=(GpuPsfGenerator&&) noexcept = default;
+
+int GpuPsfGenerator::size() const {
+    return impl_->n;
+}
+PsfGpuTimings GpuPsfGenerator::timings() const {
+    return impl_->last;
+}
+
+void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees_per_texel,
+                               const SpectralSamples& samples) {
+    Impl& m = *impl_;
+    if (pupil.n != m.n)
+        throw InputError(
+            SourceLocation{"", 0, 0, "size"},
+            fmt::format("the pupil plane is {0}×{0} but the PSF generator was made for {1}×{1}.", pupil.n, m.n));
+    const auto count = static_cast<int>(samples.wavelength_nm.size());
+    if (count < 1 || count > kMaxSpectralSamples)
+        throw InputError(SourceLocation{"", 0, 0, "spectral_samples"},
+                         fmt::format("the GPU spectral integration takes 1 to {} wavelength samples, not {}.",
+                                     kMaxSpectralSamples, count));
+    m.degrees_per_texel = degrees_per_texel;
+    const auto texels = static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n);
+    const auto n = static_cast<unsigned>(m.n);
+
+    m.timers[0].begin();
+    std::vector<float> packed(texels * 2);
+    for (std::size_t i = 0; i < texels; ++i) {
+        packed[2 * i] = static_cast<float>(pupil.data[i].real());
+        packed[2 * i + 1] = static_cast<float>(pupil.data[i].imag());
+    }
+    m.field.upload(0, packed.size() * sizeof(float), packed.data());
+    m.timers[0].end();
+
+    m.timers[1].begin();
+    m.fft.forward(m.field);
+    m.timers[1].end();
+
+    // |F|², shift, sum, unit sum, level 1.
+    m.timers[2].begin();
+    m.bind_all();
+    m.magnitude.set("n", n);
+    m.magnitude.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    Impl::barrier();
+    m.reduce_mono.set("count", static_cast<unsigned>(texels));
+    m.reduce_mono.use();
+    glDispatchCompute(1, 1, 1);
+    Impl::barrier();
+    m.scale_mono.set("n", n);
+    m.scale_mono.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    Impl::barrier();
+    m.downsample.set("n", n / 2);
+    m.downsample.use();
+    glDispatchCompute(groups_for(texels / 4), 1, 1);
+    Impl::barrier();
+    m.timers[2].end();
+
+    // Spectral integration, then unit luminance.
+    m.timers[3].begin();
+    m.spectral.set("n", n);
+    m.spectral.set("sample_count", count);
+    for (int s = 0; s < count; ++s) {
+        const double ratio = kReferenceWavelengthNm / samples.wavelength_nm[static_cast<std::size_t>(s)];
+        const glm::dvec3 w = samples.xyz_weight[static_cast<std::size_t>(s)] * ratio * ratio;
+        m.spectral.set(fmt::format("ratio[{}]", s), static_cast<float>(ratio));
+        m.spectral.set(fmt::format("weight[{}]", s), static_cast<float>(w.x), static_cast<float>(w.y),
+                       static_cast<float>(w.z));
+    }
+    const glm::mat3 xyz_to_rgb(rec709_xyz_to_rgb());
+    m.spectral.set_mat3("xyz_to_rgb", &xyz_to_rgb[0][0]);
+    m.spectral.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    Impl::barrier();
+    m.reduce_rgb.set("count", static_cast<unsigned>(texels));
+    m.reduce_rgb.use();
+    glDispatchCompute(1, 1, 1);
+    Impl::barrier();
+    m.scale_rgb.set("n", n);
+    m.scale_rgb.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    Impl::barrier();
+    m.timers[3].end();
+
+    m.last.upload_ms = m.timers[0].elapsed_ms().value_or(0);
+    m.last.fft_ms = m.timers[1].elapsed_ms().value_or(0);
+    m.last.mono_ms = m.timers[2].elapsed_ms().value_or(0);
+    m.last.spectral_ms = m.timers[3].elapsed_ms().value_or(0);
+}
+
+MonoPsf GpuPsfGenerator::read_mono() const {
+    const Impl& m = *impl_;
+    MonoPsf p;
+    p.n = m.n;
+    p.degrees_per_texel = m.degrees_per_texel;
+    p.wavelength_nm = kReferenceWavelengthNm;
+    std::vector<float> raw(static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n));
+    m.mono.download(0, raw.size() * sizeof(float), raw.data());
+    p.value.assign(raw.begin(), raw.end());
+    return p;
+}
+
+RgbPsf GpuPsfGenerator::read_rgb() const {
+    const Impl& m = *impl_;
+    RgbPsf p;
+    p.n = m.n;
+    p.degrees_per_texel = m.degrees_per_texel;
+    const auto texels = static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n);
+    std::vector<float> raw(texels * 4);
+    m.rgb.download(0, raw.size() * sizeof(float), raw.data());
+    p.rgb.resize(texels);
+    for (std::size_t i = 0; i < texels; ++i) p.rgb[i] = {raw[4 * i], raw[4 * i + 1], raw[4 * i + 2]};
+    return p;
+}
+
+}  // namespace atonlab::stimuli

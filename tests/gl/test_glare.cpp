@@ -1,0 +1,242 @@
+// The glare stage on the GPU: the PSF pipeline against its double-precision
+// CPU references, and the billboards against DESIGN.md's energy rule (glare
+// redistributes a light's energy; it neither creates nor loses it).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/glare_stage.h"
+#include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/light_model.h"
+#include "atonlab/stimuli/profile.h"
+#include "atonlab/stimuli/psf_generator.h"
+#include "gl_test_support.h"
+#include "input_error.h"
+
+namespace atonlab::test {
+namespace {
+
+using namespace atonlab::stimuli;
+
+double relative_l2(const std::vector<double>& a, const std::vector<double>& b) {
+    double num = 0, den = 0;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        num += (a[i] - b[i]) * (a[i] - b[i]);
+        den += b[i] * b[i];
+    }
+    return std::sqrt(num / den);
+}
+
+// An eye with obstacles but no gratings (those need N ≥ 512 to be resolved), so
+// small sizes exercise every part of the pupil plane quickly.
+EyeModel small_eye() {
+    EyeModel e;
+    e.pupil_diameter_mm = 6.0;
+    e.gratings.enabled = false;
+    e.halo_radius_deg.reset();
+    e.fresnel_distance_mm = 2000.0;
+    return e;
+}
+
+using GlarePsf = GLTest;
+
+TEST_F(GlarePsf, GpuMonoAndRgbMatchTheirCpuReferences) {
+    const EyeModel eye = small_eye();
+    const int n = 256;
+    const SpectralSamples samples = spectral_samples(d65_spectrum(), 30);
+    GpuPsfGenerator gen(n);
+    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    const MonoPsf gpu_mono = gen.read_mono();
+    const MonoPsf cpu_mono = mono_psf_reference(eye, n, kReferenceWavelengthNm);
+    const double e_mono = relative_l2(gpu_mono.value, cpu_mono.value);
+    const RgbPsf gpu_rgb = gen.read_rgb();
+    const RgbPsf cpu_rgb = spectral_psf_resampled(cpu_mono, samples);
+    const double e_rgb = stimuli::relative_l2(gpu_rgb, cpu_rgb);
+    std::printf("GPU vs CPU double, n=%d: mono PSF relative L2 %.3g, RGB PSF relative L2 %.3g\n", n, e_mono, e_rgb);
+    EXPECT_LT(e_mono, 1e-4);
+    EXPECT_LT(e_rgb, 1e-4);
+    EXPECT_NEAR(gpu_rgb.luminance_sum(), 1.0, 1e-5);
+    double mono_sum = 0;
+    for (double v : gpu_mono.value) mono_sum += v;
+    EXPECT_NEAR(mono_sum, 1.0, 1e-5);
+}
+
+TEST_F(GlarePsf, DefaultEyeAtN512MatchesCpuAndIsBitIdenticalForASeed) {
+    EyeModel eye;  // the default eye: gratings, particles, E; halo at 4°
+    eye.pupil_diameter_mm = 6.0;
+    const int n = 512;
+    const SpectralSamples samples = spectral_samples(d65_spectrum(), 30);
+    GpuPsfGenerator gen(n);
+    const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
+    gen.generate(field, psf_degrees_per_texel(eye), samples);
+    const RgbPsf first = gen.read_rgb();
+    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    const RgbPsf second = gen.read_rgb();
+    ASSERT_EQ(first.rgb.size(), second.rgb.size());
+    EXPECT_TRUE(first.rgb == second.rgb) << "same seed, same machine: the PSF must be bit-identical";
+    const RgbPsf cpu = spectral_psf_resampled(mono_psf_reference(eye, n, kReferenceWavelengthNm), samples);
+    EXPECT_LT(stimuli::relative_l2(first, cpu), 1e-4);
+    // The scale puts the lenticular halo's outer edge at 4°: dpt = 4° / (count/(2π r0) · W).
+    EXPECT_NEAR(first.degrees_per_texel,
+                4.0 / (eye.gratings.count / (2 * std::numbers::pi * eye.gratings.inner_radius_mm) * eye.plane_width_mm),
+                1e-9);
+    // A different seed draws a different eye.
+    eye.seed = 2;
+    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    EXPECT_FALSE(gen.read_rgb().rgb == first.rgb);
+}
+
+// ---------------------------------------------------------------------------
+// Billboards in frames.
+
+// 320×240 px at f = 2880 px (about 50 px per degree), black.
+Scene black_scene(GlareModel model) {
+    Scene s;
+    s.display = {320, 240, 0.1, 0.9};
+    s.camera.position_m = {0, 0, 0};
+    s.environment.background = Background::uniform;
+    s.environment.luminance_cd_m2 = 0.0;
+    s.glare.model = model;
+    s.glare.eye = small_eye();
+    s.glare.psf_size = 256;
+    s.glare.pupil_mm = 6.0;
+    s.glare.bloom_sigma_deg = 0.2;
+    s.glare.radius_deg = 1.0;
+    return s;
+}
+
+Light light_at(glm::dvec3 p, double intensity_cd = 100.0, double radius_m = 0.1) {
+    Light L;
+    L.position_m = p;
+    L.intensity_cd = intensity_cd;
+    L.radius_m = radius_m;
+    return L;
+}
+
+class GlareFrames : public GLTest {
+protected:
+    void SetUp() override {
+        GLTest::SetUp();
+        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
+    }
+    double energy(const Scene& scene) {
+        renderer->render(scene, 0.0);
+        return image_illuminance_lux(renderer->read_hdr(), renderer->projection().focal_px);
+    }
+    std::unique_ptr<FrameRenderer> renderer;
+};
+
+TEST_F(GlareFrames, EveryModelPutsTheLightsIlluminanceIntoTheFrame) {
+    for (GlareModel model : {GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer}) {
+        // Sub-pixel (1 km) and area lights (10 m: a 29 px disc, K2012 fig 6.17), slightly off-axis.
+        for (double d : {1000.0, 100.0, 10.0}) {
+            Scene scene = black_scene(model);
+            scene.lights = {light_at(glm::dvec3(0.013, -0.007, -1.0) * d)};
+            const double expected = 100.0 / glm::dot(scene.lights[0].position_m, scene.lights[0].position_m);
+            const double got = energy(scene);
+            EXPECT_NEAR(got / expected, 1.0, 0.01) << glare_model_name(model) << " at " << d << " m";
+            const auto& report = renderer->glare().report();
+            ASSERT_EQ(report.size(), 1u);
+            std::printf("%-14s d = %6.0f m: energy ratio %.6f, window cut %.4f, layers %d up to %.0f px\n",
+                        std::string(glare_model_name(model)).c_str(), d, got / expected, report[0].window_cut.g,
+                        report[0].area_layers, report[0].area_max_radius_px);
+        }
+    }
+}
+
+TEST_F(GlareFrames, GlareAndNoGlareFramesHoldTheSameEnergy) {
+    // K2012 fig 6.17: four 100 cd lights at 10, 20, 50 and 100 m, plus colour and fog.
+    Scene scene = black_scene(GlareModel::wave_optics);
+    scene.environment.extinction_per_m = 1e-3;
+    const double xs[] = {-0.02, -0.007, 0.007, 0.02};
+    const double ds[] = {10, 20, 50, 100};
+    for (int i = 0; i < 4; ++i) scene.lights.push_back(light_at(glm::dvec3(xs[i], 0.0, -1.0) * ds[i]));
+    scene.lights[1].rgb_per_cd = *iala_colour_rgb("red");
+    scene.lights[2].rgb_per_cd = *iala_colour_rgb("green");
+    const double with_glare = energy(scene);
+    const glm::dvec3 rgb_glare = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
+    scene.glare.model = GlareModel::none;
+    const double without = energy(scene);
+    const glm::dvec3 rgb_direct = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
+    EXPECT_NEAR(with_glare / without, 1.0, 0.01);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb_glare[c] / rgb_direct[c], 1.0, 0.01) << "channel " << c;
+    double expected = 0;
+    for (const Light& L : scene.lights)
+        expected += illuminance_lux(evaluate_light(L, scene.profiles, scene.camera.position_m, 0.0, 1e-3));
+    EXPECT_NEAR(with_glare / expected, 1.0, 0.01);
+}
+
+TEST_F(GlareFrames, HiddenLightsEmitNothing) {
+    Scene scene = black_scene(GlareModel::wave_optics);
+    scene.camera.position_m = {0, 3, 0};
+    scene.environment.background = Background::sky_sea;
+    scene.environment.luminance_cd_m2 = 1.0;
+    renderer->render(scene, 0.0);
+    const ImageRGBA32F background = renderer->read_hdr();
+
+    // Below the sea surface, in view: the sea hides it (occlusion by linear depth).
+    scene.lights = {light_at({0.0, -5.0, -1000.0}, 1e5)};
+    renderer->render(scene, 0.0);
+    EXPECT_TRUE(renderer->read_hdr().rgba == background.rgba) << "occluded light";
+    // Behind the camera.
+    scene.lights = {light_at({0.0, 3.0, 50.0}, 1e5)};
+    renderer->render(scene, 0.0);
+    EXPECT_TRUE(renderer->read_hdr().rgba == background.rgba) << "light behind the camera";
+    // Outside its sector: lit only over bearings 200..300°, and the observer is due south of it.
+    Light sectored = light_at({0.0, 3.0, -500.0}, 1e5);
+    const Sector sector{200.0, 300.0, 1.0, 0.0};
+    scene.profiles.horizontal.push_back(HorizontalProfile::from_sectors(std::span<const Sector>(&sector, 1)));
+    sectored.horizontal_profile = static_cast<int>(scene.profiles.horizontal.size()) - 1;
+    scene.lights = {sectored};
+    renderer->render(scene, 0.0);
+    EXPECT_TRUE(renderer->read_hdr().rgba == background.rgba) << "light outside its sector";
+    EXPECT_EQ(renderer->stats().drawn, 0);
+}
+
+TEST_F(GlareFrames, GlareOfALightJustOffTheImageReachesIn) {
+    // Centre 5 px beyond the right edge: its direct image is culled, its glare is not.
+    Scene scene = black_scene(GlareModel::gaussian_bloom);
+    const double f = 2880.0, x_px = 160.0 + 5.0;
+    scene.lights = {light_at({x_px / f * 1000.0, 0.0, -1000.0}, 1e4)};
+    const double got = energy(scene);
+    const double e = 1e4 / glm::dot(scene.lights[0].position_m, scene.lights[0].position_m);
+    EXPECT_GT(got, 0.1 * e);
+    EXPECT_LT(got, 0.6 * e);
+    scene.glare.model = GlareModel::none;
+    EXPECT_EQ(energy(scene), 0.0);
+}
+
+TEST_F(GlareFrames, ApertureImageGivesItsDiffractionPattern) {
+    // A hand-made obstacle: a clear disc crossed by one opaque bar, as a PNG.
+    const int w = 64;
+    std::vector<float> rgb(static_cast<std::size_t>(w) * w * 3, 0.0f);
+    for (int y = 0; y < w; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool open = std::hypot(x - 31.5, y - 31.5) < 12.0 && std::abs(y - 31.5) > 2.0;
+            for (int c = 0; c < 3; ++c) rgb[(static_cast<std::size_t>(y) * w + x) * 3 + c] = open ? 1.0f : 0.0f;
+        }
+    const auto dir = std::filesystem::temp_directory_path() / "atonlab_glare_test";
+    std::filesystem::create_directories(dir);
+    write_png_rgb8(dir / "bar.png", w, w, rgb);
+    Scene scene = black_scene(GlareModel::aperture);
+    scene.glare.aperture_image = (dir / "bar.png").string();
+    scene.lights = {light_at({0.0, 0.0, -500.0})};
+    EXPECT_NEAR(energy(scene) / (100.0 / 250000.0), 1.0, 0.01);
+    ASSERT_NE(renderer->glare().psf(0), nullptr);
+    // The bar (horizontal in the image) diffracts into a vertical streak: more energy along y than along x.
+    const RgbPsf& p = *renderer->glare().psf(0);
+    double along_x = 0, along_y = 0;
+    for (int k = 10; k < 60; ++k) {
+        along_x += p.at(p.n / 2 + k, p.n / 2).g;
+        along_y += p.at(p.n / 2, p.n / 2 + k).g;
+    }
+    EXPECT_GT(along_y, 2 * along_x);
+    scene.glare.aperture_image = (dir / "missing.png").string();
+    EXPECT_NE(input_error_of([&] { renderer->render(scene, 0.0); }).find("aperture_image"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace atonlab::test
