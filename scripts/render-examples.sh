@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Renders every scene in scenes/ to out/NAME.exr (cd/m²) and out/NAME.png.
-# The flashing buoy is sampled at several times through its period.
+# The flashing buoy is sampled at several times through its period; the others
+# are also rendered without glare (NAME-noglare), holding the same energy.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 atonlab="${ATONLAB_BUILD_DIR:-build}/runner/atonlab"
@@ -20,7 +21,9 @@ for scene in scenes/*.toml; do
           -o "out/${name}-bearing${b}.exr" --png "out/${name}-bearing${b}.png"
       done ;;
     *)
-      "$atonlab" render "$scene" -o "out/${name}.exr" --png "out/${name}.png" ;;
+      "$atonlab" render "$scene" -o "out/${name}.exr" --png "out/${name}.png"
+      # The energy-matched no-glare variant of the same frame.
+      "$atonlab" render "$scene" --set 'eye.glare="none"' -o "out/${name}-noglare.exr" --png "out/${name}-noglare.png" ;;
   esac
 done
 echo "Rendered $(ls out/*.exr | wc -l) frames: EXR (linear Rec.709, cd/m²) and PNG previews are in $(pwd)/out/"

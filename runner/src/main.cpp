@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     atonlab::runner::RenderOptions render;
     atonlab::runner::add_render_command(app, render);
+    atonlab::runner::PsfOptions psf;
+    atonlab::runner::add_psf_command(app, psf);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -23,6 +25,7 @@ int main(int argc, char** argv) {
     }
     try {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);
+        if (app.got_subcommand("psf")) return atonlab::runner::run_psf(psf);
     } catch (const atonlab::InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;

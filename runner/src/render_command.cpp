@@ -13,6 +13,7 @@
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/context.h"
+#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "commands.h"
@@ -72,6 +73,18 @@ int run_render(const RenderOptions& o) {
     meta.strings["scene"] = o.scene;
     meta.strings["time_s"] = fmt::format("{}", o.time_s);
     meta.strings["software"] = "atonlab " ATONLAB_VERSION;
+    meta.strings["glare"] = std::string(stimuli::glare_model_name(scene.glare.model));
+    std::string glare_note;
+    for (const auto& g : renderer.glare().report()) {
+        const std::string line = fmt::format(
+            "spd={} pupil_mm={:.3f} kernel_px={} radius_deg={:.3f} window={} window_cut_rgb=[{:.4f}, {:.4f}, {:.4f}] "
+            "area_layers={} area_max_radius_px={:.1f}",
+            g.spd.empty() ? "d65" : g.spd, g.pupil_mm, g.kernel_size_px, g.radius_deg,
+            stimuli::glare_window_name(scene.glare.window), g.window_cut.r, g.window_cut.g, g.window_cut.b,
+            g.area_layers, g.area_max_radius_px);
+        meta.strings[fmt::format("glare_{}", g.spd.empty() ? "d65" : g.spd)] = line;
+        glare_note += fmt::format("  glare ({}): {}\n", stimuli::glare_model_name(scene.glare.model), line);
+    }
     if (o.half) {
         // Half floats end at 65504; the core of a bright light is far above that
         // (a 250 cd, 0.1 m light is ~8000 cd/m² ... 1e9 cd/m² sub-pixel). Clamp rather
@@ -108,6 +121,7 @@ int run_render(const RenderOptions& o) {
     std::printf("%s: %dx%d, %d of %d lights drawn, %.4f deg/px -> %s%s%s\n", o.scene.c_str(), hdr.width, hdr.height,
                 st.drawn, st.lights, meta.degrees_per_pixel, o.exr.c_str(), o.png.empty() ? "" : ", ",
                 o.png.c_str());
+    std::fputs(glare_note.c_str(), stdout);
     return 0;
 }
 
