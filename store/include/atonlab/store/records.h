@@ -1,0 +1,123 @@
+#pragma once
+// The rows the store keeps, as plain values (the schema is in store/src/schema.cpp,
+// explained in docs/store.md). Times are in seconds, lengths in metres; wall-clock
+// stamps are ISO 8601 UTC text written by the store ("2024-05-01T12:00:00.123Z").
+#include <compare>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace atonlab::store {
+
+/// The row id of a session; only meaningful inside the study file it came from.
+struct SessionId {
+    std::int64_t value = 0;
+    friend auto operator<=>(const SessionId&, const SessionId&) = default;
+};
+
+/// The row id of a display calibration.
+struct CalibrationId {
+    std::int64_t value = 0;
+    friend auto operator<=>(const CalibrationId&, const CalibrationId&) = default;
+};
+
+/// A session is `running` until finish_session(); a process that dies leaves it
+/// `running`, and a later run may mark it `crashed` or resume it.
+enum class SessionStatus { running, quit, completed, crashed };
+
+/// "running", "quit", "completed", "crashed": the text stored in sessions.status.
+const char* to_string(SessionStatus status) noexcept;
+/// The inverse of to_string; std::nullopt for any other text.
+std::optional<SessionStatus> session_status_from_string(std::string_view text) noexcept;
+
+/// A display's geometry and its measured (or imported) calibration.
+struct Calibration {
+    std::string display_name;  ///< e.g. "lab-oled-1"; displays are keyed by name
+    int width_px = 0;
+    int height_px = 0;
+    double width_m = 0.0;   ///< visible image width, metres
+    double height_m = 0.0;  ///< visible image height, metres
+    double viewing_distance_m = 0.0;
+    std::string fit_json = "{}";  ///< the fitted display model's parameters, JSON text
+    std::string source;           ///< how it was obtained: "measured", "imported FILE", ...
+    std::string measured_at;      ///< ISO 8601 date or date-time of the measurement
+
+    // Filled by the store on read.
+    CalibrationId id{};
+    std::string recorded_at;  ///< when the store wrote the row
+};
+
+/// What begin_session() needs.
+struct SessionStart {
+    std::string observer_code;                 ///< 1-32 of [A-Za-z0-9_-]: a code, never a name
+    std::string protocol_text;                 ///< the protocol file's full text (stored once per hash)
+    std::string protocol_name;                 ///< e.g. the file name, for people reading the file
+    std::uint64_t seed = 0;                    ///< the session's random seed
+    std::optional<CalibrationId> calibration;  ///< the calibration the runner used, if any
+    /// The software that ran the session; empty means this library's own version
+    /// (software_version()).
+    std::string software_version;
+};
+
+/// A session as stored.
+struct SessionRecord {
+    SessionId id{};
+    std::string observer_code;
+    std::int64_t protocol_id = 0;
+    std::string protocol_name;
+    std::string protocol_sha256;  ///< lowercase hex SHA-256 of the protocol text (FIPS 180-4)
+    std::string software_version;
+    std::uint64_t seed = 0;
+    std::optional<CalibrationId> calibration;
+    std::string started_at;
+    std::optional<std::string> ended_at;  ///< set by finish_session()
+    SessionStatus status = SessionStatus::running;
+    int resume_count = 0;  ///< how many times resume_session() reopened it
+    std::int64_t trial_count = 0;
+};
+
+/// One trial: what was shown, what the observer answered, how well the frames
+/// were timed, and the procedure's state after the answer.
+struct TrialRecord {
+    std::int64_t trial_index = 0;             ///< 0-based within the session, no gaps (the store enforces it)
+    int block = 0;                            ///< 0-based block of the protocol
+    std::string condition_id;                 ///< the protocol's condition name
+    std::string procedure_id;                 ///< which procedure instance proposed the stimulus
+    double level = 0.0;                       ///< the procedure's level, in the procedure's own units (see its docs)
+    std::optional<bool> test_on_left;         ///< 2AFC: where the test stimulus was; none for yes/no and adjustment
+    std::string stimulus_json = "{}";         ///< every stimulus parameter (the resolved scene keys), JSON text
+    std::string response;                     ///< the answer's code: "left", "right", "yes", "no", "adjust", "timeout"
+    std::optional<double> response_value;     ///< method of adjustment: the value the observer set
+    double response_time_s = 0.0;             ///< stimulus onset to answer, seconds, >= 0
+    double onset_time_s = 0.0;                ///< stimulus onset on the runner's clock, seconds since session start
+    int dropped_frames = 0;                   ///< frames the presentation missed, >= 0
+    bool missed_deadline = false;             ///< the onset frame itself was late
+    std::string procedure_state_json = "{}";  ///< the procedure's state after this trial, JSON text
+
+    // Filled by the store on read.
+    std::string recorded_at;
+};
+
+/// Everything a runner needs to continue a session: replay `trials` through the
+/// protocol's procedures (parsed from `protocol_text`) and go on at next_trial_index.
+struct ResumePoint {
+    SessionRecord session;
+    std::string protocol_text;
+    std::vector<TrialRecord> trials;  ///< in trial_index order, 0 .. next_trial_index-1
+    std::int64_t next_trial_index = 0;
+};
+
+/// The stimulus as rendered for one condition of one session, e.g. an EXR file's bytes.
+struct Snapshot {
+    SessionId session{};
+    std::string condition_id;
+    std::string format = "exr";  ///< what `data` is: "exr" for an OpenEXR file's bytes
+    std::vector<std::byte> data;
+    std::string sha256;       ///< of data; the store fills and verifies it
+    std::string recorded_at;  ///< filled by the store
+};
+
+}  // namespace atonlab::store

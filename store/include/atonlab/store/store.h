@@ -1,0 +1,119 @@
+#pragma once
+// Store: one study's SQLite file (docs/store.md). A writer commits every trial in
+// its own transaction before record_trial() returns (WAL, synchronous=FULL), so
+// a response the runner was told is stored survives a killed process and a power
+// cut. Readers (open_read_only) can read while a writer session runs.
+//
+// One Store is one SQLite connection: use it from one thread at a time. Several
+// Stores (in one or several processes) may open the same file. A moved-from
+// Store may only be destroyed or assigned to.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "atonlab/store/error.h"
+#include "atonlab/store/records.h"
+
+namespace atonlab::store {
+
+struct StoreOptions {
+    /// How long a statement waits for another connection's lock before StoreErrc::busy.
+    int busy_timeout_ms = 5000;
+    /// 0: no limit. Otherwise the file may not grow past this many bytes (rounded
+    /// down to whole pages; PRAGMA max_page_count): writes beyond it fail with
+    /// StoreErrc::disk_full exactly as a full disk would. Lets a lab cap a study's
+    /// size, and lets tests exercise the disk-full path.
+    std::int64_t max_size_bytes = 0;
+};
+
+class Store {
+public:
+    /// Opens `path` for reading and writing, creating it (and its schema) if it
+    /// does not exist, migrating an older schema in one transaction. Throws
+    /// StoreError: cannot_open (missing directory, ...), not_a_database,
+    /// not_a_study, newer_schema (file untouched), read_only, io_error, busy.
+    static Store create_or_open(const std::filesystem::path& path, const StoreOptions& options = {});
+    /// As create_or_open, but the file must already exist (a typo in a path does
+    /// not silently start a new, empty study).
+    static Store open_existing(const std::filesystem::path& path, const StoreOptions& options = {});
+    /// Opens an existing study with SQLITE_OPEN_READONLY; may run alongside a
+    /// writer. Every write method then throws StoreErrc::read_only. A file whose
+    /// schema is older than this code throws older_schema (migrating needs a writer).
+    static Store open_read_only(const std::filesystem::path& path, const StoreOptions& options = {});
+
+    Store(Store&&) noexcept;
+    Store& operator=(Store&&) noexcept;
+    Store(const Store&) = delete;
+    Store& operator=(const Store&) = delete;
+    ~Store();
+
+    const std::filesystem::path& path() const noexcept;
+    bool read_only() const noexcept;
+
+    // --- Displays -----------------------------------------------------------
+    /// Stores a calibration (and its display, by name, if new).
+    CalibrationId put_calibration(const Calibration& calibration);
+    /// The display's calibration with the latest measured_at (then the latest
+    /// stored), or std::nullopt when the display has none.
+    std::optional<Calibration> latest_calibration(std::string_view display_name) const;
+    Calibration calibration(CalibrationId id) const;
+
+    // --- Sessions -----------------------------------------------------------
+    /// Records the observer and the protocol (once per text hash) if new and
+    /// starts a `running` session. One transaction.
+    SessionId begin_session(const SessionStart& start);
+    /// Ends a running session with `status` (quit, completed or crashed) and
+    /// stamps ended_at. Throws invalid_argument for `running` or a session that
+    /// is not running.
+    void finish_session(SessionId session, SessionStatus status);
+    /// Reopens a session left running (its process died), crashed or quit, so
+    /// record_trial may continue it; counts the resume. Returns the resume point.
+    /// A completed session cannot be resumed.
+    ResumePoint resume_session(SessionId session);
+
+    std::vector<SessionRecord> sessions() const;
+    SessionRecord session(SessionId session) const;
+    /// The protocol text the session ran (byte for byte what begin_session got).
+    std::string protocol_text(SessionId session) const;
+
+    // --- Trials -------------------------------------------------------------
+    /// Appends one trial in its own transaction, durable when this returns.
+    /// trial.trial_index must be the session's next index (its trial count) and
+    /// the session must be running; otherwise invalid_argument and nothing is
+    /// written. On any failure (disk full, I/O error) the trial is not stored and
+    /// every earlier trial is intact.
+    void record_trial(SessionId session, const TrialRecord& trial);
+    /// The session's trials in trial_index order.
+    std::vector<TrialRecord> trials(SessionId session) const;
+    std::int64_t trial_count(SessionId session) const;
+    /// The session, its protocol and its trials, read in one snapshot: what a
+    /// runner replays through its procedures to continue.
+    ResumePoint resume_point(SessionId session) const;
+
+    // --- Stimulus snapshots -------------------------------------------------
+    /// Stores (or replaces) the snapshot for (session, condition), with its SHA-256.
+    void put_snapshot(SessionId session, std::string_view condition_id, std::span<const std::byte> data,
+                      std::string_view format = "exr");
+    /// The snapshot, checked against its stored SHA-256 (corrupt if it differs),
+    /// or std::nullopt when there is none.
+    std::optional<Snapshot> get_snapshot(SessionId session, std::string_view condition_id) const;
+
+    // --- Maintenance --------------------------------------------------------
+    /// PRAGMA integrity_check's answer: "ok", or SQLite's list of problems.
+    std::string integrity_check() const;
+    /// The file's PRAGMA user_version.
+    int file_schema_version() const;
+
+    struct Impl;
+
+private:
+    explicit Store(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace atonlab::store

@@ -1,0 +1,155 @@
+// The study file's schema, in one place. Each Migration takes a file from
+// user_version N-1 to N; a new column or table is a new step appended to the
+// list, never an edit of a step that has shipped (files in the field were made
+// by it). docs/store.md explains every table for people reading the file.
+#include "atonlab/store/schema.h"
+
+#include <array>
+
+namespace atonlab::store {
+namespace {
+
+// Conventions used by every table:
+//  * wall-clock stamps (…_at) are ISO 8601 UTC text with milliseconds, made by
+//    SQLite: strftime('%Y-%m-%dT%H:%M:%fZ', 'now'); text order is time order;
+//  * durations and stimulus-clock times are REAL seconds (…_s);
+//  * …_json columns are JSON text, checked with SQLite's json_valid();
+//  * booleans are INTEGER 0/1; ids are INTEGER PRIMARY KEY row ids.
+constexpr std::string_view schema_v1 = R"sql(
+-- Which atonlab built or migrated this file, step by step.
+CREATE TABLE schema_history (
+    version          INTEGER PRIMARY KEY,        -- the user_version this step reached
+    description      TEXT NOT NULL,
+    software_version TEXT NOT NULL,              -- atonlab version that applied the step
+    applied_at       TEXT NOT NULL
+);
+
+-- Protocol files, byte for byte, stored once per distinct text.
+CREATE TABLE protocols (
+    id       INTEGER PRIMARY KEY,
+    sha256   TEXT NOT NULL UNIQUE CHECK (length(sha256) = 64),  -- lowercase hex SHA-256 of text (FIPS 180-4)
+    name     TEXT NOT NULL,                      -- the name it was first stored under (usually the file name)
+    text     TEXT NOT NULL,
+    added_at TEXT NOT NULL
+);
+
+-- Displays, by the name the lab gives them.
+CREATE TABLE displays (
+    id   INTEGER PRIMARY KEY,
+    name TEXT NOT NULL UNIQUE CHECK (length(name) > 0)
+);
+
+-- A display's geometry and fitted model at one date. Never updated: a new
+-- calibration is a new row, so every session keeps the one it ran with.
+CREATE TABLE calibrations (
+    id                 INTEGER PRIMARY KEY,
+    display_id         INTEGER NOT NULL REFERENCES displays(id),
+    width_px           INTEGER NOT NULL CHECK (width_px > 0),
+    height_px          INTEGER NOT NULL CHECK (height_px > 0),
+    width_m            REAL NOT NULL CHECK (width_m > 0),
+    height_m           REAL NOT NULL CHECK (height_m > 0),
+    viewing_distance_m REAL NOT NULL CHECK (viewing_distance_m > 0),
+    fit_json           TEXT NOT NULL CHECK (json_valid(fit_json)),  -- the display model's parameters
+    source             TEXT NOT NULL,            -- "measured", "imported FILE", ...
+    measured_at        TEXT NOT NULL,            -- ISO 8601 date (or date-time) of the measurement
+    recorded_at        TEXT NOT NULL
+);
+CREATE INDEX calibrations_by_display ON calibrations (display_id, measured_at);
+
+-- Observers by code only: the file never holds a person's name.
+CREATE TABLE observers (
+    id       INTEGER PRIMARY KEY,
+    code     TEXT NOT NULL UNIQUE
+             CHECK (length(code) BETWEEN 1 AND 32 AND code NOT GLOB '*[^A-Za-z0-9_-]*'),
+    added_at TEXT NOT NULL
+);
+
+-- One run of a protocol by one observer. 'running' until finished; a process
+-- that dies leaves 'running' behind, which a later run marks 'crashed' or resumes.
+CREATE TABLE sessions (
+    id               INTEGER PRIMARY KEY,
+    observer_id      INTEGER NOT NULL REFERENCES observers(id),
+    protocol_id      INTEGER NOT NULL REFERENCES protocols(id),
+    calibration_id   INTEGER REFERENCES calibrations(id),   -- NULL: run without a calibration
+    software_version TEXT NOT NULL,
+    seed             INTEGER NOT NULL,           -- the uint64 seed's bits, read as a signed 64-bit integer
+    started_at       TEXT NOT NULL,
+    ended_at         TEXT,
+    status           TEXT NOT NULL DEFAULT 'running'
+                     CHECK (status IN ('running', 'quit', 'completed', 'crashed')),
+    resume_count     INTEGER NOT NULL DEFAULT 0 CHECK (resume_count >= 0),
+    CHECK ((status = 'running') = (ended_at IS NULL))
+);
+CREATE INDEX sessions_by_observer ON sessions (observer_id);
+CREATE INDEX sessions_by_protocol ON sessions (protocol_id);
+
+-- One row per answered trial, appended in its own transaction. trial_index runs
+-- 0, 1, 2, ... within a session with no gaps (Store::record_trial enforces it).
+CREATE TABLE trials (
+    id                   INTEGER PRIMARY KEY,
+    session_id           INTEGER NOT NULL REFERENCES sessions(id),
+    trial_index          INTEGER NOT NULL CHECK (trial_index >= 0),
+    block                INTEGER NOT NULL CHECK (block >= 0),
+    condition_id         TEXT NOT NULL,
+    procedure_id         TEXT NOT NULL,
+    level                REAL NOT NULL,          -- the procedure's level, in its own units
+    test_on_left         INTEGER CHECK (test_on_left IN (0, 1)),  -- 2AFC only; NULL otherwise
+    stimulus_json        TEXT NOT NULL CHECK (json_valid(stimulus_json)),  -- every stimulus parameter
+    response             TEXT NOT NULL,          -- "left", "right", "yes", "no", "adjust", "timeout", ...
+    response_value       REAL,                   -- method of adjustment: the value set; NULL otherwise
+    response_time_s      REAL NOT NULL CHECK (response_time_s >= 0),     -- onset to answer
+    onset_time_s         REAL NOT NULL,          -- onset on the runner's clock, since session start
+    dropped_frames       INTEGER NOT NULL CHECK (dropped_frames >= 0),
+    missed_deadline      INTEGER NOT NULL CHECK (missed_deadline IN (0, 1)),
+    procedure_state_json TEXT NOT NULL CHECK (json_valid(procedure_state_json)),  -- after this trial
+    recorded_at          TEXT NOT NULL,
+    UNIQUE (session_id, trial_index)
+);
+CREATE INDEX trials_by_condition ON trials (condition_id);
+
+-- Nothing stored is lost: a recorded trial is never changed or deleted.
+CREATE TRIGGER trials_append_only_update BEFORE UPDATE ON trials
+BEGIN SELECT RAISE(ABORT, 'trials are append-only: a recorded trial cannot be changed'); END;
+CREATE TRIGGER trials_append_only_delete BEFORE DELETE ON trials
+BEGIN SELECT RAISE(ABORT, 'trials are append-only: a recorded trial cannot be deleted'); END;
+
+-- The stimulus as rendered, one per session and condition: an OpenEXR file's
+-- bytes (scene-referred cd/m2, DESIGN.md "File formats"), so a study is one file.
+CREATE TABLE snapshots (
+    session_id   INTEGER NOT NULL REFERENCES sessions(id),
+    condition_id TEXT NOT NULL,
+    format       TEXT NOT NULL,                  -- "exr"
+    data         BLOB NOT NULL,
+    sha256       TEXT NOT NULL CHECK (length(sha256) = 64),  -- of data, checked on every read
+    recorded_at  TEXT NOT NULL,
+    PRIMARY KEY (session_id, condition_id)
+);
+
+-- Every trial with who ran it and under which protocol: the flat table
+-- analysis and ad-hoc SQL start from.
+CREATE VIEW trial_log AS
+SELECT t.session_id, o.code AS observer_code, p.sha256 AS protocol_sha256, s.status AS session_status,
+       t.trial_index, t.block, t.condition_id, t.procedure_id, t.level, t.test_on_left, t.response,
+       t.response_value, t.response_time_s, t.onset_time_s, t.dropped_frames, t.missed_deadline,
+       t.stimulus_json, t.procedure_state_json, t.recorded_at
+FROM trials t
+JOIN sessions s ON s.id = t.session_id
+JOIN observers o ON o.id = s.observer_id
+JOIN protocols p ON p.id = s.protocol_id;
+)sql";
+
+constexpr std::array<Migration, 1> migrations = {
+    Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
+};
+
+}  // namespace
+
+std::span<const Migration> schema_migrations() noexcept {
+    return migrations;
+}
+
+int schema_version() noexcept {
+    return migrations.back().to_version;
+}
+
+}  // namespace atonlab::store

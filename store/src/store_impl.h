@@ -1,0 +1,42 @@
+#pragma once
+// Store's private state, shared by the files that implement its parts
+// (store.cpp, sessions.cpp, trials.cpp, calibrations.cpp, snapshots.cpp).
+#include <fmt/format.h>
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "atonlab/store/store.h"
+#include "sqlite.h"
+
+namespace atonlab::store {
+
+/// SQL for "now" as the store stamps it (see schema.cpp's conventions).
+#define ATONLAB_STORE_NOW "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
+
+struct Store::Impl {
+    std::unique_ptr<sql::Connection> db;
+    bool read_only = false;
+
+    const std::filesystem::path& path() const { return db->path(); }
+
+    /// Throws StoreErrc::read_only naming `doing` when this Store is a reader.
+    void require_writable(std::string_view doing) const;
+    /// Throws StoreErrc::invalid_argument: "PATH: cannot DOING: WHY".
+    [[noreturn]] void invalid(std::string_view doing, std::string_view why) const;
+    /// Throws StoreErrc::not_found: "PATH: cannot DOING: WHAT is not in the file".
+    [[noreturn]] void not_found(std::string_view doing, std::string_view what) const;
+
+    /// The session's status, or not_found. Call inside a transaction.
+    SessionStatus status_of(SessionId session, std::string_view doing);
+    SessionRecord read_session(SessionId session, std::string_view doing);
+    std::vector<TrialRecord> read_trials(SessionId session, std::string_view doing);
+    std::string read_protocol_text(SessionId session, std::string_view doing);
+    ResumePoint read_resume_point(SessionId session, std::string_view doing);
+};
+
+/// True when `text` is valid JSON by SQLite's own json_valid(), the CHECK the schema uses.
+bool json_valid(sql::Connection& db, std::string_view text, std::string_view doing);
+
+}  // namespace atonlab::store

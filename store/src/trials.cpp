@@ -1,0 +1,159 @@
+// Trials: one committed transaction per response, and reading them back.
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "store_impl.h"
+
+namespace atonlab::store {
+namespace {
+
+// Checks that need no database, so a bad value never starts a transaction.
+// SQLite would store a NaN as NULL, so finiteness is checked here.
+std::string why_invalid(const TrialRecord& t) {
+    if (t.trial_index < 0) return "trial_index is negative";
+    if (t.block < 0) return "block is negative";
+    if (t.condition_id.empty()) return "condition_id is empty";
+    if (t.procedure_id.empty()) return "procedure_id is empty";
+    if (!std::isfinite(t.level)) return "level is not finite";
+    if (t.response.empty()) return "response is empty";
+    if (t.response_value && !std::isfinite(*t.response_value)) return "response_value is not finite";
+    if (!std::isfinite(t.response_time_s) || t.response_time_s < 0.0) {
+        return "response_time_s is not a finite, non-negative number of seconds";
+    }
+    if (!std::isfinite(t.onset_time_s)) return "onset_time_s is not finite";
+    if (t.dropped_frames < 0) return "dropped_frames is negative";
+    return {};
+}
+
+}  // namespace
+
+void Store::record_trial(SessionId session, const TrialRecord& t) {
+    const std::string doing = fmt::format("record trial {} of session {}", t.trial_index, session.value);
+    impl_->require_writable(doing);
+    if (const std::string why = why_invalid(t); !why.empty()) impl_->invalid(doing, why);
+    sql::Connection& db = *impl_->db;
+    try {
+        sql::Transaction tx(db, sql::Transaction::Kind::write, doing);
+        {
+            // The session must be running, the index must be the next one (no gap,
+            // no overwrite), and the JSON must parse: all checked under the write
+            // lock, so two writers cannot both take the same index.
+            sql::Use s(
+                db.cached("SELECT s.status, "
+                          "coalesce((SELECT max(trial_index) FROM trials WHERE session_id = s.id), -1) + 1, "
+                          "json_valid(?2), json_valid(?3) FROM sessions s WHERE s.id = ?1"));
+            s->bind(1, session.value);
+            s->bind(2, t.stimulus_json);
+            s->bind(3, t.procedure_state_json);
+            if (!s->step(doing)) impl_->not_found(doing, fmt::format("session {}", session.value));
+            const std::string status = s->text(0);
+            if (status != "running") {
+                impl_->invalid(doing, fmt::format("session {} is {}, not running", session.value, status));
+            }
+            if (const std::int64_t next = s->int64(1); next != t.trial_index) {
+                impl_->invalid(doing, fmt::format("the session's next trial index is {}", next));
+            }
+            if (s->int64(2) != 1) impl_->invalid(doing, "stimulus_json is not valid JSON");
+            if (s->int64(3) != 1) impl_->invalid(doing, "procedure_state_json is not valid JSON");
+        }
+        {
+            sql::Use s(db.cached(
+                "INSERT INTO trials (session_id, trial_index, block, condition_id, procedure_id, level, test_on_left, "
+                "stimulus_json, response, response_value, response_time_s, onset_time_s, dropped_frames, "
+                "missed_deadline, procedure_state_json, recorded_at) "
+                "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, " ATONLAB_STORE_NOW ")"));
+            s->bind(1, session.value);
+            s->bind(2, t.trial_index);
+            s->bind(3, t.block);
+            s->bind(4, t.condition_id);
+            s->bind(5, t.procedure_id);
+            s->bind(6, t.level);
+            if (t.test_on_left) {
+                s->bind(7, *t.test_on_left ? 1 : 0);
+            } else {
+                s->bind_null(7);
+            }
+            s->bind(8, t.stimulus_json);
+            s->bind(9, t.response);
+            s->bind(10, t.response_value);
+            s->bind(11, t.response_time_s);
+            s->bind(12, t.onset_time_s);
+            s->bind(13, t.dropped_frames);
+            s->bind(14, t.missed_deadline ? 1 : 0);
+            s->bind(15, t.procedure_state_json);
+            s->run(doing);
+        }
+        tx.commit();  // synchronous=FULL: the WAL is on disk when this returns
+    } catch (const StoreError& e) {
+        if (e.kind() != StoreErrc::disk_full) throw;
+        // The transaction was rolled back before any commit record reached the WAL.
+        throw StoreError(
+            e.kind(), e.file(),
+            std::string(e.what()) + "; this trial was not stored, and the trials stored before it are intact",
+            e.sqlite_code());
+    }
+}
+
+std::vector<TrialRecord> Store::Impl::read_trials(SessionId session, std::string_view doing) {
+    std::vector<TrialRecord> out;
+    sql::Use s(db->cached(
+        "SELECT trial_index, block, condition_id, procedure_id, level, test_on_left, stimulus_json, response, "
+        "response_value, response_time_s, onset_time_s, dropped_frames, missed_deadline, procedure_state_json, "
+        "recorded_at FROM trials WHERE session_id = ?1 ORDER BY trial_index"));
+    s->bind(1, session.value);
+    while (s->step(doing)) {
+        TrialRecord t;
+        t.trial_index = s->int64(0);
+        t.block = s->int32(1);
+        t.condition_id = s->text(2);
+        t.procedure_id = s->text(3);
+        t.level = s->real(4);
+        if (!s->is_null(5)) t.test_on_left = s->int64(5) != 0;
+        t.stimulus_json = s->text(6);
+        t.response = s->text(7);
+        if (!s->is_null(8)) t.response_value = s->real(8);
+        t.response_time_s = s->real(9);
+        t.onset_time_s = s->real(10);
+        t.dropped_frames = s->int32(11);
+        t.missed_deadline = s->int64(12) != 0;
+        t.procedure_state_json = s->text(13);
+        t.recorded_at = s->text(14);
+        out.push_back(std::move(t));
+    }
+    return out;
+}
+
+std::vector<TrialRecord> Store::trials(SessionId session) const {
+    const std::string doing = fmt::format("read the trials of session {}", session.value);
+    sql::Transaction tx(*impl_->db, sql::Transaction::Kind::read, doing);
+    impl_->status_of(session, doing);  // not_found for an unknown session, rather than an empty list
+    auto out = impl_->read_trials(session, doing);
+    tx.commit();
+    return out;
+}
+
+std::int64_t Store::trial_count(SessionId session) const {
+    const std::string doing = fmt::format("count the trials of session {}", session.value);
+    sql::Transaction tx(*impl_->db, sql::Transaction::Kind::read, doing);
+    impl_->status_of(session, doing);
+    sql::Use s(impl_->db->cached("SELECT count(*) FROM trials WHERE session_id = ?1"));
+    s->bind(1, session.value);
+    s->step(doing);
+    const std::int64_t n = s->int64(0);
+    s->reset();
+    tx.commit();
+    return n;
+}
+
+ResumePoint Store::resume_point(SessionId session) const {
+    const std::string doing = fmt::format("read the resume point of session {}", session.value);
+    // One read transaction: the session row and its trials come from one snapshot
+    // even while a writer appends.
+    sql::Transaction tx(*impl_->db, sql::Transaction::Kind::read, doing);
+    ResumePoint r = impl_->read_resume_point(session, doing);
+    tx.commit();
+    return r;
+}
+
+}  // namespace atonlab::store
