@@ -19,20 +19,13 @@
 #include <vector>
 
 #include "atonlab/protocols/procedures.h"
+#include "procedure_error.h"
 
 namespace {
 
 using namespace atonlab::protocols;  // NOLINT: the test exercises the whole namespace
 
-template <class F>
-void expect_bad(F make, const std::string& parameter) {
-    try {
-        make();
-        ADD_FAILURE() << "no ProcedureError for " << parameter;
-    } catch (const ProcedureError& e) {
-        EXPECT_EQ(e.parameter(), parameter) << e.what();
-    }
-}
+using atonlab::test::expect_bad;
 
 double normal_cdf(double z) {
     return 0.5 * std::erfc(-z / std::sqrt(2.0));

@@ -16,6 +16,7 @@
 
 #include "atonlab/protocols/quest.h"
 #include "atonlab/protocols/rng.h"
+#include "procedure_error.h"
 
 namespace {
 
@@ -392,15 +393,7 @@ TEST(Quest, ProposalsAreClampedToTheLevelRange) {
 
 // ---- Bad parameters -------------------------------------------------------------
 
-template <class F>
-void expect_bad(F make, const std::string& parameter) {
-    try {
-        make();
-        ADD_FAILURE() << "no ProcedureError for " << parameter;
-    } catch (const ProcedureError& e) {
-        EXPECT_EQ(e.parameter(), parameter) << e.what();
-    }
-}
+using atonlab::test::expect_bad;
 
 TEST(Quest, BadParametersNameTheParameter) {
     const auto with = [](auto change) {

@@ -16,6 +16,7 @@
 #include "atonlab/protocols/rng.h"
 #include "atonlab/protocols/staircase.h"
 #include "atonlab/protocols/weighted_staircase.h"
+#include "procedure_error.h"
 
 namespace {
 
@@ -418,15 +419,7 @@ TEST(StaircaseConvergence, WeightedOnTargetProbability) {
 // ---- Bad parameters -----------------------------------------------------------
 
 /// Expects `make` to throw ProcedureError naming `parameter`.
-template <class F>
-void expect_bad(F make, const std::string& parameter) {
-    try {
-        make();
-        ADD_FAILURE() << "no ProcedureError for " << parameter;
-    } catch (const ProcedureError& e) {
-        EXPECT_EQ(e.parameter(), parameter) << e.what();
-    }
-}
+using atonlab::test::expect_bad;
 
 TEST(Staircase, BadParametersNameTheParameter) {
     const auto with = [](auto change) {
