@@ -1,0 +1,162 @@
+// Tone mapping (K2012 §4.4): the GLSL twin of stimuli/src/tonemap.cpp. Functions only: no
+// main, no bindings. Include it, declare a block holding a ToneMapParams (filled on the CPU
+// by tonemap_gpu_params(), tonemap.h, whose ToneMapGpuParams has this exact layout) and call
+//   vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p)
+// Input: linear Rec.709 RGB in cd/m²; output: display-relative linear Rec.709 RGB
+// (1 = display peak), never negative or NaN.
+//
+// All fp32: every step is arranged so that fp32 keeps a relative 1e-5 or better against the
+// double reference (tests/gl/test_tonemap.cpp): log1p by its series for small L, the cone
+// weight L/(σ₀+L) instead of 1-σ, and colour carried as RGB per unit X+Y+Z (no XYZ -> RGB
+// matrix with its cancellations). GLSL 4.5 has no fp64 exp/log, and nothing here needs one.
+#ifndef ATONLAB_TONEMAP_GLSL
+#define ATONLAB_TONEMAP_GLSL
+
+// ToneOperator and HuePreservation (tonemap.h).
+const uint TONE_EMPIRICAL = 0u;
+const uint TONE_PERCEPTUAL = 1u;
+const uint TONE_REINHARD = 2u;
+const uint TONE_KAKIMOTO = 3u;
+const uint TONE_LINEAR = 4u;
+const uint TONE_CLAMP = 5u;
+const uint HUE_NONE = 0u;
+const uint HUE_XYY = 1u;
+const uint HUE_RGB = 2u;
+
+// kMinAdaptationCdM2, kMaxAdaptationCdM2, kMaxInputCdM2, kMaxScotopicRatio (tonemap.h).
+const float TM_MIN_ADAPTATION = 1e-7;
+const float TM_MAX_ADAPTATION = 1e10;
+const float TM_MAX_INPUT = 1e15;
+const float TM_MAX_SCOTOPIC_RATIO = 1000.0;
+const float TM_LOG10_E = 0.43429448190325182;  // 1/ln 10
+const float TM_LOG2_10 = 3.3219280948873623;
+
+struct ToneMapParams {
+    uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift 0/1, w: white_cd_m2 given 0/1
+    vec4 curve;          // x: 1/L_white² (empirical), y: Reinhard key, z: 1/L_white² (Reinhard), w: Kakimoto g
+    vec4 display;        // x: Kakimoto k, y: white_cd_m2, z: L_dmax (cd/m²), w: L_da (cd/m²)
+    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27)
+    vec4 blue_rgb;       // xyz: blueshift RGB at Y = 1 (eq 4.29); w: blueshift y
+    vec4 blue_per_sum;   // xyz: blueshift RGB per unit X+Y+Z (eq 4.28 path)
+    vec4 rgb_to_x;       // rows of the Rec.709 RGB -> XYZ matrix
+    vec4 rgb_to_y;
+    vec4 rgb_to_z;
+};
+
+// ln(1 + x) for x >= 0. Below 0.1 by its series (to x⁷: relative error < 2e-8), because
+// 1 + x rounds away x's low bits in fp32; above, log(1 + x) is relatively accurate.
+float tm_log1p(float x) {
+    if (x < 0.1) {
+        float t = 1.0 / 5.0 - x * (1.0 / 6.0 - x / 7.0);
+        return x * (1.0 - x * (1.0 / 2.0 - x * (1.0 / 3.0 - x * (1.0 / 4.0 - x * t))));
+    }
+    return log(1.0 + x);
+}
+
+float tm_log10(float x) { return log2(x) * 0.30102999566398120; }
+float tm_exp10(float x) { return exp2(x * TM_LOG2_10); }
+
+// K2012 eq 4.27.
+float rod_sensitivity(float luminance, float sigma0) { return sigma0 / (sigma0 + max(luminance, 0.0)); }
+
+// K2012 eq 4.23 / 4.24 (log10 of the threshold in cd/m² at log10 adaptation).
+float log10_tvi_rod(float l) {
+    if (l <= -3.94) return -2.86;
+    if (l >= -1.44) return l - 0.395;
+    return pow(max(0.405 * l + 1.6, 0.0), 2.18) - 2.86;
+}
+float log10_tvi_cone(float l) {
+    if (l <= -2.6) return -0.72;
+    if (l >= 1.9) return l - 1.255;
+    return pow(max(0.249 * l + 0.65, 0.0), 2.7) - 0.72;
+}
+
+// K2012 eq 4.25 after Larson, Rushmeier & Piatko 1997: V = Y (1.33 (1 + (Y+Z)/X) - 1.68).
+float scotopic_luminance(vec3 xyz) {
+    vec3 c = max(xyz, vec3(0.0));
+    if (!(c.y > 0.0)) return 0.0;
+    float ratio = c.x > 0.0 ? min((c.y + c.z) / c.x, TM_MAX_SCOTOPIC_RATIO) : TM_MAX_SCOTOPIC_RATIO;
+    return max(c.y * (1.33 * (1.0 + ratio) - 1.68), 0.0);
+}
+
+// K2012 eq 4.19 with Krawczyk et al. 2005's log10(L + 1), as 0.002 + δ/(2 + δ).
+float krawczyk_key(float adaptation) {
+    float delta = tm_log1p(max(adaptation, 0.0)) * TM_LOG10_E;
+    return 0.002 + delta / (2.0 + delta);
+}
+
+// Reinhard et al. 2002 eq 4 / K2012 eq 4.20 as L/(1+L)·(1 + L/W²).
+float reinhard_curve(float l, float inv_white_sq) { return l / (1.0 + l) * (1.0 + l * inv_white_sq); }
+
+// The tone curve: display-relative L_d of photopic L_w and scotopic V_w (cd/m²) at adaptation
+// lwa (already clamped). Twin of tone_curve() in tonemap.cpp.
+float tone_curve(float lw, float vw, float lwa, ToneMapParams p) {
+    if (!(lw > 0.0)) return 0.0;
+    lw = min(lw, TM_MAX_INPUT);
+    uint op = p.mode.x;
+    if (op == TONE_EMPIRICAL) {
+        float lr = krawczyk_key(lwa) * (lw / lwa);  // eq 4.18
+        return reinhard_curve(lr, p.curve.x);       // eq 4.20
+    }
+    if (op == TONE_REINHARD) {
+        return reinhard_curve(p.curve.y * (lw / lwa), p.curve.z);
+    }
+    if (op == TONE_KAKIMOTO) {
+        // Kakimoto et al. 2005 eq 7 rescaled: x^g/(x^g + k), x = L_w/L_wa.
+        float xg = exp2(p.curve.w * log2(lw / lwa));
+        return xg / (xg + p.display.x);
+    }
+    if (op == TONE_PERCEPTUAL) {
+        // eq 4.21-4.26: m_C = ε_C(L_da)/ε_C(L_wa), m_R = ε_C(L_da)/ε_R(L_wa).
+        float log_lwa = tm_log10(lwa);
+        float m_c = tm_exp10(p.tvi.x - log10_tvi_cone(log_lwa));
+        float m_r = tm_exp10(p.tvi.x - log10_tvi_rod(log_lwa));
+        float v = vw > 0.0 ? min(vw, 1.33 * (1.0 + TM_MAX_SCOTOPIC_RATIO) * TM_MAX_INPUT) : 0.0;
+        return (m_c * lw + rod_sensitivity(lwa, p.tvi.y) * m_r * v) / p.display.z;
+    }
+    // TONE_LINEAR, TONE_CLAMP: white = white_cd_m2, or L_wa · L_dmax / L_da.
+    float white = p.mode.w != 0u ? p.display.y : lwa * (p.display.z / p.display.w);
+    return lw / white;
+}
+
+vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
+    // Clip to [0, max]; the comparisons send NaN to 0 (and NaN adaptation to the minimum).
+    vec3 rgb = vec3(rgb_cd_m2.r > 0.0 ? min(rgb_cd_m2.r, TM_MAX_INPUT) : 0.0,
+                    rgb_cd_m2.g > 0.0 ? min(rgb_cd_m2.g, TM_MAX_INPUT) : 0.0,
+                    rgb_cd_m2.b > 0.0 ? min(rgb_cd_m2.b, TM_MAX_INPUT) : 0.0);
+    vec3 sum_row = p.rgb_to_x.xyz + p.rgb_to_y.xyz + p.rgb_to_z.xyz;
+    float sum = dot(sum_row, rgb);  // X + Y + Z
+    if (!(sum > 0.0)) return vec3(0.0);
+    float lwa = adaptation_cd_m2 > TM_MIN_ADAPTATION ? min(adaptation_cd_m2, TM_MAX_ADAPTATION) : TM_MIN_ADAPTATION;
+
+    vec3 c = rgb / sum;  // RGB per unit X+Y+Z
+    float y_w = dot(p.rgb_to_y.xyz, c);
+    if (!(y_w > 0.0)) return vec3(0.0);
+    float lw = y_w * sum;
+    float v = 0.0;
+    if (p.mode.x == TONE_PERCEPTUAL) {
+        v = scotopic_luminance(vec3(dot(p.rgb_to_x.xyz, rgb), lw, dot(p.rgb_to_z.xyz, rgb)));
+    }
+    float ld = tone_curve(lw, v, lwa, p);
+
+    // Blueshift weights from the adaptation luminance (eq 4.27); cone weight without 1 - σ.
+    bool blue = p.mode.z != 0u;
+    float sigma0 = p.tvi.y;
+    float rod = blue ? sigma0 / (sigma0 + lwa) : 0.0;
+    float cone = blue ? lwa / (sigma0 + lwa) : 1.0;
+
+    vec3 outc;
+    if (p.mode.y == HUE_XYY) {
+        // eq 4.28 with min(1, L_d): mix in xy = mix of RGB-per-unit-sum, scaled to Y_d.
+        float y_d = cone * y_w + rod * p.blue_rgb.w;
+        outc = (min(1.0, ld) / y_d) * (cone * c + rod * p.blue_per_sum.xyz);
+    } else {
+        // eq 4.29; eq 4.30 for HUE_RGB.
+        outc = ld * ((cone / y_w) * c + rod * p.blue_rgb.xyz);
+        if (p.mode.y == HUE_RGB) outc /= max(1.0, max(outc.r, max(outc.g, outc.b)));
+    }
+    if (p.mode.x == TONE_CLAMP) outc = clamp(outc, vec3(0.0), vec3(1.0));
+    return max(outc, vec3(0.0));
+}
+
+#endif  // ATONLAB_TONEMAP_GLSL
