@@ -1,0 +1,204 @@
+// Display encoding: the GPU twin of encode_pixel() in stimuli/src/display_model.cpp
+// (docs/display-calibration.md). Functions only; include it and pass a DisplayParams.
+//
+// - DisplayParams has the layout of GpuDisplayParams (display_model.h) under both
+//   std140 and std430: fill it with gpu_display_params() and upload it as a UBO or SSBO.
+// - LUT channels read their knots (drive, cd/m², slope; doubles) from the SSBO at
+//   DISPLAY_LUT_BINDING (default 7; #define it before the #include to move it),
+//   filled with gpu_display_lut(). Shaders that never meet a LUT display may leave it unbound.
+// - The inverse transfer functions run in double precision. GLSL has no double
+//   exp/log/pow, so display_log/display_exp below implement them (frexp/ldexp range
+//   reduction and series good to ~1e-16); the dither is integer hashing only. The
+//   CPU and the GPU therefore agree on every code value but for a rounding tie.
+
+#ifndef DISPLAY_LUT_BINDING
+#define DISPLAY_LUT_BINDING 7
+#endif
+
+const int DISPLAY_SRGB = 0;  // TransferKind::srgb
+const int DISPLAY_GOG = 1;   // TransferKind::gog
+const int DISPLAY_LUT = 2;   // TransferKind::lut
+const int DISPLAY_PQ = 3;    // TransferKind::pq
+const int DISPLAY_DITHER_NONE = 0;
+
+struct DisplayChannel {
+    double black_cd_m2;  // L(0)
+    double white_cd_m2;  // L(1)
+    double pq_weight;
+    double a;
+    double b;
+    double k;
+    double gamma;
+    double inv_gamma;
+    int kind;
+    int lut_first;
+    int lut_count;
+    int pad;
+};
+
+struct DisplayParams {
+    DisplayChannel channel[3];
+    int bits;
+    int dither;
+    uint seed;
+    uint pad;
+};
+
+layout(std430, binding = DISPLAY_LUT_BINDING) readonly buffer DisplayLutKnots { double display_lut[]; };
+
+// ---------------------------------------------------------------------------
+// Double-precision log, exp and pow.
+
+const double DISPLAY_LN2_HI = 6.93147180369123816490e-01LF;  // fdlibm's split of ln 2
+const double DISPLAY_LN2_LO = 1.90821492927058770002e-10LF;
+const double DISPLAY_INV_LN2 = 1.44269504088896338700LF;
+
+// ln x for finite x > 0.
+double display_log(double x) {
+    int e;
+    double m = frexp(x, e);  // x = m 2^e, m in [0.5, 1)
+    if (m < 0.70710678118654752440LF) {
+        m *= 2.0LF;
+        e -= 1;
+    }
+    // ln m = 2 atanh(s), s = (m - 1) / (m + 1), |s| <= 0.1716: the series to s^21 leaves < 1e-18.
+    double s = (m - 1.0LF) / (m + 1.0LF);
+    double s2 = s * s;
+    double t = 1.0LF / 21.0LF;
+    t = t * s2 + 1.0LF / 19.0LF;
+    t = t * s2 + 1.0LF / 17.0LF;
+    t = t * s2 + 1.0LF / 15.0LF;
+    t = t * s2 + 1.0LF / 13.0LF;
+    t = t * s2 + 1.0LF / 11.0LF;
+    t = t * s2 + 1.0LF / 9.0LF;
+    t = t * s2 + 1.0LF / 7.0LF;
+    t = t * s2 + 1.0LF / 5.0LF;
+    t = t * s2 + 1.0LF / 3.0LF;
+    t = t * s2 + 1.0LF;
+    double de = double(e);
+    return de * DISPLAY_LN2_HI + (de * DISPLAY_LN2_LO + 2.0LF * s * t);
+}
+
+// e^x for x <= ~700 (underflows to 0 below -745).
+double display_exp(double x) {
+    if (x < -745.0LF) return 0.0LF;
+    double n = floor(x * DISPLAY_INV_LN2 + 0.5LF);
+    double r = (x - n * DISPLAY_LN2_HI) - n * DISPLAY_LN2_LO;  // |r| <= 0.347
+    // Taylor series to r^14 / 14!: truncation < 1e-17 relative.
+    double p = 1.0LF;
+    for (int k = 14; k >= 1; --k) p = 1.0LF + p * r / double(k);
+    return ldexp(p, int(n));
+}
+
+// x^y for x >= 0 and y > 0.
+double display_pow(double x, double y) { return x > 0.0LF ? display_exp(y * display_log(x)) : 0.0LF; }
+
+// ---------------------------------------------------------------------------
+// Dither (display_model.cpp dither_threshold; integer arithmetic only).
+
+uint display_hash32(uint x) {  // "lowbias32" (C. Wellons)
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint display_bayer64(uint x, uint y) {
+    uint v = 0u;
+    for (uint i = 0u; i < 6u; ++i) {
+        uint xb = (x >> i) & 1u;
+        uint yb = (y >> i) & 1u;
+        v = (v << 2) | (((xb ^ yb) << 1) | yb);
+    }
+    return v;
+}
+
+// In [0, 1), 24-bit resolution: code = floor(V (2^bits - 1) + threshold).
+double display_dither_threshold(ivec2 pixel, uint frame, int channel, uint seed) {
+    uint key = display_hash32(seed + 0x9e3779b9u * (uint(channel) + 1u));
+    uint x = uint(pixel.x) + (key & 63u);
+    uint y = uint(pixel.y) + ((key >> 6) & 63u);
+    uint phase =
+        (display_bayer64(x & 63u, y & 63u) << 20) + 0x80000u + frame * 0x9e3779b9u + display_hash32(key ^ 0x5bd1e995u);
+    return double(phase >> 8) * (1.0LF / 16777216.0LF);
+}
+
+// ---------------------------------------------------------------------------
+// Inverse transfer functions (ChannelTransfer::drive_for).
+
+// Exact inverse of the monotone cubic through the LUT knots, for black < L < white.
+double display_lut_drive(DisplayChannel c, double L) {
+    int lo = 0;
+    int hi = c.lut_count - 1;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (display_lut[3 * (c.lut_first + mid) + 1] < L) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    int i0 = 3 * (c.lut_first + lo);
+    int i1 = 3 * (c.lut_first + hi);
+    double v0 = display_lut[i0], L0 = display_lut[i0 + 1], m0 = display_lut[i0 + 2];
+    double v1 = display_lut[i1], L1 = display_lut[i1 + 1], m1 = display_lut[i1 + 2];
+    double h = v1 - v0;
+    double delta = L1 - L0;
+    double c1 = h * m0;
+    double c2 = 3.0LF * delta - 2.0LF * h * m0 - h * m1;
+    double c3 = -2.0LF * delta + h * m0 + h * m1;
+    double y = L - L0;
+    // Newton steps, bisection whenever a step leaves the bracket (display_model.cpp solve_segment).
+    double tlo = 0.0LF, thi = 1.0LF;
+    double t = y / delta;
+    for (int i = 0; i < 64; ++i) {
+        double f = t * (c1 + t * (c2 + t * c3)) - y;
+        if (f < 0.0LF) {
+            tlo = t;
+        } else {
+            thi = t;
+        }
+        double next = t - f / (c1 + t * (2.0LF * c2 + t * 3.0LF * c3));
+        if (!(next > tlo && next < thi)) next = 0.5LF * (tlo + thi);
+        bool done = abs(next - t) <= 1e-15LF || thi - tlo <= 1e-15LF;
+        t = next;
+        if (done) break;
+    }
+    return v0 + t * h;
+}
+
+double display_drive_for(DisplayChannel c, double L) {
+    if (!(L > c.black_cd_m2)) return 0.0LF;
+    L = min(L, c.white_cd_m2);
+    double v = 0.0LF;
+    if (c.kind == DISPLAY_SRGB) {
+        double t = (L - c.black_cd_m2) / (c.white_cd_m2 - c.black_cd_m2);
+        v = t <= 0.0031308049535603713LF ? 12.92LF * t : 1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF;
+    } else if (c.kind == DISPLAY_GOG) {
+        v = (display_pow(L - c.a, c.inv_gamma) - c.b) / c.k;
+    } else if (c.kind == DISPLAY_LUT) {
+        v = L >= c.white_cd_m2 ? 1.0LF : display_lut_drive(c, L);
+    } else {  // PQ: SMPTE ST 2084 inverse EOTF of L / weight
+        double ym1 = display_pow((L / c.pq_weight) / 10000.0LF, 0.1593017578125LF);
+        v = display_pow((0.8359375LF + 18.8515625LF * ym1) / (1.0LF + 18.6875LF * ym1), 78.84375LF);
+    }
+    return clamp(v, 0.0LF, 1.0LF);
+}
+
+// ---------------------------------------------------------------------------
+// The encoder: relative_rgb is linear Rec.709 relative to the display's white
+// (1 = full drive); NaN and negatives give black, values above 1 clip to full drive.
+uvec3 encode_pixel(vec3 relative_rgb, ivec2 pixel, uint frame, DisplayParams p) {
+    double max_code = double((1 << p.bits) - 1);
+    uvec3 code;
+    for (int c = 0; c < 3; ++c) {
+        float d = relative_rgb[c];
+        double dd = isnan(d) ? 0.0LF : double(d);
+        double v = display_drive_for(p.channel[c], dd * p.channel[c].white_cd_m2);
+        double u = p.dither == DISPLAY_DITHER_NONE ? 0.5LF : display_dither_threshold(pixel, frame, c, p.seed);
+        code[c] = uint(clamp(floor(v * max_code + u), 0.0LF, max_code));
+    }
+    return code;
+}

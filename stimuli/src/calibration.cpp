@@ -1,0 +1,762 @@
+#include "atonlab/stimuli/calibration.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlopt.hpp>
+#include <optional>
+#include <sstream>
+
+#include "atonlab/stimuli/colour.h"
+#include "atonlab/stimuli/error.h"
+
+namespace atonlab::stimuli {
+
+const char* channel_name(Channel c) {
+    switch (c) {
+        case Channel::red:
+            return "red";
+        case Channel::green:
+            return "green";
+        case Channel::blue:
+            return "blue";
+        case Channel::grey:
+            return "grey";
+        case Channel::other:
+            return "other";
+    }
+    return "?";
+}
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+    const auto b = s.find_first_not_of(" \t\r");
+    if (b == std::string_view::npos) return {};
+    const auto e = s.find_last_not_of(" \t\r");
+    return s.substr(b, e - b + 1);
+}
+
+std::optional<double> parse_number(std::string_view s) {
+    s = trim(s);
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(SourceLocation{path.string(), 0, 0, ""}, "the calibration file cannot be opened");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// Splits text into lines (without the newline), 1-based numbering by index + 1.
+std::vector<std::string_view> split_lines(std::string_view text) {
+    std::vector<std::string_view> lines;
+    std::size_t pos = 0;
+    while (pos <= text.size()) {
+        std::size_t end = text.find('\n', pos);
+        if (end == std::string_view::npos) end = text.size();
+        lines.push_back(text.substr(pos, end - pos));
+        if (end == text.size()) break;
+        pos = end + 1;
+    }
+    return lines;
+}
+
+glm::dvec3 rgb_of(Channel c, double level) {
+    switch (c) {
+        case Channel::red:
+            return {level, 0.0, 0.0};
+        case Channel::green:
+            return {0.0, level, 0.0};
+        case Channel::blue:
+            return {0.0, 0.0, level};
+        default:
+            return glm::dvec3(level);
+    }
+}
+
+bool is_black(const Measurement& m) {
+    return m.channel != Channel::other && m.level == 0.0;
+}
+
+std::string luminance_key(const Measurement& m) {
+    return m.file.ends_with(".ti3") ? "XYZ_Y" : "cd_m2";
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// CSV.
+
+std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name) {
+    std::vector<Measurement> out;
+    const auto lines = split_lines(text);
+    // Column index of level, channel, cd_m2; -1 until the header is read.
+    int col_level = -1, col_channel = -1, col_cd = -1;
+    std::size_t n_columns = 0;
+    int header_line = 0;
+    for (std::size_t li = 0; li < lines.size(); ++li) {
+        const int line_no = static_cast<int>(li) + 1;
+        std::string_view line = lines[li];
+        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+        if (trim(line).empty()) continue;
+
+        // Fields with their 1-based columns.
+        std::vector<std::pair<std::string_view, int>> fields;
+        std::size_t start = 0;
+        while (true) {
+            const std::size_t comma = line.find(',', start);
+            const std::string_view raw =
+                line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
+            const auto lead = raw.find_first_not_of(" \t");
+            const int column = static_cast<int>(start + (lead == std::string_view::npos ? 0 : lead)) + 1;
+            fields.emplace_back(trim(raw), column);
+            if (comma == std::string_view::npos) break;
+            start = comma + 1;
+        }
+
+        if (header_line == 0) {
+            header_line = line_no;
+            n_columns = fields.size();
+            for (std::size_t i = 0; i < fields.size(); ++i) {
+                const auto name = fields[i].first;
+                int* slot = name == "level"     ? &col_level
+                            : name == "channel" ? &col_channel
+                            : name == "cd_m2"   ? &col_cd
+                                                : nullptr;
+                if (slot == nullptr)
+                    throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
+                                     "unknown column; the header must be `level,channel,cd_m2`");
+                if (*slot >= 0)
+                    throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
+                                     "this column appears twice in the header");
+                *slot = static_cast<int>(i);
+            }
+            for (const auto& [slot, name] :
+                 {std::pair{col_level, "level"}, {col_channel, "channel"}, {col_cd, "cd_m2"}})
+                if (slot < 0)
+                    throw InputError(SourceLocation{file_name, line_no, 0, name},
+                                     "the header lacks this column; it must be `level,channel,cd_m2`");
+            continue;
+        }
+
+        if (fields.size() != n_columns)
+            throw InputError(SourceLocation{file_name, line_no, 0, ""},
+                             fmt::format("this row has {} fields but the header (line {}) has {}", fields.size(),
+                                         header_line, n_columns));
+        const auto& [level_text, level_col] = fields[static_cast<std::size_t>(col_level)];
+        const auto& [channel_text, channel_col] = fields[static_cast<std::size_t>(col_channel)];
+        const auto& [cd_text, cd_col] = fields[static_cast<std::size_t>(col_cd)];
+
+        const auto level = parse_number(level_text);
+        if (!level)
+            throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
+                             fmt::format("'{}' is not a number", level_text));
+        if (*level < 0.0 || *level > 1.0)
+            throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
+                             fmt::format("the drive level must be in [0, 1], not {}", *level));
+        Channel channel = Channel::other;
+        if (channel_text == "red") {
+            channel = Channel::red;
+        } else if (channel_text == "green") {
+            channel = Channel::green;
+        } else if (channel_text == "blue") {
+            channel = Channel::blue;
+        } else if (channel_text == "grey" || channel_text == "white" || channel_text == "black") {
+            channel = Channel::grey;
+            const double want = channel_text == "white" ? 1.0 : 0.0;
+            if (channel_text != "grey" && *level != want)
+                throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
+                                 fmt::format("a '{}' reading must have level {}, not {}", channel_text, want, *level));
+        } else {
+            throw InputError(
+                SourceLocation{file_name, line_no, channel_col, "channel"},
+                fmt::format("unknown channel '{}'; use red, green, blue, grey, white or black", channel_text));
+        }
+        const auto cd = parse_number(cd_text);
+        if (!cd)
+            throw InputError(SourceLocation{file_name, line_no, cd_col, "cd_m2"},
+                             fmt::format("'{}' is not a number", cd_text));
+        if (*cd < 0.0)
+            throw InputError(SourceLocation{file_name, line_no, cd_col, "cd_m2"},
+                             fmt::format("a luminance cannot be negative ({} cd/m²)", *cd));
+        out.push_back(Measurement{*level, channel, *cd, line_no, rgb_of(channel, *level), file_name});
+    }
+    if (header_line == 0)
+        throw InputError(SourceLocation{file_name, 0, 0, ""},
+                         "the file is empty; it needs the header `level,channel,cd_m2`");
+    if (out.empty()) throw InputError(SourceLocation{file_name, header_line, 0, ""}, "the file has no measurements");
+    return out;
+}
+
+std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path) {
+    return parse_calibration_csv(read_text(path), path.string());
+}
+
+// ---------------------------------------------------------------------------
+// ArgyllCMS .ti3 (CGATS). Layout per Argyll's doc/ti3_format.html: identifier
+// CTI3, keywords (DEVICE_CLASS "DISPLAY", LUMINANCE_XYZ_CDM2 "X Y Z",
+// NORMALIZED_TO_Y_100 "YES"), NUMBER_OF_FIELDS, BEGIN_DATA_FORMAT ...
+// END_DATA_FORMAT, NUMBER_OF_SETS, BEGIN_DATA ... END_DATA.
+
+namespace {
+
+struct Token {
+    std::string text;
+    int column;  // 1-based
+};
+
+/// CGATS tokens: whitespace separated, "quoted strings" kept whole, # to end of line a comment.
+std::vector<Token> tokenize(std::string_view line) {
+    std::vector<Token> out;
+    std::size_t i = 0;
+    while (i < line.size()) {
+        const char ch = line[i];
+        if (ch == ' ' || ch == '\t' || ch == '\r') {
+            ++i;
+        } else if (ch == '#') {
+            break;
+        } else if (ch == '"') {
+            const std::size_t end = line.find('"', i + 1);
+            const std::size_t stop = end == std::string_view::npos ? line.size() : end;
+            out.push_back({std::string(line.substr(i + 1, stop - i - 1)), static_cast<int>(i) + 1});
+            i = stop + 1;
+        } else {
+            std::size_t j = i;
+            while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r' && line[j] != '#') ++j;
+            out.push_back({std::string(line.substr(i, j - i)), static_cast<int>(i) + 1});
+            i = j;
+        }
+    }
+    return out;
+}
+
+struct Keyword {
+    std::string value;
+    int line;
+};
+
+}  // namespace
+
+std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::string& file_name) {
+    auto error = [&](int line, int column, std::string key, const std::string& message) {
+        return InputError(SourceLocation{file_name, line, column, std::move(key)}, message);
+    };
+    const auto lines = split_lines(text);
+    enum class State { identifier, header, format, data, done } state = State::identifier;
+    std::map<std::string, Keyword> keywords;
+    std::vector<std::string> fields;
+    int format_line = 0, data_line = 0, end_line = 0;
+    std::optional<std::pair<long, int>> number_of_fields, number_of_sets;  // value, line
+    std::vector<std::pair<std::vector<Token>, int>> rows;                  // tokens, line
+
+    auto parse_count = [&](const std::vector<Token>& t, int line_no) {
+        const auto v = t.size() == 2 ? parse_number(t[1].text) : std::nullopt;
+        if (!v || *v < 0.0 || *v != std::floor(*v))
+            throw error(line_no, t[0].column, t[0].text, "expects one whole number");
+        return std::pair{static_cast<long>(*v), line_no};
+    };
+
+    for (std::size_t li = 0; li < lines.size() && state != State::done; ++li) {
+        const int line_no = static_cast<int>(li) + 1;
+        const auto tokens = tokenize(lines[li]);
+        if (tokens.empty()) continue;
+        const std::string& head = tokens[0].text;
+        switch (state) {
+            case State::identifier:
+                if (head != "CTI3")
+                    throw error(line_no, 1, "",
+                                "this is not an Argyll .ti3 file: it must begin with the identifier CTI3");
+                state = State::header;
+                break;
+            case State::header:
+                if (head == "KEYWORD") {
+                    // Declares a non-standard keyword; its value follows on its own line.
+                } else if (head == "NUMBER_OF_FIELDS") {
+                    number_of_fields = parse_count(tokens, line_no);
+                } else if (head == "NUMBER_OF_SETS") {
+                    number_of_sets = parse_count(tokens, line_no);
+                } else if (head == "BEGIN_DATA_FORMAT") {
+                    format_line = line_no;
+                    state = State::format;
+                    for (std::size_t i = 1; i < tokens.size(); ++i) {
+                        if (tokens[i].text == "END_DATA_FORMAT") {
+                            state = State::header;
+                            break;
+                        }
+                        fields.push_back(tokens[i].text);
+                    }
+                } else if (head == "BEGIN_DATA") {
+                    if (fields.empty())
+                        throw error(line_no, 1, "BEGIN_DATA_FORMAT", "BEGIN_DATA comes before any BEGIN_DATA_FORMAT");
+                    data_line = line_no;
+                    state = State::data;
+                } else {
+                    std::string value;
+                    for (std::size_t i = 1; i < tokens.size(); ++i) value += (i > 1 ? " " : "") + tokens[i].text;
+                    keywords[head] = Keyword{value, line_no};
+                }
+                break;
+            case State::format:
+                for (const auto& t : tokens) {
+                    if (t.text == "END_DATA_FORMAT") {
+                        state = State::header;
+                        break;
+                    }
+                    fields.push_back(t.text);
+                }
+                break;
+            case State::data:
+                if (head == "END_DATA") {
+                    end_line = line_no;
+                    state = State::done;
+                } else {
+                    rows.emplace_back(tokens, line_no);
+                }
+                break;
+            case State::done:
+                break;
+        }
+    }
+    switch (state) {
+        case State::identifier:
+            throw error(0, 0, "", "the file is empty; an Argyll .ti3 file begins with CTI3");
+        case State::format:
+            throw error(format_line, 1, "END_DATA_FORMAT",
+                        fmt::format("BEGIN_DATA_FORMAT at line {} is never closed by END_DATA_FORMAT", format_line));
+        case State::header:
+            throw error(static_cast<int>(lines.size()), 0, "BEGIN_DATA", "the file has no data table (BEGIN_DATA)");
+        case State::data:
+            throw error(data_line, 1, "END_DATA",
+                        fmt::format("the data table that begins at line {} is never closed by END_DATA", data_line));
+        case State::done:
+            break;
+    }
+
+    if (number_of_fields && static_cast<std::size_t>(number_of_fields->first) != fields.size())
+        throw error(number_of_fields->second, 1, "NUMBER_OF_FIELDS",
+                    fmt::format("NUMBER_OF_FIELDS is {} but BEGIN_DATA_FORMAT (line {}) names {} fields",
+                                number_of_fields->first, format_line, fields.size()));
+    auto field_index = [&](const char* name) {
+        const auto it = std::find(fields.begin(), fields.end(), name);
+        if (it == fields.end())
+            throw error(format_line, 1, "BEGIN_DATA_FORMAT",
+                        fmt::format("the data format lacks the field {} (needed: RGB_R RGB_G RGB_B XYZ_Y)", name));
+        return static_cast<std::size_t>(it - fields.begin());
+    };
+    const std::size_t i_r = field_index("RGB_R"), i_g = field_index("RGB_G"), i_b = field_index("RGB_B"),
+                      i_y = field_index("XYZ_Y");
+
+    if (const auto it = keywords.find("DEVICE_CLASS"); it != keywords.end() && it->second.value != "DISPLAY")
+        throw error(it->second.line, 1, "DEVICE_CLASS",
+                    fmt::format("the measurements are of a '{}' device, not a DISPLAY", it->second.value));
+    // XYZ are absolute cd/m² unless NORMALIZED_TO_Y_100 is YES; then white Y = 100 and
+    // LUMINANCE_XYZ_CDM2 holds white's absolute XYZ (Argyll's own readers do the same).
+    double scale = 1.0;
+    if (const auto it = keywords.find("NORMALIZED_TO_Y_100"); it != keywords.end() && it->second.value == "YES") {
+        const auto lum = keywords.find("LUMINANCE_XYZ_CDM2");
+        if (lum == keywords.end())
+            throw error(it->second.line, 1, "LUMINANCE_XYZ_CDM2",
+                        "NORMALIZED_TO_Y_100 is YES but there is no LUMINANCE_XYZ_CDM2 to give the absolute scale");
+        std::istringstream ss(lum->second.value);
+        std::string xs, ys, zs, extra;
+        ss >> xs >> ys >> zs;
+        const auto x = parse_number(xs), y = parse_number(ys), z = parse_number(zs);
+        if (!x || !y || !z || (ss >> extra) || *y <= 0.0)
+            throw error(lum->second.line, 1, "LUMINANCE_XYZ_CDM2",
+                        fmt::format("expects the white's X Y Z in cd/m² (three numbers, Y > 0), not \"{}\"",
+                                    lum->second.value));
+        scale = *y / 100.0;
+    }
+
+    std::vector<Measurement> out;
+    out.reserve(rows.size());
+    for (const auto& [tokens, line_no] : rows) {
+        if (tokens.size() != fields.size())
+            throw error(line_no, 0, "",
+                        fmt::format("this data line has {} values but BEGIN_DATA_FORMAT (line {}) names {} fields",
+                                    tokens.size(), format_line, fields.size()));
+        auto number = [&](std::size_t i) {
+            const auto v = parse_number(tokens[i].text);
+            if (!v)
+                throw error(line_no, tokens[i].column, fields[i], fmt::format("'{}' is not a number", tokens[i].text));
+            return *v;
+        };
+        glm::dvec3 rgb(number(i_r), number(i_g), number(i_b));
+        for (int c = 0; c < 3; ++c) {
+            const std::size_t idx = c == 0 ? i_r : c == 1 ? i_g : i_b;
+            if (rgb[c] < 0.0 || rgb[c] > 100.0)
+                throw error(line_no, tokens[idx].column, fields[idx],
+                            fmt::format("device values are percentages in [0, 100], not {}", rgb[c]));
+        }
+        rgb /= 100.0;
+        const double Y = number(i_y);
+        if (Y < 0.0)
+            throw error(line_no, tokens[i_y].column, "XYZ_Y", fmt::format("a luminance cannot be negative ({})", Y));
+
+        Channel channel = Channel::other;
+        double level = std::max({rgb.r, rgb.g, rgb.b});
+        if (rgb.r == rgb.g && rgb.g == rgb.b) {
+            channel = Channel::grey;
+        } else if (rgb.g == 0.0 && rgb.b == 0.0) {
+            channel = Channel::red;
+        } else if (rgb.r == 0.0 && rgb.b == 0.0) {
+            channel = Channel::green;
+        } else if (rgb.r == 0.0 && rgb.g == 0.0) {
+            channel = Channel::blue;
+        }
+        out.push_back(Measurement{level, channel, Y * scale, line_no, rgb, file_name});
+    }
+    if (number_of_sets && static_cast<std::size_t>(number_of_sets->first) != rows.size())
+        throw error(number_of_sets->second, 1, "NUMBER_OF_SETS",
+                    fmt::format("NUMBER_OF_SETS is {} but the table (lines {}-{}) has {} data lines",
+                                number_of_sets->first, data_line, end_line, rows.size()));
+    if (out.empty()) throw error(data_line, 1, "BEGIN_DATA", "the data table is empty");
+    return out;
+}
+
+std::vector<Measurement> read_argyll_ti3(const std::filesystem::path& path) {
+    return parse_argyll_ti3(read_text(path), path.string());
+}
+
+std::vector<Measurement> read_calibration_file(const std::filesystem::path& path) {
+    const auto ext = path.extension().string();
+    if (ext == ".ti3") return read_argyll_ti3(path);
+    if (ext == ".csv") return read_calibration_csv(path);
+    throw InputError(SourceLocation{path.string(), 0, 0, ""},
+                     fmt::format("unknown calibration file type '{}'; use .csv or an ArgyllCMS .ti3", ext));
+}
+
+// ---------------------------------------------------------------------------
+// Checks.
+
+void check_monotonic(const std::vector<Measurement>& measurements, double relative_tolerance) {
+    for (const auto& m : measurements) {
+        const SourceLocation at{m.file, m.line, 0, luminance_key(m)};
+        if (!std::isfinite(m.luminance_cd_m2) || m.luminance_cd_m2 < 0.0)
+            throw InputError(at, fmt::format("luminance {} cd/m² is not a finite number >= 0", m.luminance_cd_m2));
+        if (!std::isfinite(m.level) || m.level < 0.0 || m.level > 1.0)
+            throw InputError(SourceLocation{m.file, m.line, 0, "level"},
+                             fmt::format("drive level {} is outside [0, 1]", m.level));
+    }
+    for (const Channel ch : {Channel::red, Channel::green, Channel::blue, Channel::grey}) {
+        std::vector<const Measurement*> ramp;
+        for (const auto& m : measurements)
+            if (m.channel == ch || is_black(m)) ramp.push_back(&m);
+        std::stable_sort(ramp.begin(), ramp.end(), [](auto* x, auto* y) { return x->level < y->level; });
+        double max_below = -1.0, max_below_level = 0.0;  // brightest reading at a lower level
+        double max_here = -1.0, level_here = -1.0;
+        for (const Measurement* m : ramp) {
+            if (m->level > level_here) {
+                if (max_here > max_below) {
+                    max_below = max_here;
+                    max_below_level = level_here;
+                }
+                level_here = m->level;
+                max_here = -1.0;
+            }
+            if (m->luminance_cd_m2 < max_below * (1.0 - relative_tolerance))
+                throw InputError(
+                    SourceLocation{m->file, m->line, 0, luminance_key(*m)},
+                    fmt::format("the {} ramp is not monotonic: {} cd/m² at level {} is below the {} cd/m² "
+                                "measured at the lower level {}",
+                                channel_name(ch), m->luminance_cd_m2, m->level, max_below, max_below_level));
+            max_here = std::max(max_here, m->luminance_cd_m2);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// GOG fits.
+
+double gog_luminance_cd_m2(const GogFit& fit, double level) {
+    const double base = fit.b + fit.k * level;
+    return base > 0.0 ? fit.a + std::pow(base, fit.gamma) : fit.a;
+}
+
+GogParams gog_params(const GogFit& fit) {
+    return GogParams{fit.a, fit.b, fit.k, fit.gamma};
+}
+
+namespace {
+
+struct FitData {
+    std::vector<double> level;
+    std::vector<double> log10_cd;  // floored
+    double scale;                  // S: the model is S (alpha + (beta + kappa V)^gamma)
+    double floor_cd;               // luminance floor for logs (a photometer's noise floor)
+};
+
+double model_normalised(const double* x, double v) {
+    const double base = x[1] + x[2] * v;
+    return x[0] + (base > 0.0 ? std::pow(base, x[3]) : 0.0);
+}
+
+double sum_squares(unsigned n, const double* x, double* grad, void* data) {
+    (void)n;
+    (void)grad;  // derivative-free (BOBYQA)
+    const auto& d = *static_cast<const FitData*>(data);
+    double s = 0.0;
+    for (std::size_t i = 0; i < d.level.size(); ++i) {
+        const double L = std::max(d.scale * model_normalised(x, d.level[i]), d.floor_cd);
+        const double r = std::log10(L) - d.log10_cd[i];
+        s += r * r;
+    }
+    return s;
+}
+
+}  // namespace
+
+GogFit fit_gog(const std::vector<Measurement>& ramp) {
+    const SourceLocation where =
+        ramp.empty() ? SourceLocation{} : SourceLocation{ramp.front().file, ramp.front().line, 0, "level"};
+    std::vector<double> levels;
+    for (const auto& m : ramp) levels.push_back(m.level);
+    std::sort(levels.begin(), levels.end());
+    const auto distinct = std::unique(levels.begin(), levels.end()) - levels.begin();
+    if (distinct < 4)
+        throw InputError(
+            where, fmt::format("a GOG fit needs readings at 4 or more distinct levels, this ramp has {}", distinct));
+
+    // Black (mean at level 0, else the darkest reading) and white (mean at the top level).
+    const double top = levels[static_cast<std::size_t>(distinct - 1)];
+    double black_sum = 0.0, white_sum = 0.0, darkest = std::numeric_limits<double>::infinity(), brightest = 0.0;
+    int n_black = 0, n_white = 0;
+    for (const auto& m : ramp) {
+        if (m.level == 0.0) {
+            black_sum += m.luminance_cd_m2;
+            ++n_black;
+        }
+        if (m.level == top) {
+            white_sum += m.luminance_cd_m2;
+            ++n_white;
+        }
+        darkest = std::min(darkest, m.luminance_cd_m2);
+        brightest = std::max(brightest, m.luminance_cd_m2);
+    }
+    const double black = n_black > 0 ? black_sum / n_black : darkest;
+    const double white = white_sum / n_white;
+    if (!(white > black))
+        throw InputError(where, fmt::format("the ramp does not rise: {} cd/m² at level {} against {} cd/m² at black",
+                                            white, top, black));
+
+    FitData d;
+    d.scale = white - black;
+    d.floor_cd = 1e-6 * brightest;  // readings below a millionth of the peak are photometer noise
+    for (const auto& m : ramp) {
+        d.level.push_back(m.level);
+        d.log10_cd.push_back(std::log10(std::max(m.luminance_cd_m2, d.floor_cd)));
+    }
+
+    // Starting point: the straight line log10(L - black) = gamma log10 V + c over V >= 0.1.
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+    int n_line = 0;
+    for (const auto& m : ramp) {
+        if (m.level < 0.1 || m.luminance_cd_m2 <= black) continue;
+        const double x = std::log10(m.level), y = std::log10(m.luminance_cd_m2 - black);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        ++n_line;
+    }
+    double gamma0 = 2.2, kappa0 = 1.0;
+    if (n_line >= 2 && n_line * sxx - sx * sx > 0.0) {
+        gamma0 = (n_line * sxy - sx * sy) / (n_line * sxx - sx * sx);
+        const double c = (sy - gamma0 * sx) / n_line;
+        kappa0 = std::pow(std::pow(10.0, c) / d.scale, 1.0 / gamma0);
+    }
+
+    // Bounds in the normalised parameters (alpha, beta, kappa, gamma); wide enough for any
+    // real display (gamma 0.5-5, cut-off or offset up to half the drive range).
+    const std::vector<double> lb = {0.0, -0.5, 0.1, 0.5};
+    const std::vector<double> ub = {std::max(1.0, 2.0 * black / d.scale), 0.5, 3.0, 5.0};
+    auto clamp_to_bounds = [&](std::vector<double> x) {
+        for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::clamp(x[i], lb[i] + 1e-9, ub[i] - 1e-9);
+        return x;
+    };
+
+    std::vector<double> best;
+    double best_f = std::numeric_limits<double>::infinity();
+    // Three starts (no offset, cut-off, offset) guard against the a/b trade-off near black.
+    for (const double beta0 : {0.0, -0.05, 0.05}) {
+        std::vector<double> x = clamp_to_bounds({black / d.scale, beta0, kappa0 - beta0, gamma0});
+        nlopt::opt opt(nlopt::LN_BOBYQA, 4);
+        opt.set_lower_bounds(lb);
+        opt.set_upper_bounds(ub);
+        opt.set_min_objective(sum_squares, &d);
+        opt.set_xtol_rel(1e-10);
+        opt.set_ftol_abs(1e-16);
+        opt.set_maxeval(20000);
+        double f = 0.0;
+        try {
+            opt.optimize(x, f);
+        } catch (const nlopt::roundoff_limited&) {
+            // x holds the best point found; the residual is as small as rounding allows.
+            f = sum_squares(4, x.data(), nullptr, &d);
+        }
+        if (f < best_f) {
+            best_f = f;
+            best = x;
+        }
+    }
+
+    const double root = std::pow(d.scale, 1.0 / best[3]);
+    GogFit fit;
+    fit.a = d.scale * best[0];
+    fit.b = best[1] * root;
+    fit.k = best[2] * root;
+    fit.gamma = best[3];
+    fit.n = static_cast<int>(ramp.size());
+    fit.rmse_log10 = std::sqrt(best_f / static_cast<double>(fit.n));
+    return fit;
+}
+
+double effective_gamma(const GogFit& fit) {
+    const double l0 = gog_luminance_cd_m2(fit, 0.0);
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+    int n = 0;
+    for (int i = 0; i <= 45; ++i) {
+        const double lv = -1.0 + static_cast<double>(i) / 45.0;  // log10 V from -1 to 0
+        const double dl = gog_luminance_cd_m2(fit, std::pow(10.0, lv)) - l0;
+        if (dl <= 0.0) continue;
+        const double y = std::log10(dl);
+        sx += lv;
+        sy += y;
+        sxx += lv * lv;
+        sxy += lv * y;
+        ++n;
+    }
+    if (n < 2) return 0.0;
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+// ---------------------------------------------------------------------------
+// The whole calibration.
+
+const RampReport* CalibrationReport::ramp(Channel c) const {
+    for (const auto& r : ramps)
+        if (r.channel == c) return &r;
+    return nullptr;
+}
+
+CalibrationReport fit_calibration(const std::vector<Measurement>& measurements) {
+    const std::string file = measurements.empty() ? std::string() : measurements.front().file;
+    if (measurements.empty()) throw InputError(SourceLocation{file, 0, 0, ""}, "there are no measurements to fit");
+    check_monotonic(measurements);
+
+    CalibrationReport report;
+    report.n_measurements = static_cast<int>(measurements.size());
+    double black_sum = 0.0;
+    int n_black = 0;
+    for (const auto& m : measurements) {
+        if (m.channel == Channel::other) ++report.n_other;
+        if (is_black(m)) {
+            black_sum += m.luminance_cd_m2;
+            ++n_black;
+        }
+    }
+    if (n_black == 0)
+        throw InputError(SourceLocation{file, 0, 0, ""}, "the calibration has no black reading (level 0)");
+    report.black_cd_m2 = black_sum / n_black;
+
+    auto mean_at_full = [&](Channel ch) -> std::optional<double> {
+        double s = 0.0;
+        int n = 0;
+        for (const auto& m : measurements)
+            if (m.channel == ch && m.level == 1.0) {
+                s += m.luminance_cd_m2;
+                ++n;
+            }
+        return n > 0 ? std::optional<double>(s / n) : std::nullopt;
+    };
+    if (const auto w = mean_at_full(Channel::grey)) {
+        report.white_cd_m2 = *w;
+    } else {
+        const auto r = mean_at_full(Channel::red), g = mean_at_full(Channel::green), b = mean_at_full(Channel::blue);
+        if (!r || !g || !b)
+            throw InputError(SourceLocation{file, 0, 0, ""},
+                             "the calibration has no white reading (grey at level 1, or red, green and blue at 1)");
+        // The channels add; each reading includes the other two channels' black.
+        report.white_cd_m2 = *r + *g + *b - 2.0 * report.black_cd_m2;
+    }
+    report.contrast_ratio =
+        report.black_cd_m2 > 0.0 ? report.white_cd_m2 / report.black_cd_m2 : std::numeric_limits<double>::infinity();
+
+    for (const Channel ch : {Channel::red, Channel::green, Channel::blue, Channel::grey}) {
+        std::vector<Measurement> ramp;
+        bool lit = false;
+        for (const auto& m : measurements) {
+            if (m.channel == ch && m.level > 0.0) lit = true;
+            if (m.channel == ch || is_black(m)) ramp.push_back(m);
+        }
+        if (!lit) continue;
+        std::vector<double> levels;
+        for (const auto& m : ramp) levels.push_back(m.level);
+        std::sort(levels.begin(), levels.end());
+        const int distinct = static_cast<int>(std::unique(levels.begin(), levels.end()) - levels.begin());
+        if (distinct < 4) {
+            report.notes.push_back(
+                fmt::format("the {} ramp has {} distinct levels (black included); 4 are needed for "
+                            "a fit, so it is not fitted",
+                            channel_name(ch), distinct));
+            continue;
+        }
+        RampReport r;
+        r.channel = ch;
+        r.fit = fit_gog(ramp);
+        r.effective_gamma = effective_gamma(r.fit);
+        r.black_cd_m2 = gog_luminance_cd_m2(r.fit, 0.0);
+        r.white_cd_m2 = gog_luminance_cd_m2(r.fit, 1.0);
+        r.levels = distinct;
+        report.ramps.push_back(r);
+    }
+    if (report.ramps.empty())
+        throw InputError(
+            SourceLocation{file, 0, 0, ""},
+            "no ramp (red, green, blue or grey) has readings at 4 or more levels, so nothing can be fitted");
+    return report;
+}
+
+DisplayModel display_from_calibration(const CalibrationReport& report, std::string name) {
+    std::array<GogParams, 3> params{};
+    const RampReport* rgb[3] = {report.ramp(Channel::red), report.ramp(Channel::green), report.ramp(Channel::blue)};
+    const RampReport* grey = report.ramp(Channel::grey);
+    if (rgb[0] && rgb[1] && rgb[2]) {
+        for (int c = 0; c < 3; ++c) {
+            // Each ramp was read with the other two channels at black; channel c keeps its
+            // Rec.709 share of that black so that the three add up to the measured black.
+            auto& p = params[static_cast<std::size_t>(c)];
+            p = gog_params(rgb[c]->fit);
+            p.a -= (1.0 - rec709_rgb_to_xyz()[c][1]) * report.black_cd_m2;
+        }
+    } else if (grey) {
+        for (int c = 0; c < 3; ++c) {
+            // w (b + k V)^gamma = (w^(1/gamma) b + w^(1/gamma) k V)^gamma.
+            const double w = rec709_rgb_to_xyz()[c][1];
+            const auto g = gog_params(grey->fit);
+            const double root = std::pow(w, 1.0 / g.gamma);
+            params[static_cast<std::size_t>(c)] = GogParams{w * g.a, root * g.b, root * g.k, g.gamma};
+        }
+    } else {
+        throw InputError(SourceLocation{"", 0, 0, ""},
+                         "a display model needs fitted red, green and blue ramps or a fitted grey ramp");
+    }
+    DisplayModel model = DisplayModel::gog(params, std::move(name));
+    model.validate();
+    return model;
+}
+
+}  // namespace atonlab::stimuli

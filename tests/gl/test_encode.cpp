@@ -1,0 +1,134 @@
+// The GLSL display encoder (display_encode.glsl, through test_encode.comp)
+// against the CPU reference encode_pixel(): every transfer kind, dither on and
+// off, 8 and 10 bits, the std430 and std140 layouts of DisplayParams. Inputs
+// are random relative RGB in [0, 1.2] with exact 0 and 1 and a few NaN,
+// negative and infinite values. The contract: >= 99.9 % of 8-bit codes
+// identical and none more than one code apart (in practice all are identical:
+// the inverse runs in double with a double exp/log, the dither is integer-only).
+#include <epoxy/gl.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "atonlab/stimuli/display_model.h"
+#include "atonlab/stimuli/gl/objects.h"
+#include "gl_test_support.h"
+
+namespace atonlab::test {
+namespace {
+
+using namespace atonlab::stimuli;
+using GpuEncode = GLTest;
+
+constexpr int kWidth = 192;
+constexpr int kHeight = 128;
+constexpr std::uint32_t kFrame = 12345;
+
+std::vector<LutPoint> measured_lut(double scale) {
+    return {{0.0, 0.05 * scale}, {0.05, 0.05 * scale}, {0.1, 0.12 * scale},  {0.25, 1.1 * scale},
+            {0.5, 5.0 * scale},  {0.7, 11.0 * scale},  {0.85, 16.5 * scale}, {1.0, 22.0 * scale}};
+}
+
+std::vector<DisplayModel> every_kind() {
+    return {
+        DisplayModel::srgb(120.0, 0.2),
+        DisplayModel::gog(
+            {GogParams{0.05, 0.04, 4.0, 2.4}, GogParams{0.1, 0.0, 7.0, 2.2}, GogParams{0.02, -0.02, 2.0, 2.3}}, "GOG"),
+        DisplayModel::pq(1000.0, 0.005),
+        DisplayModel::lut({measured_lut(1.0), measured_lut(3.3), measured_lut(0.35)}, "LUT")};
+}
+
+/// Random relative RGB in [0, 1.2]; every 53rd component exactly 0, every 59th exactly 1,
+/// and a handful of NaN, negative and infinite values.
+std::vector<float> make_inputs() {
+    std::mt19937 rng(2024);
+    std::uniform_real_distribution<float> u(0.0f, 1.2f);
+    std::vector<float> rgba(static_cast<std::size_t>(kWidth * kHeight * 4), 0.0f);
+    for (std::size_t i = 0; i < rgba.size(); ++i) {
+        if (i % 4 == 3) continue;
+        rgba[i] = i % 53 == 0 ? 0.0f : i % 59 == 0 ? 1.0f : u(rng);
+    }
+    const float specials[] = {std::numeric_limits<float>::quiet_NaN(), -0.25f, -std::numeric_limits<float>::infinity(),
+                              std::numeric_limits<float>::infinity(),  1e30f,  1.0e-7f};
+    for (std::size_t k = 0; k < std::size(specials); ++k) rgba[4 * (1000 + 37 * k) + k % 3] = specials[k];
+    return rgba;
+}
+
+struct Agreement {
+    long identical = 0, total = 0;
+    int max_diff = 0;
+};
+
+Agreement run_case(const gl::Program& prog, bool ubo, const DisplayModel& display, const EncodeSettings& settings,
+                   const std::vector<float>& inputs) {
+    const std::size_t n = inputs.size() / 4;
+    const GpuDisplayParams params = gpu_display_params(display, settings);
+    const std::vector<double> lut = gpu_display_lut(display);
+    auto b_in = gl::Buffer::from(std::span<const float>(inputs));
+    gl::Buffer b_params(sizeof(params), &params, gl::BufferUsage::static_draw);
+    auto b_lut = gl::Buffer::from(std::span<const double>(lut));
+    gl::Buffer b_out(n * 4 * sizeof(std::uint32_t), nullptr, gl::BufferUsage::dynamic_read);
+    prog.use();
+    prog.set("count", static_cast<unsigned>(n));
+    prog.set("width", kWidth);
+    prog.set("frame", static_cast<unsigned>(kFrame));
+    b_in.bind_storage(0);
+    if (ubo) {
+        b_params.bind_uniform(1);
+    } else {
+        b_params.bind_storage(1);
+    }
+    b_out.bind_storage(2);
+    b_lut.bind_storage(3);
+    glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<std::uint32_t> codes(n * 4);
+    b_out.download(0, codes.size() * sizeof(std::uint32_t), codes.data());
+
+    Agreement a;
+    const int max_code = (1 << settings.bits) - 1;
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::ivec2 pixel(static_cast<int>(i) % kWidth, static_cast<int>(i) / kWidth);
+        const glm::dvec3 rel(inputs[4 * i], inputs[4 * i + 1], inputs[4 * i + 2]);
+        const glm::ivec3 cpu = encode_pixel(display, rel, pixel, kFrame, settings);
+        for (int c = 0; c < 3; ++c) {
+            const int gpu = static_cast<int>(codes[4 * i + static_cast<std::size_t>(c)]);
+            EXPECT_GE(gpu, 0);
+            EXPECT_LE(gpu, max_code);
+            a.max_diff = std::max(a.max_diff, std::abs(gpu - cpu[c]));
+            a.identical += gpu == cpu[c] ? 1 : 0;
+            ++a.total;
+        }
+    }
+    return a;
+}
+
+TEST_F(GpuEncode, MatchesTheCpuReferenceForEveryTransferKind) {
+    const auto ssbo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}});
+    const auto ubo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}}, {"PARAMS_IN_UBO"});
+    const auto inputs = make_inputs();
+    for (const auto& display : every_kind()) {
+        for (const int bits : {8, 10}) {
+            for (const Dither dither : {Dither::none, Dither::spatiotemporal}) {
+                for (const bool use_ubo : {false, true}) {
+                    const EncodeSettings settings{bits, dither, 77};
+                    const Agreement a = run_case(use_ubo ? ubo : ssbo, use_ubo, display, settings, inputs);
+                    const double fraction = static_cast<double>(a.identical) / static_cast<double>(a.total);
+                    std::printf("%-5s %2d bits dither %-3s %s: %ld/%ld codes identical (%.5f %%), max diff %d\n",
+                                display.name.c_str(), bits, dither == Dither::none ? "off" : "on",
+                                use_ubo ? "std140" : "std430", a.identical, a.total, 100.0 * fraction, a.max_diff);
+                    EXPECT_GE(fraction, 0.999) << display.name << " " << bits << " bits";
+                    EXPECT_LE(a.max_diff, 1) << display.name << " " << bits << " bits";
+                }
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace atonlab::test
