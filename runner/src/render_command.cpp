@@ -1,13 +1,14 @@
 // `atonlab render SCENE.toml -o OUT.exr [--png OUT.png] [--time S] [--set key=value]...`
-// One frame, headless: the scene-referred EXR (cd/m²) and optionally a PNG.
+// One frame, headless: the scene-referred EXR (cd/m²) and optionally the PNG of
+// the code values the calibrated display is sent (tone mapped, encoded, dithered).
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
-
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
 
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
@@ -15,6 +16,7 @@
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "commands.h"
 
@@ -29,21 +31,20 @@ void add_render_command(CLI::App& app, RenderOptions& o) {
     cmd->add_option("--set", o.overrides, "Override a scene key: section.key=value (TOML value; repeatable)");
     cmd->add_flag("--half", o.half, "Write the EXR as half floats instead of 32-bit floats");
     cmd->add_option("--white-cd-m2", o.white_cd_m2,
-                    "PNG exposure: the luminance (cd/m²) shown as display white (default 20 × the adaptation luminance)");
+                    "linear and clamp tone mappers: the luminance (cd/m²) shown as display white "
+                    "(default: the adaptation luminance at the display's own adaptation level)");
 }
 
 namespace {
 
-// Plain exposure and the sRGB curve (K2012 eq 3.13): the PNG of this command is
-// a preview, not a calibrated stimulus (tone mapping and display models are
-// their own stage).
-std::vector<float> encode_preview(const stimuli::ImageRGBA32F& img, double white_cd_m2) {
-    std::vector<float> rgb(static_cast<std::size_t>(img.width) * img.height * 3);
-    const double scale = 1.0 / white_cd_m2;
-    for (std::size_t i = 0, n = rgb.size() / 3; i < n; ++i)
-        for (int c = 0; c < 3; ++c)
-            rgb[i * 3 + c] = static_cast<float>(stimuli::srgb_encode(std::clamp(img.rgba[i * 4 + c] * scale, 0.0, 1.0)));
-    return rgb;
+// The display's code values as the 8-bit PNG (exact for an 8-bit display;
+// deeper displays are rounded to 8 bits for the preview and say so).
+std::vector<float> png_values(const stimuli::EncodedImage& codes) {
+    std::vector<float> v(codes.rgb.size());
+    const double max_code = static_cast<double>((1 << codes.bits) - 1);
+    for (std::size_t i = 0; i < v.size(); ++i)
+        v[i] = static_cast<float>(std::round(codes.rgb[i] / max_code * 255.0) / 255.0);
+    return v;
 }
 
 }  // namespace
@@ -51,15 +52,21 @@ std::vector<float> encode_preview(const stimuli::ImageRGBA32F& img, double white
 int run_render(const RenderOptions& o) {
     std::vector<stimuli::SceneOverride> overrides;
     for (const auto& s : o.overrides) overrides.push_back(stimuli::SceneOverride::parse(s));
-    if (!std::isfinite(o.time_s)) throw InputError(SourceLocation{"--time", 0, 0, ""}, "the time must be a finite number of seconds");
+    if (!std::isfinite(o.time_s))
+        throw InputError(SourceLocation{"--time", 0, 0, ""}, "the time must be a finite number of seconds");
     if (o.white_cd_m2 && !(*o.white_cd_m2 > 0.0 && std::isfinite(*o.white_cd_m2)))
-        throw InputError(SourceLocation{"--white-cd-m2", 0, 0, ""}, "the white luminance must be a positive number of cd/m²");
+        throw InputError(SourceLocation{"--white-cd-m2", 0, 0, ""},
+                         "the white luminance must be a positive number of cd/m²");
     // Validate everything before touching the GPU or the output paths.
-    const stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);
+    stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);
+    if (o.white_cd_m2) scene.output.tonemap.white_cd_m2 = *o.white_cd_m2;
+    stimuli::validate_output_settings(scene.output);
 
     auto context = gl::create_headless_context();
-    stimuli::FrameRenderer renderer;
-    renderer.render(scene, o.time_s);
+    stimuli::Pipeline pipeline;
+    // One frame: dynamic adaptation adopts the frame's log-average at once.
+    pipeline.render(scene, o.time_s, 0.0);
+    const stimuli::FrameRenderer& renderer = pipeline.frame();
     const stimuli::ImageRGBA32F hdr = renderer.read_hdr();
 
     stimuli::ExrMetadata meta;
@@ -74,6 +81,15 @@ int run_render(const RenderOptions& o) {
     meta.strings["time_s"] = fmt::format("{}", o.time_s);
     meta.strings["software"] = "atonlab " ATONLAB_VERSION;
     meta.strings["glare"] = std::string(stimuli::glare_model_name(scene.glare.model));
+    const double adapted = pipeline.display().adaptation_cd_m2();
+    meta.strings["tonemap"] = fmt::format(
+        "operator={} adaptation={} adapted_cd_m2={:.6g} blueshift={} hue_preservation={} display={} peak_cd_m2={} "
+        "black_cd_m2={} bits={}{}",
+        stimuli::tone_operator_name(scene.output.tonemap.tone_operator),
+        scene.output.adaptation.mode == stimuli::AdaptationMode::dynamic ? "dynamic" : "fixed", adapted,
+        scene.output.tonemap.blueshift, stimuli::hue_preservation_name(scene.output.tonemap.hue_preservation),
+        scene.output.display.name, scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2,
+        scene.output.encode.bits, scene.output.ldr_glare ? " ldr_glare" : "");
     std::string glare_note;
     for (const auto& g : renderer.glare().report()) {
         const std::string line = fmt::format(
@@ -108,8 +124,11 @@ int run_render(const RenderOptions& o) {
     }
     if (!o.png.empty()) {
         try {
-            const double white = o.white_cd_m2.value_or(20.0 * scene.adaptation_cd_m2);
-            stimuli::write_png_rgb8(o.png, hdr.width, hdr.height, encode_preview(hdr, white));
+            const stimuli::EncodedImage codes = pipeline.display().read_codes();
+            if (codes.bits != 8)
+                std::fprintf(stderr, "atonlab: note: the display takes %d-bit codes; %s shows them rounded to 8 bits\n",
+                             codes.bits, o.png.c_str());
+            stimuli::write_png_rgb8(o.png, codes.width, codes.height, png_values(codes));
         } catch (...) {
             // Both or neither: a half-written result set is worse than none.
             std::error_code ec;
@@ -119,9 +138,9 @@ int run_render(const RenderOptions& o) {
     }
     const auto st = renderer.stats();
     std::printf("%s: %dx%d, %d of %d lights drawn, %.4f deg/px -> %s%s%s\n", o.scene.c_str(), hdr.width, hdr.height,
-                st.drawn, st.lights, meta.degrees_per_pixel, o.exr.c_str(), o.png.empty() ? "" : ", ",
-                o.png.c_str());
+                st.drawn, st.lights, meta.degrees_per_pixel, o.exr.c_str(), o.png.empty() ? "" : ", ", o.png.c_str());
     std::fputs(glare_note.c_str(), stdout);
+    std::printf("  %s\n", meta.strings["tonemap"].c_str());
     return 0;
 }
 

@@ -75,8 +75,8 @@ struct FrameRenderer::Impl {
     gl::Program light_direct = gl::Program::build(
         {{gl::ShaderStage::vertex, "light_direct.vert"}, {gl::ShaderStage::fragment, "light_direct.frag"}});
     gl::VertexArray vao = gl::VertexArray::create();
-    gl::Texture2D hdr, depth;
-    gl::Framebuffer fbo;
+    gl::Texture2D hdr, depth, glare_only;
+    gl::Framebuffer fbo, glare_fbo;
     gl::Buffer lights, profiles, knots, draws;
     int light_count = 0;
     GlareStage glare;
@@ -90,6 +90,15 @@ struct FrameRenderer::Impl {
         fbo.attach_colour(hdr, 0);
         fbo.attach_colour(depth, 1);
         fbo.check_complete("HDR frame");
+        glare_fbo = {};
+        glare_only = {};
+    }
+    void ensure_glare_target() {
+        if (glare_only) return;
+        glare_only = gl::Texture2D(hdr.width(), hdr.height(), gl::PixelFormat::rgba32f);
+        glare_fbo = gl::Framebuffer::create();
+        glare_fbo.attach_colour(glare_only, 0);
+        glare_fbo.check_complete("glare buffer");
     }
 };
 
@@ -174,7 +183,8 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
         glBlendEquation(GL_FUNC_ADD);
-        if (glare) {
+        const bool ldr = glare && scene.output.ldr_glare;
+        if (glare && !ldr) {
             // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
             m.glare.draw(m.light_count, P);
         } else {
@@ -183,6 +193,15 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
             m.light_direct.use();
             m.vao.bind();
             glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
+        }
+        if (ldr) {
+            // K2012 §6.2.2: the glare alone, into its own buffer, for the LDR path.
+            m.ensure_glare_target();
+            m.glare_fbo.bind();
+            const float zero[4] = {0, 0, 0, 0};
+            glClearBufferfv(GL_COLOR, 0, zero);
+            m.glare.draw(m.light_count, P);
+            m.fbo.bind();
         }
         glDisable(GL_BLEND);
         const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
@@ -244,6 +263,10 @@ FrameStats FrameRenderer::stats() const {
 }
 
 const GlareStage& FrameRenderer::glare() const { return impl_->glare; }
+
+const gl::Texture2D* FrameRenderer::glare_texture() const {
+    return impl_->glare_only ? &impl_->glare_only : nullptr;
+}
 
 const gl::Texture2D& FrameRenderer::hdr_texture() const { return impl_->hdr; }
 const gl::Texture2D& FrameRenderer::view_depth_texture() const { return impl_->depth; }

@@ -155,6 +155,7 @@ void Program::set(std::string_view n, float v) const { glProgramUniform1f(id(), 
 void Program::set(std::string_view n, double v) const { glProgramUniform1d(id(), uniform_location(n), v); }
 void Program::set(std::string_view n, int v) const { glProgramUniform1i(id(), uniform_location(n), v); }
 void Program::set(std::string_view n, unsigned v) const { glProgramUniform1ui(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, int x, int y) const { glProgramUniform2i(id(), uniform_location(n), x, y); }
 void Program::set(std::string_view n, float x, float y) const { glProgramUniform2f(id(), uniform_location(n), x, y); }
 void Program::set(std::string_view n, float x, float y, float z) const {
     glProgramUniform3f(id(), uniform_location(n), x, y, z);

@@ -27,6 +27,7 @@
 #include <utility>
 
 #include "atonlab/stimuli/atmosphere.h"
+#include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/fft.h"
@@ -46,12 +47,17 @@ constexpr std::string_view kSetPrefix = "--set ";  // source path of an override
 
 using KeyList = std::span<const std::string_view>;
 
-constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "profiles", "light"};
-constexpr std::string_view kDisplayKeys[] = {"width_px", "height_px", "width_m", "viewing_distance_m"};
+constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light"};
+constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",     "viewing_distance_m",
+                                             "peak_cd_m2", "black_cd_m2", "transfer",    "calibration",
+                                             "bits",       "dither",      "dither_seed"};
 constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
-constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm"};
+constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride"};
+constexpr std::string_view kTonemapKeys[] = {
+    "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
+    "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_xy", "hue_preservation", "ldr_glare"};
 constexpr std::string_view kGlareKeys[] = {
     "psf_size", "spectral_samples", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
     "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
@@ -82,11 +88,6 @@ const std::vector<std::vector<std::string_view>>& exclusive_groups() {
 
 constexpr std::string_view kBuiltinVertical[] = {"uniform", "sabik-vp"};
 constexpr std::string_view kBuiltinHorizontal[] = {"uniform"};
-// DESIGN.md sketches a [tonemap] table; it arrives with the tone-mapping stage.
-constexpr std::string_view kLaterTonemap = "tonemap";
-const std::string kTonemapNotYet =
-    "the [tonemap] table is not available yet: tone mapping comes with the tone-mapping stage; remove it.";
-
 bool contains(KeyList list, std::string_view key) {
     return std::find(list.begin(), list.end(), key) != list.end();
 }
@@ -665,7 +666,8 @@ Environment read_environment(const Document& doc, const Section& root) {
 }
 
 /// Returns Scene::adaptation_cd_m2; sets the glare model and pupil.
-double read_eye(const Document& doc, const Section& root, const Environment& environment, GlareSettings& glare) {
+double read_eye(const Document& doc, const Section& root, const Environment& environment, GlareSettings& glare,
+                AdaptationSettings& adapt) {
     const double fallback = environment.luminance_cd_m2 > 0.0 ? environment.luminance_cd_m2 : 0.001;
     const toml::table* t = sub_table(root, "eye", "[eye]");
     if (t == nullptr) return fallback;
@@ -673,13 +675,12 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
     s.allow(kEyeKeys);
     if (auto a = s.string("adaptation")) {
         if (*a == "dynamic")
+            adapt.mode = AdaptationMode::dynamic;
+        else if (*a != "fixed")
             s.fail(s.get("adaptation"), "adaptation",
-                   "adaptation = \"dynamic\" is not available yet: log-average and temporal adaptation come with tone "
-                   "mapping; use \"fixed\".");
-        if (*a != "fixed")
-            s.fail(s.get("adaptation"), "adaptation",
-                   fmt::format("unknown adaptation \"{}\"; it must be \"fixed\".", *a));
+                   fmt::format("unknown adaptation \"{}\"; it must be \"fixed\" or \"dynamic\".", *a));
     }
+    adapt.stride = s.integer("adaptation_stride", 1, 64).value_or(adapt.stride);
     const double adaptation = s.number_or("adaptation_cd_m2", fallback);
     s.greater_than("adaptation_cd_m2", adaptation, 0.0);
     if (auto g = s.string("glare")) {
@@ -783,6 +784,83 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
     } catch (const InputError& err) {
         const std::string key = err.where() ? err.where()->key : std::string();
         s.fail_table(fmt::format("the eye model is invalid ({}): {}", key, err.message()));
+    }
+}
+
+/// The display model ([display] photometric keys) and [tonemap] (docs/scene-file.md).
+void read_output(const Document& doc, const Section& root, OutputSettings& out) {
+    if (const toml::table* t = sub_table(root, "display", "[display]")) {
+        Section s(doc, *t, "display", "the [display] table");
+        const double peak = s.number_or("peak_cd_m2", out.display.peak_cd_m2);
+        s.greater_than("peak_cd_m2", peak, 0.0);
+        const double black = s.number_or("black_cd_m2", out.display.black_cd_m2);
+        s.at_least("black_cd_m2", black, 0.0);
+        if (!(black < peak))
+            s.fail(s.has("black_cd_m2") ? s.get("black_cd_m2") : s.get("peak_cd_m2"), "black_cd_m2",
+                   fmt::format("the display's black ({} cd/m²) must be below its peak ({} cd/m²).", number_text(black),
+                               number_text(peak)));
+        const std::string transfer = s.string("transfer").value_or("srgb");
+        if (transfer == "srgb")
+            out.display = DisplayModel::srgb(peak, black);
+        else if (transfer == "pq")
+            out.display = DisplayModel::pq(peak, black);
+        else
+            s.fail(s.get("transfer"), "transfer",
+                   fmt::format("unknown transfer \"{}\"; it must be \"srgb\" or \"pq\" (or give a calibration file).",
+                               transfer));
+        if (auto cal = s.string("calibration")) {
+            std::filesystem::path p(*cal);
+            if (p.is_relative() && doc.file() != kSetFile) p = std::filesystem::path(doc.file()).parent_path() / p;
+            try {
+                out.display = display_from_calibration(fit_calibration(read_calibration_file(p)), p.stem().string());
+            } catch (const InputError& e) {
+                s.fail(s.get("calibration"), "calibration", fmt::format("the calibration file is unusable: {}", e.what()));
+            }
+        }
+        out.encode.bits = s.integer("bits", 1, 16).value_or(out.encode.bits);
+        if (auto d = s.boolean("dither")) out.encode.dither = *d ? Dither::spatiotemporal : Dither::none;
+        if (auto seed = s.integer("dither_seed", 0, std::numeric_limits<int>::max()))
+            out.encode.seed = static_cast<std::uint32_t>(*seed);
+    }
+    ToneMapSettings& tm = out.tonemap;
+    tm.display_peak_cd_m2 = out.display.peak_cd_m2;
+    const toml::table* t = sub_table(root, "tonemap", "[tonemap]");
+    if (t == nullptr) return;
+    Section s(doc, *t, "tonemap", "the [tonemap] table");
+    s.allow(kTonemapKeys);
+    if (auto op = s.string("operator")) {
+        auto v = tone_operator_from_name(*op);
+        if (!v)
+            s.fail(s.get("operator"), "operator",
+                   fmt::format("unknown tone-mapping operator \"{}\"; it must be one of {}.", *op,
+                               join(tone_operator_names(), "\"")));
+        tm.tone_operator = *v;
+    }
+    tm.white_relative = s.number_or("white_relative", tm.white_relative);
+    tm.reinhard_key = s.number_or("reinhard_key", tm.reinhard_key);
+    tm.reinhard_white_relative = s.number_or("reinhard_white_relative", tm.reinhard_white_relative);
+    tm.kakimoto_g = s.number_or("kakimoto_g", tm.kakimoto_g);
+    tm.kakimoto_k = s.number_or("kakimoto_k", tm.kakimoto_k);
+    if (auto w = s.number("white_cd_m2")) tm.white_cd_m2 = *w;
+    if (auto a = s.number("display_adaptation_cd_m2")) tm.display_adaptation_cd_m2 = *a;
+    tm.blueshift = s.boolean("blueshift").value_or(tm.blueshift);
+    if (auto xy = s.numbers("blueshift_xy", 2)) tm.blueshift_xy = {(*xy)[0], (*xy)[1]};
+    if (auto h = s.string("hue_preservation")) {
+        auto v = hue_preservation_from_name(*h);
+        if (!v)
+            s.fail(s.get("hue_preservation"), "hue_preservation",
+                   fmt::format("unknown hue preservation \"{}\"; it must be one of {}.", *h,
+                               join(hue_preservation_names(), "\"")));
+        tm.hue_preservation = *v;
+    }
+    out.ldr_glare = s.boolean("ldr_glare").value_or(out.ldr_glare);
+    try {
+        validate_tonemap_settings(tm);
+    } catch (const InputError& e) {
+        // The validator names "tonemap.KEY"; point at that key's line.
+        std::string key = e.where() ? e.where()->key : std::string();
+        if (key.starts_with("tonemap.")) key.erase(0, 8);
+        s.fail(s.has(key) ? s.get(key) : &s.table(), key.empty() ? "operator" : key, e.message());
     }
 }
 
@@ -962,7 +1040,6 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
         // Unknown top-level tables are reported with the list of sections.
         for (auto&& [k, v] : root_table) {
             if (contains(kSections, k.str())) continue;
-            if (k.str() == kLaterTonemap) throw InputError(doc.where(k, std::string(k.str())), kTonemapNotYet);
             throw InputError(
                 doc.where(k, std::string(k.str())),
                 fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key", k.str(),
@@ -973,8 +1050,10 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     scene.display = read_display(doc, root);
     scene.camera = read_camera(doc, root);
     scene.environment = read_environment(doc, root);
-    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare);
+    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation);
+    scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
     read_glare(doc, root, scene.glare);
+    read_output(doc, root, scene.output);
     const Profiles profiles = read_profiles(doc, root);
 
     if (const toml::node* lights = root.get("light")) {
@@ -1144,7 +1223,6 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
     } else {
         const auto dot = k.find('.');
         const std::string section = k.substr(0, dot);
-        if (section == kLaterTonemap) override_error(k, kTonemapNotYet);
         if (!contains(kSections, section))
             override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", k, join(kSections)));
         if (dot == std::string::npos || dot + 1 == k.size())
@@ -1155,6 +1233,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
                                 : section == "camera"      ? KeyList(kCameraKeys)
                                 : section == "environment" ? KeyList(kEnvironmentKeys)
                                 : section == "glare"       ? KeyList(kGlareKeys)
+                                : section == "tonemap"     ? KeyList(kTonemapKeys)
                                                            : KeyList(kEyeKeys);
         if (!contains(allowed, key)) unknown(section, allowed, key);
         target = &table_for_override(doc, root, section, k, section);

@@ -358,8 +358,8 @@ TEST(SceneFileErrors, UnknownKeyAndUnknownSection) {
     const std::string section = std::string(kMinimal) + "\n[enviroment]\nluminance_cd_m2 = 1\n";
     expect_error_at(section, line_of(section, "[enviroment]"), "enviroment",
                     "unknown table 'enviroment'. Did you mean 'environment'?");
-    const std::string tonemap = std::string(kMinimal) + "\n[tonemap]\noperator = \"linear\"\n";
-    expect_error_at(tonemap, line_of(tonemap, "[tonemap]"), "tonemap", "not available yet");
+    const std::string tonemap = std::string(kMinimal) + "\n[tonemap]\noperator = \"sepia\"\n";
+    expect_error_at(tonemap, line_of(tonemap, "operator"), "tonemap.operator", "unknown tone-mapping operator");
     const std::string cam = std::string(kMinimal) + "[camera]\nyaw = 4\n";
     expect_error_at(cam, 7, "camera.yaw", "Did you mean 'yaw_deg'?");
 }
@@ -407,9 +407,9 @@ TEST(SceneFileErrors, DuplicateLightNames) {
     expect_error_at(text, second_name, "light[1].name", "already used by light[0]");
 }
 
-TEST(SceneFileErrors, NotYetAvailableChoicesSaySo) {
-    const std::string dynamic = std::string(kMinimal) + "[eye]\nadaptation = \"dynamic\"\n";
-    expect_error_at(dynamic, 7, "eye.adaptation", "not available yet");
+TEST(SceneFileErrors, UnknownChoicesSaySo) {
+    const std::string adaptation = std::string(kMinimal) + "[eye]\nadaptation = \"sticky\"\n";
+    expect_error_at(adaptation, 7, "eye.adaptation", "\"fixed\" or \"dynamic\"");
     const std::string bogus = std::string(kMinimal) + "[eye]\nglare = \"sparkle\"\n";
     expect_error_at(bogus, 7, "eye.glare", "unknown glare model");
 }
@@ -431,6 +431,31 @@ TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
     // Every model name round-trips; --set switches glare off.
     for (const char* m : {"none", "wave-optics", "gaussian-bloom", "spencer", "aperture"})
         EXPECT_EQ(glare_model_name(*glare_model_from_name(m)), m);
+}
+
+TEST(SceneFileOutput, TonemapDisplayAndAdaptationAreRead) {
+    const std::string text = std::string(kMinimal) +
+                             "peak_cd_m2 = 250\nblack_cd_m2 = 0.2\nbits = 10\ndither = false\n"
+                             "[eye]\nadaptation = \"dynamic\"\nadaptation_cd_m2 = 0.03\n"
+                             "[tonemap]\noperator = \"perceptual\"\nblueshift = false\nhue_preservation = \"rgb\"\n"
+                             "ldr_glare = true\n";
+    const Scene scene = parse_scene(text, "out.toml");
+    EXPECT_EQ(scene.output.adaptation.mode, AdaptationMode::dynamic);
+    EXPECT_EQ(scene.output.adaptation.fixed_cd_m2, 0.03);
+    EXPECT_EQ(scene.output.display.peak_cd_m2, 250.0);
+    EXPECT_EQ(scene.output.display.black_cd_m2, 0.2);
+    EXPECT_EQ(scene.output.tonemap.display_peak_cd_m2, 250.0);
+    EXPECT_EQ(scene.output.encode.bits, 10);
+    EXPECT_EQ(scene.output.encode.dither, Dither::none);
+    EXPECT_EQ(scene.output.tonemap.tone_operator, ToneOperator::perceptual);
+    EXPECT_FALSE(scene.output.tonemap.blueshift);
+    EXPECT_EQ(scene.output.tonemap.hue_preservation, HuePreservation::rgb);
+    EXPECT_TRUE(scene.output.ldr_glare);
+    // A display whose black is not below its peak is refused where it is written.
+    const std::string bad = std::string(kMinimal) + "peak_cd_m2 = 100\nblack_cd_m2 = 100\n";
+    expect_error_at(bad, line_of(bad, "black_cd_m2"), "display.black_cd_m2", "below its peak");
+    const std::string white = std::string(kMinimal) + "[tonemap]\nwhite_relative = -1\n";
+    expect_error_at(white, line_of(white, "white_relative"), "tonemap.white_relative", "white_relative");
 }
 
 TEST(SceneFileGlare, BadGlareInputNamesTheKey) {

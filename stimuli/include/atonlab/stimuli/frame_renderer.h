@@ -69,6 +69,9 @@ public:
     /// The glare stage of the last frame: kernels, layers, what it reported.
     const GlareStage& glare() const;
     const gl::Texture2D& hdr_texture() const;
+    /// With scene.output.ldr_glare and a glare model: the glare billboards alone
+    /// (cd/m²), while hdr_texture() holds the scene with direct images; else nullptr.
+    const gl::Texture2D* glare_texture() const;
     const gl::Texture2D& view_depth_texture() const;
 
 private:

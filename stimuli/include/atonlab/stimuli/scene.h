@@ -13,6 +13,7 @@
 
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/output_settings.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
 
@@ -117,6 +118,10 @@ struct Scene {
     std::vector<Light> lights;
     double adaptation_cd_m2 = 0.001;  ///< recorded in image headers; drives later stages
     GlareSettings glare;
+    /// Adaptation, tone mapping, display model and encoding ([eye], [tonemap],
+    /// [display] of the scene file). output.adaptation.fixed_cd_m2 mirrors
+    /// adaptation_cd_m2.
+    OutputSettings output;
 };
 
 }  // namespace atonlab::stimuli

@@ -148,6 +148,7 @@ public:
     void set(std::string_view name, int v) const;
     void set(std::string_view name, unsigned v) const;
     void set(std::string_view name, float x, float y) const;
+    void set(std::string_view name, int x, int y) const;  ///< ivec2
     void set(std::string_view name, float x, float y, float z) const;
     void set(std::string_view name, float x, float y, float z, float w) const;
     void set_mat3(std::string_view name, const float* column_major) const;

@@ -1,0 +1,57 @@
+#pragma once
+// Adaptation, tone mapping and display encoding of HDR frames on the GPU
+// (DESIGN.md pipeline steps 4-6; K2012 §4.4): the log-average luminance by a
+// double-precision GPU reduction (eq 4.15), temporal adaptation (eq 4.16-4.17)
+// driven by the real frame time, or a fixed level; tonemap.glsl; then
+// display_encode.glsl to the display's code values with dithering. The state
+// stays on the GPU between frames: no CPU round trip per frame. Needs a
+// current GL 4.5 context.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/output_settings.h"
+
+namespace atonlab::stimuli {
+
+/// Code values of one frame, row 0 at the top, RGB interleaved.
+struct EncodedImage {
+    int width = 0, height = 0, bits = 8;
+    std::vector<std::uint16_t> rgb;
+};
+
+class DisplayPipeline {
+public:
+    DisplayPipeline();
+    ~DisplayPipeline();
+    DisplayPipeline(const DisplayPipeline&) = delete;
+    DisplayPipeline& operator=(const DisplayPipeline&) = delete;
+
+    /// hdr: RGBA32F in cd/m². dt_s: seconds since the previous frame (≥ 0; the
+    /// first frame adopts its log-average at once). frame: dither frame index.
+    void process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame);
+    /// The LDR integration path (K2012 §6.2.2): `ldr` is display-referred linear
+    /// RGB relative to the display's white (what an LDR renderer produced) when
+    /// hdr_scale = 0, or an HDR frame (cd/m²) that is shown by exposure
+    /// (× hdr_scale, clipped at white); `glare` holds the glare billboards alone
+    /// in cd/m², tone-mapped at the fixed adaptation and added.
+    void process_ldr(const gl::Texture2D& ldr, const gl::Texture2D& glare, const OutputSettings& s, std::uint32_t frame,
+                     double hdr_scale = 0.0);
+    /// Forget the adapted luminance (the next dynamic frame adopts its log-average).
+    void reset_adaptation();
+
+    EncodedImage read_codes() const;
+    /// The adapted luminance and the last log-average (cd/m²); reads the GPU state back.
+    double adaptation_cd_m2() const;
+    double log_average_cd_m2() const;
+    /// Draws the codes into the bound framebuffer with the lower-left corner at
+    /// (x, y); exact for a unorm framebuffer of the encoder's bit depth.
+    void present(int x, int y) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace atonlab::stimuli

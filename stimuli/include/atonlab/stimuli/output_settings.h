@@ -1,0 +1,38 @@
+#pragma once
+// What happens to an HDR frame after the lights and the glare (DESIGN.md
+// pipeline steps 4-6): adaptation, tone mapping, display model and encoding.
+// Plain settings (no GL), part of a Scene; DisplayPipeline carries them out.
+#include <cstdint>
+
+#include "atonlab/stimuli/display_model.h"
+#include "atonlab/stimuli/tonemap.h"
+
+namespace atonlab::stimuli {
+
+enum class AdaptationMode : std::uint8_t {
+    fixed,    ///< the protocol (or scene) sets the adaptation luminance
+    dynamic,  ///< log-average of the frame (eq 4.15) + temporal adaptation (eq 4.16-4.17)
+};
+
+struct AdaptationSettings {
+    AdaptationMode mode = AdaptationMode::fixed;
+    double fixed_cd_m2 = 0.001;                     ///< fixed mode (cd/m²)
+    double epsilon_cd_m2 = kLogAverageEpsilonCdM2;  ///< ε of eq 4.15 (cd/m²)
+    int stride = 1;  ///< dynamic: every stride-th pixel in x and y enters the log-average
+};
+
+/// Everything after the HDR frame: how it is adapted, tone-mapped and encoded.
+struct OutputSettings {
+    AdaptationSettings adaptation;
+    ToneMapSettings tonemap;
+    DisplayModel display = DisplayModel::srgb(100.0, 0.1);
+    EncodeSettings encode;
+    /// K2012 §6.2.2: glare billboards go to their own buffer, are tone-mapped on
+    /// their own and added to a display-referred scene (simulators without HDR).
+    bool ldr_glare = false;
+};
+/// InputError naming the key for an invalid combination (tone-map settings,
+/// display model, bits outside 1..16, stride < 1, fixed level ≤ 0).
+void validate_output_settings(const OutputSettings& s);
+
+}  // namespace atonlab::stimuli

@@ -1,0 +1,40 @@
+#include "atonlab/stimuli/pipeline.h"
+
+#include "atonlab/stimuli/error.h"
+
+namespace atonlab::stimuli {
+
+void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
+    validate_output_settings(scene.output);
+    frame_.render(scene, time_s);
+    const OutputSettings& out = scene.output;
+    if (const gl::Texture2D* glare = frame_.glare_texture();
+        glare && out.ldr_glare && scene.glare.model != GlareModel::none) {
+        // The scene as an LDR renderer shows it: exposure to the linear
+        // operator's white (the adaptation luminance at the display's own
+        // adaptation level), clipped; the glare is tone-mapped and added.
+        const ToneMapSettings& tm = out.tonemap;
+        const double white = tm.white_cd_m2
+                                 ? *tm.white_cd_m2
+                                 : out.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / display_adaptation_cd_m2(tm);
+        display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index_, 1.0 / white);
+    } else {
+        display_.process(frame_.hdr_texture(), out, dt_s, frame_index_);
+    }
+    ++frame_index_;
+}
+
+void Pipeline::render_ldr(const gl::Texture2D& ldr, const Scene& scene, double time_s) {
+    validate_output_settings(scene.output);
+    Scene glare_scene = scene;
+    glare_scene.output.ldr_glare = true;
+    if (glare_scene.glare.model == GlareModel::none)
+        throw InputError(
+            SourceLocation{"", 0, 0, "eye.glare"},
+            "the LDR path adds glare to a display-referred frame; choose a glare model other than \"none\".");
+    frame_.render(glare_scene, time_s);
+    display_.process_ldr(ldr, *frame_.glare_texture(), scene.output, frame_index_, 0.0);
+    ++frame_index_;
+}
+
+}  // namespace atonlab::stimuli
