@@ -1,0 +1,268 @@
+#pragma once
+// A protocol: what a study asks (DESIGN.md "Experiments"; every key of the file
+// in docs/protocol-file.md). The display, the scene template, blocks of
+// conditions that override scene keys, and for each condition the task, the
+// procedure, what the procedure's level controls and how the stimulus is
+// presented. Plain values: the protocol-file parser (protocol_file.h) fills
+// them, the schedule (protocol_schedule.h) runs them.
+//
+// A condition never touches the scene itself: it produces scene overrides
+// ("section.key=value", the value in TOML syntax, exactly what `atonlab render
+// --set` takes; docs/scene-file.md "Overrides with --set"), so this library
+// needs neither the stimuli library nor GL.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "atonlab/protocols/procedures.h"
+
+namespace atonlab::protocols {
+
+/// Bad input in a protocol file (or a scripted observer's answer file): one
+/// sentence and where it happened. what() is "FILE:LINE: key 'KEY': MESSAGE",
+/// the parts omitted when unknown (line 0, empty key) — the same shape as the
+/// stimuli library's InputError, which this library must not include.
+class ProtocolError : public std::runtime_error {
+public:
+    ProtocolError(std::string file, int line, int column, std::string key, const std::string& message);
+
+    const std::string& file() const noexcept { return file_; }
+    int line() const noexcept { return line_; }               ///< 1-based; 0 when unknown
+    int column() const noexcept { return column_; }           ///< 1-based; 0 when unknown
+    const std::string& key() const noexcept { return key_; }  ///< dotted key as written; may be empty
+    const std::string& message() const noexcept { return message_; }
+
+private:
+    std::string file_;
+    int line_;
+    int column_;
+    std::string key_;
+    std::string message_;
+};
+
+/// What the observer is asked to do on a trial.
+enum class Task : std::uint8_t {
+    TwoAfc,  ///< "2afc": which of two (intervals or sides)? Answers Left / Right
+    YesNo,   ///< "yes-no": seen or not? Answers Yes / No
+    Adjust,  ///< "adjust": method of adjustment; answers the five adjustment actions
+};
+std::string_view to_string(Task t) noexcept;
+std::optional<Task> parse_task(std::string_view text) noexcept;
+
+/// How the test and the reference are shown.
+enum class Presentation : std::uint8_t {
+    Single,       ///< "single": one frame (yes-no)
+    TwoInterval,  ///< "two-interval": two frames one after the other (temporal 2IFC; adjust alternates them)
+    SideBySide,   ///< "side-by-side": one frame holding both lights, at two positions
+};
+std::string_view to_string(Presentation p) noexcept;
+std::optional<Presentation> parse_presentation(std::string_view text) noexcept;
+
+/// How a procedure level becomes the scene value of `level_key`.
+enum class LevelScale : std::uint8_t {
+    Log10,   ///< "log10": value = 10^level (levels in log10 units of the key's unit)
+    Linear,  ///< "linear": value = level
+};
+std::string_view to_string(LevelScale s) noexcept;
+std::optional<LevelScale> parse_level_scale(std::string_view text) noexcept;
+
+/// The two stimuli of a comparison. A single presentation shows the test only.
+enum class Role : std::uint8_t { Test, Reference };
+std::string_view to_string(Role r) noexcept;
+std::optional<Role> parse_role(std::string_view text) noexcept;
+
+enum class ProcedureKind : std::uint8_t { Staircase, WeightedStaircase, Quest, Adjustment, ConstantStimuli };
+/// "staircase", "weighted-staircase", "quest", "adjustment", "constant-stimuli".
+std::string_view to_string(ProcedureKind k) noexcept;
+std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcept;
+
+/// One scene override, "key=value" with a TOML value, and where the protocol wrote it.
+struct Override {
+    std::string key;    ///< dotted scene key, e.g. "eye.glare", "light.reference.intensity_cd"
+    std::string value;  ///< TOML value text, e.g. "\"none\"", "120", "[0.0, 3.0, -500.0]"
+    int line = 0;       ///< line in the protocol file (0: made by the program)
+    int column = 0;
+    /// "key=value", as `atonlab render --set` and stimuli::SceneOverride::parse take it.
+    std::string text() const { return key + "=" + value; }
+};
+
+/// A procedure and its parameters, 1:1 the procedures' parameter structs.
+using ProcedureParams =
+    std::variant<StaircaseParams, WeightedStaircaseParams, QuestParams, AdjustmentParams, ConstantStimuliParams>;
+
+struct ProcedureSpec {
+    ProcedureKind kind = ProcedureKind::Staircase;
+    ProcedureParams params;
+    /// One interleaved track per entry: the track's `start` (staircases) or
+    /// `t_guess` (QUEST). Empty: one track with the parameters as they are.
+    std::vector<double> track_starts;
+
+    std::size_t tracks() const noexcept { return track_starts.empty() ? 1 : track_starts.size(); }
+};
+
+/// One condition of a block: the scene as overridden, the task, the procedure.
+struct Condition {
+    std::string name;  ///< unique in the protocol; the store's condition_id
+    int line = 0;      ///< of its [[block.condition]] table
+    Task task = Task::TwoAfc;
+    Presentation presentation = Presentation::TwoInterval;
+    std::string prompt;  ///< the question shown with the stimulus; empty: none
+    /// Applied in order to every frame of the condition ([defaults], then the
+    /// block's, then the condition's own), then test_set to the test's frame and
+    /// reference_set to the reference's (both, in that order, to a side-by-side
+    /// frame), then the level.
+    std::vector<Override> set;
+    std::vector<Override> test_set;
+    std::vector<Override> reference_set;
+    std::string level_key;  ///< the scene key the procedure's level sets, e.g. "light.reference.intensity_cd"
+    LevelScale level_scale = LevelScale::Log10;
+    Role level_on = Role::Reference;                       ///< which stimulus the level is applied to
+    ChoiceMapping choice = ChoiceMapping::ChoseReference;  ///< 2AFC: what Yes means to the procedure
+    std::string test_light;       ///< the scene light the observer judges as the test; empty: image centre
+    std::string reference_light;  ///< the scene light of the reference; empty: image centre
+    /// Side-by-side: where the left and right lights go (metres, world frame);
+    /// the test goes left when the forced choice says so.
+    std::optional<std::array<double, 3>> left_position_m;
+    std::optional<std::array<double, 3>> right_position_m;
+    ProcedureSpec procedure;
+
+    /// The value written to level_key for a procedure level (10^level or level).
+    double scene_value(double level) const;
+};
+
+struct Block {
+    std::string name;  ///< unique in the protocol
+    int line = 0;
+    double adaptation_s = 0.0;  ///< the observer adapts this long before each run of the block, s
+    int repetitions = 1;        ///< runs of the block in a row, each with fresh procedures
+    InterleaveOrder interleave = InterleaveOrder::Random;  ///< of all the tracks of all its conditions
+    std::string instructions;                              ///< a text screen before each run; empty: none
+    std::vector<Condition> conditions;
+};
+
+/// The observer's display: the scene's [display] keys (docs/scene-file.md).
+struct Display {
+    int width_px = 0;
+    int height_px = 0;
+    double width_m = 0.0;             ///< visible width of the picture, metres
+    double viewing_distance_m = 0.0;  ///< eye to screen, metres
+};
+
+struct Timing {
+    double stimulus_s = 1.0;                   ///< each interval / the frame, s
+    double inter_stimulus_s = 0.5;             ///< blank between the two intervals, s
+    double inter_trial_s = 1.0;                ///< answer to the next stimulus, s
+    std::optional<double> response_timeout_s;  ///< none: wait for the answer
+};
+
+struct Screens {
+    std::string instructions;  ///< before the first block
+    std::string between;       ///< between runs of blocks (the file's `break`)
+    std::string end;           ///< after the last block
+};
+
+/// What a key or a gamepad button does.
+enum class Action : std::uint8_t {
+    Left,
+    Right,
+    Yes,
+    No,
+    CoarseUp,
+    CoarseDown,
+    FineUp,
+    FineDown,
+    Confirm,
+    Continue,  ///< dismisses a text screen
+    Quit,      ///< ends the session (what is recorded stays)
+};
+inline constexpr std::size_t kActionCount = 11;
+/// "left", "right", "yes", "no", "coarse_up", "coarse_down", "fine_up", "fine_down", "confirm", "continue", "quit".
+std::string_view to_string(Action a) noexcept;
+/// The procedure answer an action gives (Continue and Quit give none).
+std::optional<Response> response_of(Action a) noexcept;
+/// The actions a task takes as answers.
+std::span<const Action> task_actions(Task t) noexcept;
+
+/// Keys and gamepad buttons for each action (names in docs/protocol-file.md).
+struct ResponseMap {
+    std::array<std::vector<std::string>, kActionCount> keys;
+    std::array<std::vector<std::string>, kActionCount> buttons;
+
+    /// The defaults: arrows for 2AFC and coarse adjustment, y/n, enter/space, escape; no buttons.
+    static ResponseMap defaults();
+    const std::vector<std::string>& keys_of(Action a) const { return keys[static_cast<std::size_t>(a)]; }
+    const std::vector<std::string>& buttons_of(Action a) const { return buttons[static_cast<std::size_t>(a)]; }
+    /// During a trial of `task`: the action of a key (one of the task's, or
+    /// Quit), or nothing.
+    std::optional<Action> key_action(Task task, std::string_view key) const;
+    std::optional<Action> button_action(Task task, std::string_view button) const;
+    /// On a text screen: Continue, Quit or nothing.
+    std::optional<Action> screen_key_action(std::string_view key) const;
+};
+
+struct Protocol {
+    std::string file;  ///< as given to the parser (messages)
+    std::string name;
+    std::string description;
+    std::filesystem::path scene;  ///< the scene template, resolved against the protocol file's folder
+    std::uint64_t seed = 0;       ///< the session's random seed unless the runner overrides it
+    Display display;
+    Timing timing;
+    ResponseMap responses;
+    Screens screens;
+    std::vector<Block> blocks;
+
+    /// The condition called `name`, or nullptr.
+    const Condition* find_condition(std::string_view name) const;
+    /// The display as scene overrides ("display.width_px=1920", ...).
+    std::vector<std::string> display_overrides() const;
+};
+
+/// Track `track` of a condition's procedure: the procedure built from its
+/// parameters (with that track's start), wrapped in a ForcedChoice for 2AFC.
+/// Seeds: the procedure gets derive_seed(seed, 0), the forced choice derive_seed(seed, 1).
+/// Throws ProcedureError for bad parameters.
+std::unique_ptr<Procedure> make_track(const Condition& condition, std::size_t track, std::uint64_t seed);
+
+/// The condition's procedure: its one track, or an Interleaver (random order)
+/// of its tracks, track t seeded derive_seed(seed, t) and the interleaver
+/// derive_seed(seed, tracks). The Schedule builds the same tracks (same
+/// seeds) but interleaves all the tracks of a block together.
+std::unique_ptr<Procedure> make_procedure(const Condition& condition, std::uint64_t seed);
+
+/// One frame to render: the scene overrides in the order they apply.
+struct Frame {
+    std::optional<Role> role;  ///< whose frame it is; nullopt: side-by-side (both)
+    std::vector<std::string> overrides;
+};
+
+/// One light the observer judges: in which frame and which scene light.
+struct StimulusView {
+    std::size_t frame = 0;
+    std::string light;  ///< scene light name; empty: the image centre
+    Role role = Role::Test;
+};
+
+/// Everything a proposal asks to be shown.
+struct Stimulus {
+    std::vector<Frame> frames;                 ///< in presentation order
+    std::vector<StimulusView> views;           ///< [0] left / first interval, [1] right / second; one for yes-no
+    std::optional<std::size_t> adjusted_view;  ///< adjust: the view whose level the actions change
+    double level = 0.0;                        ///< the procedure's level
+    double scene_value = 0.0;                  ///< what level_key is set to
+};
+
+/// The frames and views for a proposal of the condition's procedure. The test
+/// goes first / left when proposal.test_on_left is true or absent. Every frame
+/// starts with the protocol's display overrides.
+Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, const Proposal& proposal);
+
+}  // namespace atonlab::protocols

@@ -1,0 +1,143 @@
+// The scripted observer: answers read from a file (observer.h).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <system_error>
+
+#include "atonlab/protocols/observer.h"
+
+namespace atonlab::protocols {
+
+namespace {
+
+constexpr std::pair<std::string_view, Response> kWords[] = {{"left", Response::Left},
+                                                            {"first", Response::Left},
+                                                            {"right", Response::Right},
+                                                            {"second", Response::Right},
+                                                            {"yes", Response::Yes},
+                                                            {"no", Response::No},
+                                                            {"coarse_up", Response::CoarseUp},
+                                                            {"coarse_down", Response::CoarseDown},
+                                                            {"fine_up", Response::FineUp},
+                                                            {"fine_down", Response::FineDown},
+                                                            {"confirm", Response::Confirm}};
+
+constexpr std::string_view kWordList =
+    "left, right, first, second, yes, no, coarse_up, coarse_down, fine_up, fine_down, confirm";
+
+std::vector<std::string_view> split(std::string_view s) {
+    std::vector<std::string_view> out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) ++i;
+        const std::size_t start = i;
+        while (i < s.size() && s[i] != ' ' && s[i] != '\t' && s[i] != '\r') ++i;
+        if (i > start) out.push_back(s.substr(start, i - start));
+    }
+    return out;
+}
+
+bool fits(Task task, Response r) {
+    const auto actions = task_actions(task);
+    return std::any_of(actions.begin(), actions.end(), [r](Action a) { return response_of(a) == r; });
+}
+
+std::string_view takes(Task task) {
+    switch (task) {
+        case Task::TwoAfc:
+            return "left or right";
+        case Task::YesNo:
+            return "yes or no";
+        case Task::Adjust:
+            return "coarse_up, coarse_down, fine_up, fine_down or confirm";
+    }
+    return "?";
+}
+
+}  // namespace
+
+ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view file_name) {
+    const std::string file(file_name);
+    std::vector<Line> lines;
+    int number = 0;
+    std::size_t pos = 0;
+    while (pos <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', pos), text.size());
+        std::string_view line = text.substr(pos, end - pos);
+        pos = end + 1;
+        ++number;
+        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+        const std::vector<std::string_view> tokens = split(line);
+        if (tokens.empty()) {
+            if (end == text.size()) break;
+            continue;
+        }
+        if (tokens.size() > 2)
+            throw ProtocolError(file, number, 0, "",
+                                fmt::format("expected an answer and at most a response time in seconds "
+                                            "(\"left 0.62\"), got \"{}\".",
+                                            line));
+        std::string word(tokens[0]);
+        std::transform(word.begin(), word.end(), word.begin(), [](char c) {
+            return c == '-' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        });
+        const auto it =
+            std::find_if(std::begin(kWords), std::end(kWords), [&](const auto& w) { return w.first == word; });
+        if (it == std::end(kWords))
+            throw ProtocolError(file, number, 0, "",
+                                fmt::format("unknown answer \"{}\"; expected one of {}.", tokens[0], kWordList));
+        Line l;
+        l.line = number;
+        l.word = std::string(tokens[0]);
+        l.answer.response = it->second;
+        if (tokens.size() == 2) {
+            double rt = 0.0;
+            const auto [ptr, ec] = std::from_chars(tokens[1].data(), tokens[1].data() + tokens[1].size(), rt);
+            if (ec != std::errc() || ptr != tokens[1].data() + tokens[1].size() || !std::isfinite(rt) || rt < 0.0)
+                throw ProtocolError(
+                    file, number, 0, "",
+                    fmt::format("the response time \"{}\" is not a number of seconds >= 0.", tokens[1]));
+            l.answer.response_time_s = rt;
+        }
+        lines.push_back(std::move(l));
+        if (end == text.size()) break;
+    }
+    return ScriptedObserver(file, std::move(lines));
+}
+
+ScriptedObserver ScriptedObserver::load(const std::filesystem::path& file) {
+    std::FILE* f = std::fopen(file.c_str(), "rb");
+    if (f == nullptr)
+        throw ProtocolError(
+            file.string(), 0, 0, "",
+            fmt::format("cannot read the answer file: {}.", std::error_code(errno, std::generic_category()).message()));
+    std::string text;
+    char buffer[65536];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) throw ProtocolError(file.string(), 0, 0, "", "cannot read the answer file: a read error occurred.");
+    return parse(text, file.string());
+}
+
+Answer ScriptedObserver::answer(const Shown& shown) {
+    if (next_ >= lines_.size())
+        throw ProtocolError(file_, 0, 0, "",
+                            fmt::format("the script's {} {} used up: answer {} needs one more line.", lines_.size(),
+                                        lines_.size() == 1 ? "answer is" : "answers are", next_ + 1));
+    const Line& l = lines_[next_];
+    if (!fits(shown.task, l.answer.response))
+        throw ProtocolError(file_, l.line, 0, "",
+                            fmt::format("the answer \"{}\" does not fit a {} trial, which takes {}.", l.word,
+                                        to_string(shown.task), takes(shown.task)));
+    ++next_;
+    return l.answer;
+}
+
+}  // namespace atonlab::protocols

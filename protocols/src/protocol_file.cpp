@@ -1,0 +1,851 @@
+// The protocol file (protocol_file.h; every key in docs/protocol-file.md).
+// Three steps: parse the TOML text (syntax errors keep the parser's line), read
+// every table of the schema strictly, then build each condition's procedures
+// once so that the procedures' own parameter checks (ProcedureError) are
+// reported at the line of the offending key.
+#include "atonlab/protocols/protocol_file.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+#include <system_error>
+
+#include "protocol_reader.h"
+
+namespace atonlab::protocols {
+
+namespace {
+
+using detail::Document;
+using detail::KeyList;
+using detail::Section;
+
+constexpr std::string_view kRootKeys[] = {"protocol", "display", "timing", "responses", "screens", "defaults", "block"};
+constexpr std::string_view kProtocolKeys[] = {"name", "description", "scene", "seed", "adaptation_s"};
+constexpr std::string_view kDisplayKeys[] = {"width_px", "height_px", "width_m", "viewing_distance_m"};
+constexpr std::string_view kTimingKeys[] = {"stimulus_s", "inter_stimulus_s", "inter_trial_s", "response_timeout_s"};
+constexpr std::string_view kScreenKeys[] = {"instructions", "break", "end"};
+constexpr std::string_view kResponseKeys[] = {"keys", "gamepad"};
+constexpr std::string_view kActionNames[] = {"left",    "right",     "yes",     "no",       "coarse_up", "coarse_down",
+                                             "fine_up", "fine_down", "confirm", "continue", "quit"};
+
+// Condition keys may be written in [defaults], in a [[block]] (for all its
+// conditions) or in the [[block.condition]] itself; the nearest wins, and the
+// override lists add up.
+constexpr std::string_view kConditionKeys[] = {
+    "task",        "presentation", "prompt", "set",        "test_set",        "reference_set",   "level_key",
+    "level_scale", "level_on",     "choice", "test_light", "reference_light", "left_position_m", "right_position_m",
+    "procedure"};
+constexpr std::string_view kBlockOwnKeys[] = {"name",       "adaptation_s", "repetitions",
+                                              "interleave", "instructions", "condition"};
+
+constexpr std::string_view kStaircaseKeys[] = {
+    "kind",        "start",    "step_sizes", "step_type", "n_up",      "n_down",        "apply_initial_rule",
+    "n_reversals", "n_trials", "max_trials", "min_level", "max_level", "up_step_ratio", "estimate_reversals"};
+constexpr std::string_view kWeightedKeys[] = {
+    "kind",     "start",      "target",    "step_sizes", "step_type",         "n_reversals",
+    "n_trials", "max_trials", "min_level", "max_level",  "estimate_reversals"};
+constexpr std::string_view kQuestKeys[] = {
+    "kind",  "t_guess", "t_guess_sd",     "p_threshold", "beta",          "delta",     "gamma",     "grain",
+    "range", "method",  "quantile_order", "n_trials",    "stop_interval", "min_level", "max_level", "first_at_guess"};
+constexpr std::string_view kAdjustmentKeys[] = {"kind",      "start_min", "start_max", "coarse_step",
+                                                "fine_step", "min_level", "max_level", "n_trials"};
+constexpr std::string_view kConstantKeys[] = {"kind", "levels", "repetitions", "order", "criterion"};
+constexpr std::string_view kKindNames[] = {"staircase", "weighted-staircase", "quest", "adjustment",
+                                           "constant-stimuli"};
+
+// Key names (GLFW's key names, lower case with underscores) and gamepad buttons
+// (GLFW_GAMEPAD_BUTTON_*).
+const std::vector<std::string>& key_names() {
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> v;
+        for (char c = 'a'; c <= 'z'; ++c) v.emplace_back(1, c);
+        for (char c = '0'; c <= '9'; ++c) v.emplace_back(1, c);
+        for (int i = 1; i <= 12; ++i) v.push_back(fmt::format("f{}", i));
+        for (int i = 0; i <= 9; ++i) v.push_back(fmt::format("kp_{}", i));
+        for (const char* s :
+             {"left",         "right",         "up",        "down",        "space",       "enter",     "escape",
+              "backspace",    "tab",           "insert",    "delete",      "home",        "end",       "page_up",
+              "page_down",    "kp_enter",      "kp_add",    "kp_subtract", "kp_multiply", "kp_divide", "kp_decimal",
+              "comma",        "period",        "slash",     "semicolon",   "apostrophe",  "minus",     "equal",
+              "left_bracket", "right_bracket", "backslash", "grave_accent"})
+            v.emplace_back(s);
+        return v;
+    }();
+    return names;
+}
+constexpr std::string_view kButtonNames[] = {
+    "a",     "b",          "x",           "y",       "left_bumper", "right_bumper", "back",     "start",
+    "guide", "left_thumb", "right_thumb", "dpad_up", "dpad_right",  "dpad_down",    "dpad_left"};
+
+std::string strip_period(std::string s) {
+    while (!s.empty() && s.back() == '.') s.pop_back();
+    return s;
+}
+
+// ---------------------------------------------------------------------------
+// A condition's keys, looked up from the most specific table outwards.
+
+struct Found {
+    const toml::node* node = nullptr;
+    std::string key;  ///< dotted path where it was written
+};
+
+struct Layer {
+    const toml::table* table = nullptr;  ///< may be null ([defaults] absent)
+    std::string path;                    ///< "defaults", "block[0]", "block[0].condition[1]"
+};
+
+class ConditionReader {
+public:
+    ConditionReader(const Document& doc, std::vector<Layer> outer_to_inner, std::string name, int line)
+        : doc_(doc), layers_(std::move(outer_to_inner)), name_(std::move(name)), line_(line) {
+        context_ = fmt::format("in condition \"{}\", ", name_);
+    }
+
+    const std::string& context() const noexcept { return context_; }
+    const Layer& own() const { return layers_.back(); }
+
+    std::optional<Found> find(std::string_view key) const {
+        for (auto it = layers_.rbegin(); it != layers_.rend(); ++it)
+            if (it->table != nullptr)
+                if (const toml::node* n = it->table->get(key)) return Found{n, it->path + "." + std::string(key)};
+        return std::nullopt;
+    }
+
+    /// Every layer's value of a list key, outer first.
+    std::vector<Found> find_all(std::string_view key) const {
+        std::vector<Found> out;
+        for (const Layer& l : layers_)
+            if (l.table != nullptr)
+                if (const toml::node* n = l.table->get(key)) out.push_back(Found{n, l.path + "." + std::string(key)});
+        return out;
+    }
+
+    [[noreturn]] void missing(std::string_view key, std::string_view what) const {
+        doc_.fail_at_line(line_, own().path + "." + std::string(key),
+                          fmt::format("condition \"{}\" (line {}) has no '{}', which is required ({}); give it in "
+                                      "the condition, its [[block]] or [defaults].",
+                                      name_, line_, key, what));
+    }
+    [[noreturn]] void fail(const Found& f, const std::string& message) const {
+        doc_.fail(f.node, f.key, context_ + message);
+    }
+    [[noreturn]] void fail_condition(std::string_view key, const std::string& message) const {
+        doc_.fail_at_line(line_, own().path + "." + std::string(key), context_ + message);
+    }
+
+    std::optional<std::string> string(std::string_view key) const {
+        auto f = find(key);
+        if (!f) return std::nullopt;
+        return doc_.string(f->node, f->key, context_);
+    }
+
+    /// An enumerated string value.
+    template <class E>
+    std::optional<E> choice(std::string_view key, std::optional<E> (*parse)(std::string_view) noexcept,
+                            KeyList allowed) const {
+        auto f = find(key);
+        if (!f) return std::nullopt;
+        const std::string text = doc_.string(f->node, f->key, context_);
+        if (auto e = parse(text)) return e;
+        fail(*f, fmt::format("{} must be one of {}, got \"{}\".", key, detail::join_quoted(allowed), text));
+    }
+
+private:
+    const Document& doc_;
+    std::vector<Layer> layers_;
+    std::string name_;
+    int line_;
+    std::string context_;
+};
+
+// ---------------------------------------------------------------------------
+// The procedure table, merged over the layers.
+
+KeyList keys_of(ProcedureKind k) {
+    switch (k) {
+        case ProcedureKind::Staircase:
+            return kStaircaseKeys;
+        case ProcedureKind::WeightedStaircase:
+            return kWeightedKeys;
+        case ProcedureKind::Quest:
+            return kQuestKeys;
+        case ProcedureKind::Adjustment:
+            return kAdjustmentKeys;
+        case ProcedureKind::ConstantStimuli:
+            return kConstantKeys;
+    }
+    return {};
+}
+
+const std::vector<std::string_view>& all_procedure_keys() {
+    static const std::vector<std::string_view> all = [] {
+        std::set<std::string_view> s;
+        for (auto list : {KeyList(kStaircaseKeys), KeyList(kWeightedKeys), KeyList(kQuestKeys),
+                          KeyList(kAdjustmentKeys), KeyList(kConstantKeys)})
+            s.insert(list.begin(), list.end());
+        return std::vector<std::string_view>(s.begin(), s.end());
+    }();
+    return all;
+}
+
+class ProcedureReader {
+public:
+    ProcedureReader(const Document& doc, const ConditionReader& cond) : doc_(doc), cond_(cond) {}
+
+    /// Merges the layers' procedure tables. A layer that names a different
+    /// kind from the one inherited starts afresh.
+    void merge(const std::vector<Found>& tables) {
+        for (const Found& f : tables) {
+            if (!f.node->is_table())
+                doc_.fail(f.node, f.key,
+                          cond_.context() + fmt::format("expected a procedure table (procedure = {{ kind = "
+                                                        "\"staircase\", ... }}), got {}.",
+                                                        detail::type_phrase(f.node->type())));
+            const toml::table& t = *f.node->as_table();
+            table_ = f;
+            if (const toml::node* k = t.get("kind")) {
+                const std::string text = doc_.string(k, f.key + ".kind", cond_.context());
+                const auto parsed = parse_procedure_kind(text);
+                if (!parsed)
+                    doc_.fail(k, f.key + ".kind",
+                              cond_.context() + fmt::format("kind must be one of {}, got \"{}\".",
+                                                            detail::join_quoted(kKindNames), text));
+                if (kind_ && *kind_ != *parsed) entries_.clear();
+                kind_ = parsed;
+                kind_at_ = Found{k, f.key + ".kind"};
+            }
+            const KeyList allowed = kind_ ? keys_of(*kind_) : KeyList(all_procedure_keys());
+            for (auto&& [key, value] : t) {
+                if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
+                    const std::string what =
+                        kind_ ? fmt::format("a {} procedure", to_string(*kind_)) : std::string("a procedure");
+                    doc_.fail_at_key(
+                        key, f.key + "." + std::string(key.str()),
+                        cond_.context() + fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", key.str(), what,
+                                                      detail::suggestion(key.str(), allowed),
+                                                      detail::join_quoted(allowed)));
+                }
+                if (key.str() != "kind")
+                    entries_[std::string(key.str())] = Found{&value, f.key + "." + std::string(key.str())};
+            }
+        }
+    }
+
+    std::optional<ProcedureKind> kind() const { return kind_; }
+    const std::optional<Found>& kind_at() const { return kind_at_; }
+    const std::optional<Found>& table() const { return table_; }
+
+    const Found* entry(std::string_view key) const {
+        auto it = entries_.find(std::string(key));
+        return it == entries_.end() ? nullptr : &it->second;
+    }
+    bool has(std::string_view key) const { return entry(key) != nullptr; }
+
+    /// Where a parameter error is reported: at the key when it was written,
+    /// else at the nearest procedure table.
+    [[noreturn]] void fail(std::string_view key, const std::string& message) const {
+        if (const Found* f = entry(key)) doc_.fail(f->node, f->key, cond_.context() + message);
+        doc_.fail(table_->node, table_->key + "." + std::string(key), cond_.context() + message);
+    }
+
+    std::optional<double> number(std::string_view key) const {
+        const Found* f = entry(key);
+        return f ? std::optional<double>(doc_.number(f->node, f->key, key, cond_.context())) : std::nullopt;
+    }
+    void number(std::string_view key, double& out) const {
+        if (auto v = number(key)) out = *v;
+    }
+    void number(std::string_view key, std::optional<double>& out) const {
+        if (auto v = number(key)) out = *v;
+    }
+    std::optional<int> integer(std::string_view key) const {
+        const Found* f = entry(key);
+        if (f == nullptr) return std::nullopt;
+        return doc_.integer(f->node, f->key, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+                            cond_.context());
+    }
+    void integer(std::string_view key, int& out) const {
+        if (auto v = integer(key)) out = *v;
+    }
+    void integer(std::string_view key, std::optional<int>& out) const {
+        if (auto v = integer(key)) out = *v;
+    }
+    void boolean(std::string_view key, bool& out) const {
+        if (const Found* f = entry(key)) out = doc_.boolean(f->node, f->key, cond_.context());
+    }
+    std::optional<std::string> string(std::string_view key) const {
+        const Found* f = entry(key);
+        return f ? std::optional<std::string>(doc_.string(f->node, f->key, cond_.context())) : std::nullopt;
+    }
+    std::optional<std::vector<double>> numbers(std::string_view key, bool scalar_ok) const {
+        const Found* f = entry(key);
+        if (f == nullptr) return std::nullopt;
+        return doc_.numbers(f->node, f->key, key, scalar_ok, cond_.context());
+    }
+
+    /// A start that may be a list (one interleaved track per entry).
+    void starts(std::string_view key, double& first, std::vector<double>& tracks) const {
+        const Found* f = entry(key);
+        if (f == nullptr)
+            fail(key, fmt::format("the {} procedure has no '{}', which is required.", to_string(*kind_), key));
+        std::vector<double> v = doc_.numbers(f->node, f->key, key, true, cond_.context());
+        first = v.front();
+        if (f->node->is_array()) tracks = std::move(v);
+    }
+
+    void require_stop_rule(std::initializer_list<std::string_view> keys, std::string_view what) const {
+        for (std::string_view k : keys)
+            if (has(k)) return;
+        // Reported at the condition's own procedure table (or the one it inherits).
+        doc_.fail(
+            table_->node, table_->key,
+            cond_.context() + fmt::format("the {} procedure has no stop rule: give {}.", to_string(*kind_), what));
+    }
+
+private:
+    const Document& doc_;
+    const ConditionReader& cond_;
+    std::optional<ProcedureKind> kind_;
+    std::optional<Found> kind_at_;
+    std::optional<Found> table_;
+    std::map<std::string, Found> entries_;
+};
+
+ProcedureSpec read_procedure(const ProcedureReader& r) {
+    ProcedureSpec spec;
+    spec.kind = *r.kind();
+    switch (spec.kind) {
+        case ProcedureKind::Staircase: {
+            StaircaseParams p;
+            r.starts("start", p.start, spec.track_starts);
+            if (auto v = r.numbers("step_sizes", true)) p.step_sizes = *v;
+            if (auto s = r.string("step_type")) p.step_type = parse_step_type(*s);
+            r.integer("n_up", p.n_up);
+            r.integer("n_down", p.n_down);
+            r.boolean("apply_initial_rule", p.apply_initial_rule);
+            r.integer("n_reversals", p.n_reversals);
+            r.integer("n_trials", p.n_trials);
+            r.integer("max_trials", p.max_trials);
+            r.number("min_level", p.min_level);
+            r.number("max_level", p.max_level);
+            r.number("up_step_ratio", p.up_step_ratio);
+            r.integer("estimate_reversals", p.estimate_reversals);
+            r.require_stop_rule({"n_reversals", "n_trials", "max_trials"}, "n_reversals, n_trials or max_trials");
+            spec.params = std::move(p);
+            break;
+        }
+        case ProcedureKind::WeightedStaircase: {
+            WeightedStaircaseParams p;
+            r.starts("start", p.start, spec.track_starts);
+            r.number("target", p.target);
+            if (auto v = r.numbers("step_sizes", true)) p.step_sizes = *v;
+            if (auto s = r.string("step_type")) p.step_type = parse_step_type(*s);
+            r.integer("n_reversals", p.n_reversals);
+            r.integer("n_trials", p.n_trials);
+            r.integer("max_trials", p.max_trials);
+            r.number("min_level", p.min_level);
+            r.number("max_level", p.max_level);
+            r.integer("estimate_reversals", p.estimate_reversals);
+            r.require_stop_rule({"n_reversals", "n_trials", "max_trials"}, "n_reversals, n_trials or max_trials");
+            spec.params = std::move(p);
+            break;
+        }
+        case ProcedureKind::Quest: {
+            QuestParams p;
+            r.starts("t_guess", p.t_guess, spec.track_starts);
+            r.number("t_guess_sd", p.t_guess_sd);
+            r.number("p_threshold", p.p_threshold);
+            r.number("beta", p.beta);
+            r.number("delta", p.delta);
+            r.number("gamma", p.gamma);
+            r.number("grain", p.grain);
+            r.number("range", p.range);
+            if (auto s = r.string("method")) p.method = parse_quest_method(*s);
+            r.number("quantile_order", p.quantile_order);
+            r.integer("n_trials", p.n_trials);
+            r.number("stop_interval", p.stop_interval);
+            r.number("min_level", p.min_level);
+            r.number("max_level", p.max_level);
+            r.boolean("first_at_guess", p.first_at_guess);
+            r.require_stop_rule({"n_trials"}, "n_trials (and, if you like, stop_interval)");
+            spec.params = std::move(p);
+            break;
+        }
+        case ProcedureKind::Adjustment: {
+            AdjustmentParams p;
+            if (!r.has("start_min"))
+                r.fail("start_min", "the adjustment procedure has no 'start_min', which is required.");
+            if (!r.has("start_max"))
+                r.fail("start_max", "the adjustment procedure has no 'start_max', which is required.");
+            r.number("start_min", p.start_min);
+            r.number("start_max", p.start_max);
+            r.number("coarse_step", p.coarse_step);
+            r.number("fine_step", p.fine_step);
+            r.number("min_level", p.min_level);
+            r.number("max_level", p.max_level);
+            r.integer("n_trials", p.n_trials);
+            r.require_stop_rule({"n_trials"}, "n_trials (the matches to make)");
+            spec.params = std::move(p);
+            break;
+        }
+        case ProcedureKind::ConstantStimuli: {
+            ConstantStimuliParams p;
+            auto levels = r.numbers("levels", false);
+            if (!levels) r.fail("levels", "the constant-stimuli procedure has no 'levels', which is required.");
+            p.levels = std::move(*levels);
+            r.integer("repetitions", p.repetitions);
+            if (auto s = r.string("order")) p.order = parse_constant_order(*s);
+            r.number("criterion", p.criterion);
+            spec.params = std::move(p);
+            break;
+        }
+    }
+    return spec;
+}
+
+// ---------------------------------------------------------------------------
+// The whole file.
+
+class Parser {
+public:
+    explicit Parser(std::string file) : doc_(std::move(file)) {}
+
+    Protocol parse(std::string_view text, bool check_scene_exists) {
+        try {
+            root_ = toml::parse(text, doc_.file());
+        } catch (const toml::parse_error& e) {
+            throw ProtocolError(doc_.file(), static_cast<int>(e.source().begin.line),
+                                static_cast<int>(e.source().begin.column), "",
+                                fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
+        }
+        Section root(doc_, root_, "", "the protocol file");
+        root.allow(kRootKeys);
+
+        Protocol p;
+        p.file = doc_.file();
+        read_header(root, p, check_scene_exists);
+        read_display(root, p);
+        read_timing(root, p);
+        read_screens(root, p);
+        read_blocks(root, p);
+        read_responses(root, p);
+        return p;
+    }
+
+private:
+    void read_header(const Section& root, Protocol& p, bool check_scene_exists) {
+        const toml::table* t = root.table("protocol");
+        if (t == nullptr)
+            doc_.fail_at_line(0, "protocol",
+                              "the protocol file has no [protocol] table, which is required (its scene and seed).");
+        Section s(doc_, *t, "protocol", "the [protocol] table");
+        s.allow(kProtocolKeys);
+        p.name = s.string("name").value_or(std::filesystem::path(doc_.file()).stem().string());
+        p.description = s.string("description").value_or("");
+        const auto scene = s.string("scene");
+        if (!scene) s.missing("scene", "the scene file the conditions override, relative to this file");
+        if (scene->empty()) s.fail("scene", "scene must name a scene file, got an empty string.");
+        const std::filesystem::path as_written(*scene);
+        p.scene = as_written.is_absolute()
+                      ? as_written
+                      : (std::filesystem::path(doc_.file()).parent_path() / as_written).lexically_normal();
+        if (check_scene_exists) {
+            std::error_code ec;
+            if (!std::filesystem::is_regular_file(p.scene, ec))
+                s.fail("scene",
+                       fmt::format("the scene file \"{}\" does not exist (looked for {}).", *scene, p.scene.string()));
+        }
+        const toml::node* seed = s.get("seed");
+        if (seed == nullptr) s.missing("seed", "the random seed, an integer >= 0");
+        const std::int64_t v = doc_.integer64(seed, "protocol.seed");
+        if (v < 0) s.fail("seed", fmt::format("seed must be at least 0, got {}.", v));
+        p.seed = static_cast<std::uint64_t>(v);
+        adaptation_s_ = s.number("adaptation_s").value_or(0.0);
+        s.at_least("adaptation_s", adaptation_s_, 0.0);
+    }
+
+    void read_display(const Section& root, Protocol& p) {
+        const toml::table* t = root.table("display");
+        if (t == nullptr)
+            doc_.fail_at_line(0, "display",
+                              "the protocol file has no [display] table, which is required (the observer's display, "
+                              "with the scene file's [display] keys).");
+        Section s(doc_, *t, "display", "the [display] table");
+        s.allow(kDisplayKeys);
+        auto px = [&](std::string_view key, std::string_view what) {
+            auto v = s.integer(key, 1, 65536);
+            if (!v) s.missing(key, what);
+            return *v;
+        };
+        p.display.width_px = px("width_px", "the display's width in pixels");
+        p.display.height_px = px("height_px", "the display's height in pixels");
+        p.display.width_m = s.required_number("width_m", "the picture's visible width in metres");
+        s.greater_than("width_m", p.display.width_m, 0.0);
+        p.display.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen in metres");
+        s.greater_than("viewing_distance_m", p.display.viewing_distance_m, 0.0);
+    }
+
+    void read_timing(const Section& root, Protocol& p) {
+        const toml::table* t = root.table("timing");
+        if (t == nullptr) return;
+        Section s(doc_, *t, "timing", "the [timing] table");
+        s.allow(kTimingKeys);
+        if (auto v = s.number("stimulus_s")) {
+            s.greater_than("stimulus_s", *v, 0.0);
+            p.timing.stimulus_s = *v;
+        }
+        if (auto v = s.number("inter_stimulus_s")) {
+            s.at_least("inter_stimulus_s", *v, 0.0);
+            p.timing.inter_stimulus_s = *v;
+        }
+        if (auto v = s.number("inter_trial_s")) {
+            s.at_least("inter_trial_s", *v, 0.0);
+            p.timing.inter_trial_s = *v;
+        }
+        if (auto v = s.number("response_timeout_s")) {
+            s.greater_than("response_timeout_s", *v, 0.0);
+            p.timing.response_timeout_s = *v;
+        }
+    }
+
+    void read_screens(const Section& root, Protocol& p) {
+        const toml::table* t = root.table("screens");
+        if (t == nullptr) return;
+        Section s(doc_, *t, "screens", "the [screens] table");
+        s.allow(kScreenKeys);
+        p.screens.instructions = s.string("instructions").value_or("");
+        p.screens.between = s.string("break").value_or("");
+        p.screens.end = s.string("end").value_or("");
+    }
+
+    void read_responses(const Section& root, Protocol& p) {
+        p.responses = ResponseMap::defaults();
+        // Where the file bound each action (for conflict messages).
+        std::array<const toml::node*, kActionCount> key_nodes{};
+        std::array<std::string, kActionCount> key_paths{};
+        std::array<const toml::node*, kActionCount> button_nodes{};
+        std::array<std::string, kActionCount> button_paths{};
+        const toml::table* t = root.table("responses");
+        if (t != nullptr) {
+            Section s(doc_, *t, "responses", "the [responses] table");
+            s.allow(kResponseKeys);
+            auto read = [&](std::string_view sub, auto& table, auto& nodes, auto& paths, KeyList names,
+                            std::string_view what) {
+                const toml::table* st = s.table(sub);
+                if (st == nullptr) return;
+                Section ss(doc_, *st, s.key_path(sub), fmt::format("the [responses.{}] table", sub));
+                ss.allow(kActionNames);
+                for (std::size_t a = 0; a < kActionCount; ++a) {
+                    const std::string_view action = kActionNames[a];
+                    const toml::node* n = ss.get(action);
+                    if (n == nullptr) continue;
+                    std::vector<std::string> v = doc_.strings(n, ss.key_path(action));
+                    for (const std::string& name : v)
+                        if (std::find(names.begin(), names.end(), name) == names.end())
+                            doc_.fail(n, ss.key_path(action),
+                                      fmt::format("\"{}\" is not a {} name.{} See docs/protocol-file.md for the "
+                                                  "names.",
+                                                  name, what, detail::suggestion(name, names)));
+                    table[a] = std::move(v);
+                    nodes[a] = n;
+                    paths[a] = ss.key_path(action);
+                }
+            };
+            const auto& kn = key_names();
+            const std::vector<std::string_view> key_views(kn.begin(), kn.end());
+            read("keys", p.responses.keys, key_nodes, key_paths, KeyList(key_views), "key");
+            read("gamepad", p.responses.buttons, button_nodes, button_paths, KeyList(kButtonNames), "gamepad button");
+        }
+
+        // Every action the protocol needs has a key, and no key means two things at once.
+        std::set<Task> tasks;
+        for (const Block& b : p.blocks)
+            for (const Condition& c : b.conditions) tasks.insert(c.task);
+        std::vector<std::vector<Action>> contexts;
+        for (Task task : tasks) {
+            std::vector<Action> v(task_actions(task).begin(), task_actions(task).end());
+            v.push_back(Action::Quit);
+            contexts.push_back(std::move(v));
+        }
+        contexts.push_back({Action::Continue, Action::Quit});
+        for (const auto& actions : contexts)
+            for (Action a : actions) {
+                const auto i = static_cast<std::size_t>(a);
+                if (p.responses.keys[i].empty()) {
+                    const std::string key = fmt::format("responses.keys.{}", to_string(a));
+                    if (key_nodes[i] != nullptr)
+                        doc_.fail(key_nodes[i], key,
+                                  fmt::format("'{}' needs at least one key: the protocol uses it.", to_string(a)));
+                    doc_.fail_at_line(0, key, fmt::format("'{}' needs at least one key.", to_string(a)));
+                }
+            }
+        check_conflicts(p.responses.keys, key_nodes, key_paths, contexts, "key", "responses.keys");
+        check_conflicts(p.responses.buttons, button_nodes, button_paths, contexts, "gamepad button",
+                        "responses.gamepad");
+    }
+
+    void check_conflicts(const std::array<std::vector<std::string>, kActionCount>& table,
+                         const std::array<const toml::node*, kActionCount>& nodes,
+                         const std::array<std::string, kActionCount>& paths,
+                         const std::vector<std::vector<Action>>& contexts, std::string_view what,
+                         std::string_view table_path) const {
+        for (const auto& actions : contexts)
+            for (std::size_t x = 0; x < actions.size(); ++x)
+                for (std::size_t y = x + 1; y < actions.size(); ++y) {
+                    const auto a = static_cast<std::size_t>(actions[x]);
+                    const auto b = static_cast<std::size_t>(actions[y]);
+                    for (const std::string& name : table[a]) {
+                        if (std::find(table[b].begin(), table[b].end(), name) == table[b].end()) continue;
+                        // Report at the binding the file wrote (the later one if both).
+                        const std::size_t at = nodes[b] != nullptr ? b : a;
+                        const std::string message =
+                            fmt::format("the {} \"{}\" is bound to both '{}' and '{}', which are used together.", what,
+                                        name, to_string(actions[x]), to_string(actions[y]));
+                        if (nodes[at] != nullptr) doc_.fail(nodes[at], paths[at], message);
+                        doc_.fail_at_line(0, fmt::format("{}.{}", table_path, to_string(actions[y])), message);
+                    }
+                }
+    }
+
+    void read_blocks(const Section& root, Protocol& p) {
+        const toml::table* defaults = root.table("defaults");
+        if (defaults != nullptr) {
+            Section d(doc_, *defaults, "defaults", "the [defaults] table");
+            d.allow(kConditionKeys);
+        }
+        const toml::node* blocks = root.get("block");
+        if (blocks == nullptr)
+            doc_.fail_at_line(0, "block",
+                              "the protocol file has no [[block]], which is required (at least one block of "
+                              "conditions).");
+        if (!blocks->is_array_of_tables())
+            doc_.fail(
+                blocks, "block",
+                fmt::format("expected an array of tables [[block]], got {}.", detail::type_phrase(blocks->type())));
+        std::vector<std::string_view> block_keys(std::begin(kBlockOwnKeys), std::end(kBlockOwnKeys));
+        block_keys.insert(block_keys.end(), std::begin(kConditionKeys), std::end(kConditionKeys));
+
+        std::map<std::string, int> block_lines;
+        std::map<std::string, int> condition_lines;
+        const toml::array& arr = *blocks->as_array();
+        for (std::size_t bi = 0; bi < arr.size(); ++bi) {
+            const toml::table& bt = *arr.get(bi)->as_table();
+            const std::string bpath = fmt::format("block[{}]", bi);
+            Section bs(doc_, bt, bpath, fmt::format("[[block]] {}", bi));
+            bs.allow(block_keys);
+            Block b;
+            b.line = bs.line();
+            b.name = bs.string("name").value_or(fmt::format("block{}", bi));
+            if (b.name.empty()) bs.fail("name", "name must not be empty.");
+            if (auto [it, inserted] = block_lines.emplace(b.name, b.line); !inserted)
+                bs.fail("name", fmt::format("a block called \"{}\" already exists (line {}).", b.name, it->second));
+            b.adaptation_s = bs.number("adaptation_s").value_or(adaptation_s_);
+            bs.at_least("adaptation_s", b.adaptation_s, 0.0);
+            b.repetitions = bs.integer("repetitions", 1, 1000).value_or(1);
+            if (auto s = bs.string("interleave")) {
+                try {
+                    b.interleave = parse_interleave_order(*s);
+                } catch (const ProcedureError& e) {
+                    bs.fail("interleave", fmt::format("interleave {}.", e.message()));
+                }
+            }
+            b.instructions = bs.string("instructions").value_or("");
+
+            const toml::node* conds = bs.get("condition");
+            if (conds == nullptr)
+                doc_.fail_at_line(b.line, bs.key_path("condition"),
+                                  fmt::format("block \"{}\" (line {}) has no [[block.condition]], which is required "
+                                              "(at least one condition).",
+                                              b.name, b.line));
+            if (!conds->is_array_of_tables())
+                doc_.fail(conds, bs.key_path("condition"),
+                          fmt::format("expected an array of tables [[block.condition]], got {}.",
+                                      detail::type_phrase(conds->type())));
+            const toml::array& carr = *conds->as_array();
+            for (std::size_t ci = 0; ci < carr.size(); ++ci) {
+                const toml::table& ct = *carr.get(ci)->as_table();
+                const std::string cpath = fmt::format("{}.condition[{}]", bpath, ci);
+                Section cs(doc_, ct, cpath, fmt::format("[[block.condition]] {} of block \"{}\"", ci, b.name));
+                std::vector<std::string_view> ckeys(std::begin(kConditionKeys), std::end(kConditionKeys));
+                ckeys.push_back("name");
+                cs.allow(ckeys);
+                std::string name = cs.string("name").value_or(fmt::format("{}-c{}", b.name, ci));
+                if (name.empty()) cs.fail("name", "name must not be empty.");
+                if (auto [it, inserted] = condition_lines.emplace(name, cs.line()); !inserted)
+                    cs.fail("name",
+                            fmt::format("a condition called \"{}\" already exists (line {}); condition names are "
+                                        "unique in the protocol.",
+                                        name, it->second));
+                ConditionReader cr(doc_, {Layer{defaults, "defaults"}, Layer{&bt, bpath}, Layer{&ct, cpath}}, name,
+                                   cs.line());
+                b.conditions.push_back(read_condition(cr, name, cs.line()));
+            }
+            p.blocks.push_back(std::move(b));
+        }
+    }
+
+    Condition read_condition(const ConditionReader& r, std::string name, int line) {
+        Condition c;
+        c.name = std::move(name);
+        c.line = line;
+
+        const auto task = r.choice<Task>("task", parse_task, kTaskNames);
+        if (!task) r.missing("task", "\"2afc\", \"yes-no\" or \"adjust\"");
+        c.task = *task;
+
+        c.presentation = c.task == Task::YesNo ? Presentation::Single : Presentation::TwoInterval;
+        if (auto v = r.choice<Presentation>("presentation", parse_presentation, kPresentationNames)) {
+            c.presentation = *v;
+            const bool single = *v == Presentation::Single;
+            if (single != (c.task == Task::YesNo))
+                r.fail(*r.find("presentation"),
+                       c.task == Task::YesNo
+                           ? fmt::format("a yes-no task shows one stimulus: presentation must be \"single\", got "
+                                         "\"{}\".",
+                                         to_string(*v))
+                           : fmt::format("a {} task compares two stimuli: presentation must be \"two-interval\" or "
+                                         "\"side-by-side\", got \"single\".",
+                                         to_string(c.task)));
+        }
+        c.prompt = r.string("prompt").value_or("");
+
+        for (const Found& f : r.find_all("set")) append(c.set, doc_.scene_overrides(f.node, f.key, r.context()));
+        for (const Found& f : r.find_all("test_set"))
+            append(c.test_set, doc_.scene_overrides(f.node, f.key, r.context()));
+        for (const Found& f : r.find_all("reference_set")) {
+            if (c.presentation == Presentation::Single)
+                r.fail(f,
+                       "a single presentation has no reference: reference_set is not used; put the overrides in "
+                       "set or test_set.");
+            append(c.reference_set, doc_.scene_overrides(f.node, f.key, r.context()));
+        }
+
+        const auto level_key = r.find("level_key");
+        if (!level_key)
+            r.missing("level_key", "the scene key the procedure's level sets, e.g. \"light.reference.intensity_cd\"");
+        c.level_key = doc_.scene_key(level_key->node, level_key->key, r.context());
+        c.level_scale = r.choice<LevelScale>("level_scale", parse_level_scale, kScaleNames).value_or(LevelScale::Log10);
+
+        c.level_on = c.task == Task::YesNo ? Role::Test : Role::Reference;
+        if (auto v = r.choice<Role>("level_on", parse_role, kRoleNames)) {
+            if (c.task == Task::YesNo && *v == Role::Reference)
+                r.fail(*r.find("level_on"), "a yes-no task shows the test alone: level_on must be \"test\".");
+            c.level_on = *v;
+        }
+        c.choice = c.level_on == Role::Reference ? ChoiceMapping::ChoseReference : ChoiceMapping::ChoseTest;
+        if (auto f = r.find("choice")) {
+            if (c.task != Task::TwoAfc)
+                r.fail(*f, fmt::format("choice applies to the 2afc task only, not to \"{}\".", to_string(c.task)));
+            const std::string text = doc_.string(f->node, f->key, r.context());
+            try {
+                c.choice = parse_choice_mapping(text);
+            } catch (const ProcedureError& e) {
+                r.fail(*f, fmt::format("choice {}.", strip_period(e.message())));
+            }
+        }
+
+        c.test_light = r.string("test_light").value_or("");
+        c.reference_light = r.string("reference_light").value_or("");
+        if (auto f = r.find("left_position_m"))
+            c.left_position_m = doc_.vec3(f->node, f->key, "left_position_m", r.context());
+        if (auto f = r.find("right_position_m"))
+            c.right_position_m = doc_.vec3(f->node, f->key, "right_position_m", r.context());
+        if (c.presentation == Presentation::SideBySide) {
+            const std::string_view what = "side-by-side needs both lights and both positions";
+            if (c.test_light.empty()) r.missing("test_light", what);
+            if (c.reference_light.empty()) r.missing("reference_light", what);
+            if (c.test_light == c.reference_light)
+                r.fail(*r.find("reference_light"),
+                       fmt::format("side-by-side needs two different lights, got \"{}\" twice.", c.test_light));
+            if (!c.left_position_m) r.missing("left_position_m", what);
+            if (!c.right_position_m) r.missing("right_position_m", what);
+        } else {
+            for (std::string_view k : {"left_position_m", "right_position_m"})
+                if (auto f = r.find(k))
+                    r.fail(*f, fmt::format("{} is used by presentation = \"side-by-side\" only, not \"{}\".", k,
+                                           to_string(c.presentation)));
+        }
+
+        // The procedure.
+        const std::vector<Found> tables = r.find_all("procedure");
+        if (tables.empty())
+            r.missing("procedure",
+                      "a table with kind = \"staircase\", \"weighted-staircase\", \"quest\", "
+                      "\"adjustment\" or \"constant-stimuli\" and its parameters");
+        ProcedureReader pr(doc_, r);
+        pr.merge(tables);
+        if (!pr.kind())
+            doc_.fail(pr.table()->node, pr.table()->key + ".kind",
+                      r.context() + fmt::format("the procedure has no kind: give kind = one of {}.",
+                                                detail::join_quoted(kKindNames)));
+        const bool adjustment = *pr.kind() == ProcedureKind::Adjustment;
+        if (adjustment != (c.task == Task::Adjust))
+            r.fail(
+                *pr.kind_at(),
+                adjustment
+                    ? fmt::format("the adjustment procedure needs task = \"adjust\", not \"{}\".", to_string(c.task))
+                    : fmt::format("task = \"adjust\" needs kind = \"adjustment\", not \"{}\".", to_string(*pr.kind())));
+        if (*pr.kind() == ProcedureKind::Quest && c.level_scale != LevelScale::Log10) {
+            const auto f = r.find("level_scale");
+            r.fail(*f,
+                   "QUEST works in log10 units (its Weibull is a function of log intensity): level_scale must be "
+                   "\"log10\".");
+        }
+        try {
+            c.procedure = read_procedure(pr);
+            for (std::size_t t = 0; t < c.procedure.tracks(); ++t) (void)make_track(c, t, 0);
+        } catch (const ProcedureError& e) {
+            pr.fail(e.parameter(), fmt::format("{} {}.", e.parameter(), strip_period(e.message())));
+        }
+        return c;
+    }
+
+    static void append(std::vector<Override>& to, std::vector<Override> from) {
+        to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
+    }
+
+    static constexpr std::string_view kTaskNames[] = {"2afc", "yes-no", "adjust"};
+    static constexpr std::string_view kPresentationNames[] = {"single", "two-interval", "side-by-side"};
+    static constexpr std::string_view kScaleNames[] = {"log10", "linear"};
+    static constexpr std::string_view kRoleNames[] = {"test", "reference"};
+
+    Document doc_;
+    toml::table root_;
+    double adaptation_s_ = 0.0;
+};
+
+std::string read_text(const std::filesystem::path& file) {
+    std::FILE* f = std::fopen(file.c_str(), "rb");
+    if (f == nullptr)
+        throw ProtocolError(file.string(), 0, 0, "",
+                            fmt::format("cannot read the protocol file: {}.",
+                                        std::error_code(errno, std::generic_category()).message()));
+    std::string text;
+    char buffer[65536];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
+    const bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) throw ProtocolError(file.string(), 0, 0, "", "cannot read the protocol file: a read error occurred.");
+    return text;
+}
+
+}  // namespace
+
+Protocol load_protocol(const std::filesystem::path& file) {
+    const std::string text = read_text(file);
+    return Parser(file.string()).parse(text, true);
+}
+
+Protocol parse_protocol(std::string_view toml_text, std::string_view file_name) {
+    return Parser(std::string(file_name)).parse(toml_text, false);
+}
+
+}  // namespace atonlab::protocols
