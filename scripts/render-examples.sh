@@ -20,6 +20,14 @@ for scene in scenes/*.toml; do
         "$atonlab" render "$scene" --set "camera.position_m=$pos" --set "camera.yaw_deg=$((10#$b))" \
           -o "out/${name}-bearing${b}.exr" --png "out/${name}-bearing${b}.png"
       done ;;
+    tonemap-four-lights)
+      # K2012 fig 6.20-6.24: adaptation levels (cd/m²) x tone mappers.
+      for level in 0.001 0.0051 0.016 0.03 0.15 24 1570; do
+        for op in empirical perceptual; do
+          "$atonlab" render "$scene" --set "environment.luminance_cd_m2=$level" --set "eye.adaptation_cd_m2=$level" \
+            --set "tonemap.operator=\"$op\"" -o "out/${name}-${level}-${op}.exr" --png "out/${name}-${level}-${op}.png"
+        done
+      done ;;
     *)
       "$atonlab" render "$scene" -o "out/${name}.exr" --png "out/${name}.png"
       # The energy-matched no-glare variant of the same frame.
