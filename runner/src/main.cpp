@@ -1,6 +1,7 @@
 // atonlab: one binary, subcommands (DESIGN.md "Command line").
 // Bad input: one sentence on stderr naming file, line and key; exit status 2.
 // No usable GL: one sentence saying why; exit status 3.
+// `atonlab run`: the study file failed (StoreError): exit status 4 (run_command.cpp).
 #include <cstdio>
 #include <exception>
 
@@ -18,6 +19,8 @@ int main(int argc, char** argv) {
     atonlab::runner::add_render_command(app, render);
     atonlab::runner::PsfOptions psf;
     atonlab::runner::add_psf_command(app, psf);
+    atonlab::runner::RunOptions run;
+    atonlab::runner::add_run_command(app, run);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -26,6 +29,7 @@ int main(int argc, char** argv) {
     try {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);
         if (app.got_subcommand("psf")) return atonlab::runner::run_psf(psf);
+        if (app.got_subcommand("run")) return atonlab::runner::run_run(run);
     } catch (const atonlab::InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;

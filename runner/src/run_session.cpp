@@ -1,0 +1,1310 @@
+// The engine of `atonlab run` (run_session.h; docs/running.md).
+#include "run_session.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <system_error>
+#include <type_traits>
+#include <variant>
+
+#include "atonlab/protocols/protocol_file.h"
+#include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/protocols/rng.h"
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/gl/context.h"
+#include "atonlab/stimuli/rhythm.h"
+#include "atonlab/stimuli/scene_file.h"
+#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/store/sha256.h"
+#include "atonlab/store/store.h"
+
+namespace atonlab::runner {
+
+namespace p = atonlab::protocols;
+namespace s = atonlab::stimuli;
+namespace st = atonlab::store;
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// SIGINT / SIGTERM: a flag checked between trials. The trial being shown is
+// finished and committed; then the session is marked "quit".
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int signal_number) {
+    g_stop_signal = signal_number;
+}
+
+class StopSignals {
+public:
+    StopSignals() {
+        g_stop_signal = 0;
+        struct sigaction sa {};
+        sa.sa_handler = on_stop_signal;
+        sa.sa_flags = SA_RESTART;  // a write or fsync of the study file is not cut short
+        sigemptyset(&sa.sa_mask);
+        sigaction(SIGINT, &sa, &old_int_);
+        sigaction(SIGTERM, &sa, &old_term_);
+    }
+    ~StopSignals() { restore(); }
+    StopSignals(const StopSignals&) = delete;
+    StopSignals& operator=(const StopSignals&) = delete;
+    /// Back to what was there (after the last trial, a signal ends the summary at once).
+    void restore() {
+        if (restored_) return;
+        sigaction(SIGINT, &old_int_, nullptr);
+        sigaction(SIGTERM, &old_term_, nullptr);
+        restored_ = true;
+    }
+
+private:
+    struct sigaction old_int_ {};
+    struct sigaction old_term_ {};
+    bool restored_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// Small helpers
+
+std::string json_string(std::string_view text) {
+    std::string out = "\"";
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        switch (ch) {
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\r':
+                out += "\\r";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
+            default:
+                if (c < 0x20)
+                    out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+                else
+                    out += ch;
+        }
+    }
+    return out + "\"";
+}
+
+/// Shortest round-trip text of a finite double (JSON has no NaN or infinity: null then).
+std::string json_number(double v) {
+    return std::isfinite(v) ? fmt::format("{}", v) : std::string("null");
+}
+
+std::string read_text(const std::filesystem::path& file, std::string_view what) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(SourceLocation{file.string(), 0, 0, ""}, fmt::format("cannot read the {}.", what));
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+InputError input_error(const p::ProtocolError& e) {
+    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
+}
+
+/// The store's response codes: the action words of docs/protocol-file.md.
+std::string_view response_word(p::Response r) {
+    switch (r) {
+        case p::Response::No:
+            return "no";
+        case p::Response::Yes:
+            return "yes";
+        case p::Response::Left:
+            return "left";
+        case p::Response::Right:
+            return "right";
+        case p::Response::CoarseUp:
+            return "coarse_up";
+        case p::Response::CoarseDown:
+            return "coarse_down";
+        case p::Response::FineUp:
+            return "fine_up";
+        case p::Response::FineDown:
+            return "fine_down";
+        case p::Response::Confirm:
+            return "confirm";
+    }
+    return "?";
+}
+
+std::optional<p::Response> response_from_word(std::string_view w) {
+    for (const p::Response r :
+         {p::Response::No, p::Response::Yes, p::Response::Left, p::Response::Right, p::Response::CoarseUp,
+          p::Response::CoarseDown, p::Response::FineUp, p::Response::FineDown, p::Response::Confirm})
+        if (response_word(r) == w) return r;
+    return std::nullopt;
+}
+
+bool valid_observer_code(std::string_view code) {
+    if (code.empty() || code.size() > 32) return false;
+    return std::all_of(code.begin(), code.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    });
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string clock_text(double seconds) {
+    const auto total = static_cast<long long>(std::llround(std::max(0.0, seconds)));
+    if (total >= 3600) return fmt::format("{}:{:02}:{:02}", total / 3600, total / 60 % 60, total % 60);
+    return fmt::format("{}:{:02}", total / 60, total % 60);
+}
+
+/// How long a trial's stimulus is on the screen: one interval, or two with the blank between (s).
+double presentation_s(const p::Protocol& protocol, const p::Condition& condition) {
+    const p::Timing& t = protocol.timing;
+    return condition.presentation == p::Presentation::TwoInterval ? 2.0 * t.stimulus_s + t.inter_stimulus_s
+                                                                  : t.stimulus_s;
+}
+
+/// The lights judged in frame `f` of a stimulus, in view order.
+std::vector<std::string> judged_lights(const p::Stimulus& stimulus, std::size_t f) {
+    std::vector<std::string> lights;
+    for (const p::StimulusView& v : stimulus.views)
+        if (v.frame == f) lights.push_back(v.light);
+    return lights;
+}
+
+const s::Light* find_light(const s::Scene& scene, std::string_view name) {
+    for (const s::Light& l : scene.lights)
+        if (l.name == name) return &l;
+    return nullptr;
+}
+
+/// The moment within [0, interval_s] at which the judged lights are brightest
+/// (their rhythms' summed level), so that a model observer looking at one
+/// frame sees, e.g., the flash that the interval holds. Rhythms are piecewise
+/// linear between knots: the levels at the midpoints between consecutive knot
+/// times pick a plateau's middle, away from the edges where the GPU's
+/// tabulated rhythm and the CPU's could disagree. All fixed: 0.
+double brightest_moment_s(const s::Scene& scene, const std::vector<std::string>& lights, double interval_s) {
+    std::vector<const s::Light*> judged;
+    for (const std::string& name : lights)
+        if (const s::Light* l = find_light(scene, name); l && l->rhythm_period_s > 0) judged.push_back(l);
+    if (judged.empty() || !(interval_s > 0)) return 0.0;
+    std::vector<double> cuts{0.0, interval_s};
+    for (const s::Light* l : judged) {
+        const double period = l->rhythm_period_s;
+        for (const s::RhythmKnot& k : l->rhythm) {
+            double t = k.t_s - l->rhythm_phase_s;
+            t -= std::floor(t / period) * period;
+            for (int n = 0; t <= interval_s && n < 100000; t += period, ++n) cuts.push_back(t);
+        }
+    }
+    std::sort(cuts.begin(), cuts.end());
+    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    double best_t = 0.0;
+    double best = -1.0;
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+        const double t = 0.5 * (cuts[i] + cuts[i + 1]);
+        double level = 0.0;
+        for (const s::Light* l : judged) level += s::rhythm_level(l->rhythm, l->rhythm_period_s, t + l->rhythm_phase_s);
+        if (level > best) {
+            best = level;
+            best_t = t;
+        }
+    }
+    return best_t;
+}
+
+std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lights) {
+    std::string key;
+    for (const std::string& o : frame.overrides) (key += o) += '\n';
+    key += '\x1f';
+    for (const std::string& l : lights) (key += l) += '\n';
+    return key;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// StimulusRenderer
+
+StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
+                                   double interval_s, std::size_t cache_frames)
+    : scene_text_(std::move(scene_text)),
+      scene_file_(std::move(scene_file)),
+      window_radius_deg_(window_radius_deg),
+      interval_s_(interval_s),
+      capacity_(std::max<std::size_t>(cache_frames, 1)) {}
+
+s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
+    std::vector<s::SceneOverride> parsed;
+    parsed.reserve(overrides.size());
+    for (const std::string& o : overrides) parsed.push_back(s::SceneOverride::parse(o));
+    s::Scene scene = s::parse_scene(scene_text_, scene_file_.string(), parsed);
+    s::validate_output_settings(scene.output);
+    return scene;
+}
+
+std::shared_ptr<const FrameViews> StimulusRenderer::views(const p::Frame& frame,
+                                                          const std::vector<std::string>& lights) {
+    ++requested_;
+    const std::string key = cache_key(frame, lights);
+    if (auto it = index_.find(key); it != index_.end()) {
+        lru_.splice(lru_.begin(), lru_, it->second);
+        return it->second->second;
+    }
+    return render(frame, lights, nullptr, nullptr);
+}
+
+s::ImageRGBA32F StimulusRenderer::hdr(const p::Frame& frame, const std::vector<std::string>& lights,
+                                      double& degrees_per_pixel) {
+    s::ImageRGBA32F image;
+    render(frame, lights, &image, &degrees_per_pixel);
+    return image;
+}
+
+void StimulusRenderer::remember(const std::string& key, std::shared_ptr<const FrameViews> views) {
+    if (auto it = index_.find(key); it != index_.end()) {
+        it->second->second = std::move(views);
+        lru_.splice(lru_.begin(), lru_, it->second);
+        return;
+    }
+    lru_.emplace_front(key, std::move(views));
+    index_[key] = lru_.begin();
+    while (lru_.size() > capacity_) {
+        index_.erase(lru_.back().first);
+        lru_.pop_back();
+    }
+}
+
+std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
+                                                           const std::vector<std::string>& lights, s::ImageRGBA32F* hdr,
+                                                           double* degrees_per_pixel) {
+    const auto started = std::chrono::steady_clock::now();
+    const s::Scene sc = scene(frame.overrides);
+    auto out = std::make_shared<FrameViews>();
+    out->time_s = brightest_moment_s(sc, lights, interval_s_);
+
+    // stimuli::Pipeline::render, with two differences that make a frame a pure
+    // function of its overrides (so a cached frame, and a resumed session, see
+    // exactly what an uninterrupted run saw): each frame adapts afresh
+    // (reset_adaptation, dt = 0: a dynamic scene adopts its own log-average; a
+    // fixed one is unaffected), and the dither pattern is that of frame 0
+    // instead of advancing with the number of frames rendered so far.
+    frame_.render(sc, out->time_s);
+    const s::OutputSettings& os = sc.output;
+    display_.reset_adaptation();
+    if (const gl::Texture2D* glare = frame_.glare_texture();
+        glare && os.ldr_glare && sc.glare.model != s::GlareModel::none) {
+        const s::ToneMapSettings& tm = os.tonemap;
+        const double white = tm.white_cd_m2
+                                 ? *tm.white_cd_m2
+                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / s::display_adaptation_cd_m2(tm);
+        display_.process_ldr(frame_.hdr_texture(), *glare, os, 0, 1.0 / white);
+    } else {
+        display_.process(frame_.hdr_texture(), os, 0.0, 0);
+    }
+    ++rendered_;
+
+    const s::EncodedImage codes = display_.read_codes();
+    const std::vector<s::LightDrawRecord> draws = frame_.read_light_draws();
+    const s::CameraProjection& proj = frame_.projection();
+    const double dpp = proj.degrees_per_pixel_at_centre();
+    const int half = static_cast<int>(std::ceil(2.0 * window_radius_deg_ / dpp)) + 2;
+    const int n = 2 * half + 1;
+
+    // What the screen emits for each code triple: the display model's
+    // luminance (cd/m²), memoised per distinct code (a frame has few).
+    std::map<std::uint64_t, float> emitted;
+    auto luminance_at = [&](int x, int y) -> float {
+        const std::size_t i =
+            (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) * 3;
+        const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
+        const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
+                                (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
+        auto [it, fresh] = emitted.try_emplace(k, 0.0f);
+        if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(os.display, code, codes.bits));
+        return it->second;
+    };
+
+    for (const std::string& name : lights) {
+        // The light's centre in window coordinates (origin lower-left): the GPU's
+        // own projection when it drew the light, else the same pinhole on the CPU
+        // (a dark or culled light still has a place on the screen).
+        glm::dvec2 centre_win{0.5 * codes.width, 0.5 * codes.height};
+        bool behind = false;
+        if (!name.empty()) {
+            std::size_t index = sc.lights.size();
+            for (std::size_t i = 0; i < sc.lights.size() && index == sc.lights.size(); ++i)
+                if (sc.lights[i].name == name) index = i;
+            if (index < draws.size() && draws[index].area_px2 > 0) {
+                centre_win = draws[index].centre_px;
+            } else if (index < sc.lights.size()) {
+                const glm::dvec3 v = proj.view_from_world(sc.lights[index].position_m - proj.eye_position_m);
+                if (v.z < 0) {
+                    centre_win = glm::dvec2(0.5 * proj.width_px, 0.5 * proj.height_px) +
+                                 proj.focal_px * glm::dvec2(v.x, v.y) / -v.z;
+                } else {
+                    behind = true;
+                }
+            }
+        }
+        // Row 0 at the top, as the codes are.
+        const glm::dvec2 centre{centre_win.x, static_cast<double>(codes.height) - centre_win.y};
+        LightWindow w;
+        w.image.width = n;
+        w.image.height = n;
+        w.image.deg_per_px = dpp;
+        w.image.luminance_cd_m2.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
+        const int x0 = static_cast<int>(std::floor(centre.x)) - half;
+        const int y0 = static_cast<int>(std::floor(centre.y)) - half;
+        w.light_px = centre - glm::dvec2(x0, y0);
+        if (!behind && std::isfinite(centre.x) && std::isfinite(centre.y)) {
+            for (int v = 0; v < n; ++v) {
+                const int y = y0 + v;
+                if (y < 0 || y >= codes.height) continue;
+                for (int u = 0; u < n; ++u) {
+                    const int x = x0 + u;
+                    if (x < 0 || x >= codes.width) continue;
+                    w.image.luminance_cd_m2[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) +
+                                            static_cast<std::size_t>(u)] = luminance_at(x, y);
+                }
+            }
+        }
+        out->windows.push_back(std::move(w));
+    }
+    if (hdr) *hdr = frame_.read_hdr();
+    if (degrees_per_pixel) *degrees_per_pixel = dpp;
+    remember(cache_key(frame, lights), out);
+    render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return out;
+}
+
+// ---------------------------------------------------------------------------
+// The session
+
+namespace {
+
+/// Where an override a frame applies was written in the protocol.
+struct OverrideSource {
+    int line = 0;
+    int column = 0;
+};
+
+/// `text` is the frame's override the scene refused ("key=value"; the last of
+/// its key: the scene loader validates the value each key ends with).
+OverrideSource override_source(const p::Condition& c, const std::string& key, const std::string& text) {
+    for (const auto* list : {&c.reference_set, &c.test_set, &c.set})
+        for (auto it = list->rbegin(); it != list->rend(); ++it)
+            if ((text.empty() ? it->key == key : it->text() == text) && it->line > 0) return {it->line, it->column};
+    // The level, the display or a side-by-side position: the condition's own line.
+    return {c.line, 0};
+}
+
+/// The scene of one of a condition's frames, with an error in an override
+/// re-thrown at the protocol's line that wrote it (the condition named).
+s::Scene condition_scene(const std::string& scene_text, const std::filesystem::path& scene_file,
+                         const p::Protocol& protocol, const p::Condition& condition, const p::Frame& frame) {
+    try {
+        std::vector<s::SceneOverride> parsed;
+        for (const std::string& o : frame.overrides) parsed.push_back(s::SceneOverride::parse(o));
+        s::Scene scene = s::parse_scene(scene_text, scene_file.string(), parsed);
+        s::validate_output_settings(scene.output);
+        return scene;
+    } catch (const InputError& e) {
+        const std::optional<SourceLocation>& w = e.where();
+        const bool from_override = w && w->file.rfind("--set", 0) == 0;
+        if (!from_override) {
+            // The scene file's own error (it names its file and line), or a
+            // setting that only the combination of overrides breaks.
+            if (w && !w->file.empty() && w->file != scene_file.string()) throw;
+            throw InputError(SourceLocation{protocol.file, condition.line, 0, w ? w->key : std::string()},
+                             fmt::format("in condition \"{}\", the scene {} with this condition's overrides is "
+                                         "refused: {}",
+                                         condition.name, scene_file.filename().string(), e.message()));
+        }
+        // "--set KEY" (a value) or "--set" with the key: the override's key.
+        std::string key = w->file.size() > 6 ? w->file.substr(6) : w->key;
+        std::string text;
+        for (const std::string& o : frame.overrides)
+            if (o.compare(0, key.size() + 1, key + "=") == 0) text = o;
+        const OverrideSource src = override_source(condition, key, text);
+        throw InputError(SourceLocation{protocol.file, src.line, src.column, key},
+                         fmt::format("in condition \"{}\" (line {}), the scene override '{}' is refused by the scene "
+                                     "{}: {}",
+                                     condition.name, condition.line, text.empty() ? key : text,
+                                     scene_file.filename().string(), e.message()));
+    }
+}
+
+/// The levels a procedure says it stays within: its min_level and max_level
+/// where given (constant stimuli: its lowest and highest level).
+std::vector<double> level_bounds(const p::ProcedureSpec& spec) {
+    return std::visit(
+        [](const auto& params) -> std::vector<double> {
+            using T = std::decay_t<decltype(params)>;
+            std::vector<double> out;
+            if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
+                if (!params.levels.empty()) {
+                    const auto [lo, hi] = std::minmax_element(params.levels.begin(), params.levels.end());
+                    out = {*lo, *hi};
+                }
+            } else {
+                if (params.min_level) out.push_back(*params.min_level);
+                if (params.max_level) out.push_back(*params.max_level);
+            }
+            return out;
+        },
+        spec.params);
+}
+
+/// Every frame of one proposal through the scene loader, and the judged lights exist.
+void check_stimulus(const p::Protocol& protocol, const std::string& scene_text, const std::filesystem::path& scene_file,
+                    const p::Condition& c, const p::Proposal& proposal) {
+    const p::Stimulus stim = p::make_stimulus(protocol, c, proposal);
+    for (std::size_t f = 0; f < stim.frames.size(); ++f) {
+        const s::Scene scene = condition_scene(scene_text, scene_file, protocol, c, stim.frames[f]);
+        for (const p::StimulusView& v : stim.views) {
+            if (v.frame != f || v.light.empty() || find_light(scene, v.light)) continue;
+            std::string names;
+            for (const s::Light& l : scene.lights) names += (names.empty() ? "\"" : ", \"") + l.name + "\"";
+            throw InputError(
+                SourceLocation{protocol.file, c.line, 0, v.role == p::Role::Test ? "test_light" : "reference_light"},
+                fmt::format("in condition \"{}\", the {} light \"{}\" is not a light of the scene {} (its lights: {}).",
+                            c.name, p::to_string(v.role), v.light, scene_file.filename().string(),
+                            names.empty() ? "none" : names));
+        }
+    }
+}
+
+/// Load-time checks of every condition: each frame's scene for a proposal at
+/// the procedure's first level and at its level bounds where it has them
+/// (2AFC: in both orders), and the judged lights exist.
+void validate_conditions(const p::Protocol& protocol, const std::string& scene_text,
+                         const std::filesystem::path& scene_file) {
+    for (const p::Block& block : protocol.blocks) {
+        for (const p::Condition& c : block.conditions) {
+            std::unique_ptr<p::Procedure> proc;
+            try {
+                proc = p::make_procedure(c, 0);
+            } catch (const p::ProcedureError& e) {
+                throw InputError(SourceLocation{protocol.file, c.line, 0, e.parameter()},
+                                 fmt::format("in condition \"{}\", {}", c.name, e.message()));
+            }
+            const std::optional<p::Proposal> first = proc->next();
+            if (!first) continue;
+            std::vector<double> levels{first->level};
+            for (const double b : level_bounds(c.procedure)) levels.push_back(b);
+            p::Proposal proposal = *first;
+            for (const double level : levels) {
+                proposal.level = level;
+                if (c.task != p::Task::TwoAfc) {
+                    check_stimulus(protocol, scene_text, scene_file, c, proposal);
+                    continue;
+                }
+                for (const bool left : {true, false}) {
+                    proposal.test_on_left = left;
+                    check_stimulus(protocol, scene_text, scene_file, c, proposal);
+                }
+            }
+        }
+    }
+}
+
+/// The most trials each track can take, summed over the session; nullopt when
+/// a procedure has no upper bound (staircases without max_trials, adjustment).
+std::optional<std::size_t> trial_bound(const p::Protocol& protocol, const p::Schedule& schedule) {
+    std::size_t total = 0;
+    for (const p::BlockRun& run : schedule.block_runs()) {
+        for (const p::Condition& c : protocol.blocks[run.block].conditions) {
+            const std::optional<std::size_t> per_track = std::visit(
+                [](const auto& params) -> std::optional<std::size_t> {
+                    using T = std::decay_t<decltype(params)>;
+                    if constexpr (std::is_same_v<T, p::StaircaseParams> ||
+                                  std::is_same_v<T, p::WeightedStaircaseParams>) {
+                        if (params.max_trials) return static_cast<std::size_t>(*params.max_trials);
+                        return std::nullopt;
+                    } else if constexpr (std::is_same_v<T, p::QuestParams>) {
+                        return static_cast<std::size_t>(params.n_trials);
+                    } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
+                        return params.levels.size() * static_cast<std::size_t>(params.repetitions);
+                    } else {
+                        return std::nullopt;
+                    }
+                },
+                c.procedure.params);
+            if (!per_track) return std::nullopt;
+            total += *per_track * c.procedure.tracks();
+        }
+    }
+    return total;
+}
+
+// --- The observer ------------------------------------------------------------
+
+/// A model observer's answers are a pure function of (observer seed, the
+/// trial's first step, what it was shown): each trial (each adjustment match)
+/// gets a fresh ModelObserver seeded derive_seed(observer_seed, step), so a
+/// resumed session answers exactly as an uninterrupted one would have.
+class SessionObserver {
+public:
+    SessionObserver(const RunOptions& o, std::uint64_t observer_seed, std::optional<p::ScriptedObserver> script)
+        : model_(o.model_observer), seed_(observer_seed), script_(std::move(script)) {}
+
+    bool model() const noexcept { return model_; }
+    std::uint64_t seed() const noexcept { return seed_; }
+    const p::ModelObserverParams& params() const noexcept { return params_; }
+
+    /// The answer to trial `t`. Renders what the model observer looks at.
+    p::Answer answer(const p::ScheduledTrial& t, StimulusRenderer* renderer) {
+        if (!model_) return script_->answer(p::Shown{t.task, {}, t.stimulus.adjusted_view});
+        const std::string match = fmt::format("{}#{}", t.procedure_id, t.proposal.trial);
+        if (!current_ || t.task != p::Task::Adjust || match != match_) {
+            current_ = std::make_unique<p::ModelObserver>(params_, p::derive_seed(seed_, t.step));
+            match_ = match;
+        }
+        std::vector<std::shared_ptr<const FrameViews>> frames(t.stimulus.frames.size());
+        p::Shown shown;
+        shown.task = t.task;
+        shown.adjusted_view = t.stimulus.adjusted_view;
+        for (std::size_t f = 0; f < frames.size(); ++f)
+            frames[f] = renderer->views(t.stimulus.frames[f], judged_lights(t.stimulus, f));
+        std::vector<std::size_t> seen(frames.size(), 0);
+        for (const p::StimulusView& v : t.stimulus.views) {
+            const LightWindow& w = frames[v.frame]->windows[seen[v.frame]++];
+            shown.views.push_back(p::View{&w.image, w.light_px});
+        }
+        return current_->answer(shown);
+    }
+
+    /// A scripted observer skips the lines the logged trials used.
+    void skip(p::Task task, std::optional<std::size_t> adjusted_view) {
+        if (script_) script_->answer(p::Shown{task, {}, adjusted_view});
+    }
+
+private:
+    bool model_;
+    std::uint64_t seed_;
+    p::ModelObserverParams params_{};
+    std::optional<p::ScriptedObserver> script_;
+    std::unique_ptr<p::ModelObserver> current_;
+    std::string match_;
+};
+
+// --- Progress ----------------------------------------------------------------
+
+class Progress {
+public:
+    Progress(bool quiet, int every, std::optional<std::size_t> bound)
+        : quiet_(quiet),
+          tty_(isatty(STDOUT_FILENO) == 1),
+          every_(every > 0 ? every : 25),
+          bound_(bound),
+          start_(std::chrono::steady_clock::now()) {}
+
+    void block(const p::Protocol& protocol, const p::ScheduledTrial& t, std::size_t runs) {
+        if (quiet_) return;
+        end_line();
+        const p::Block& b = protocol.blocks[t.block];
+        std::printf("block \"%s\" (run %zu of %zu, repetition %d of %d): adaptation %s simulated\n", b.name.c_str(),
+                    t.run + 1, runs, t.repetition + 1, b.repetitions, clock_text(b.adaptation_s).c_str());
+        std::fflush(stdout);
+    }
+
+    /// After trial `committed` (1-based count of the session's stored trials) is stored.
+    void trial(const p::Protocol& protocol, const p::ScheduledTrial& t, std::size_t committed) {
+        ++done_here_;
+        if (quiet_) return;
+        const double elapsed = seconds();
+        std::string line = fmt::format("{} · trial {}", protocol.blocks[t.block].name, committed);
+        if (bound_) line += fmt::format(" of ≤ {}", *bound_);
+        line += fmt::format(" · {} elapsed", clock_text(elapsed));
+        if (bound_ && done_here_ > 0 && *bound_ > committed)
+            line += fmt::format(" · ETA ≤ {}", clock_text(elapsed / static_cast<double>(done_here_) *
+                                                          static_cast<double>(*bound_ - committed)));
+        if (tty_) {
+            std::printf("\r\x1b[K%s", line.c_str());
+            open_line_ = true;
+        } else if (committed % static_cast<std::size_t>(every_) == 0) {
+            std::printf("%s\n", line.c_str());
+        }
+        std::fflush(stdout);
+    }
+
+    void end_line() {
+        if (open_line_) std::printf("\n");
+        open_line_ = false;
+    }
+    double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+    std::size_t done_here() const noexcept { return done_here_; }
+
+private:
+    bool quiet_;
+    bool tty_;
+    int every_;
+    std::optional<std::size_t> bound_;
+    std::chrono::steady_clock::time_point start_;
+    std::size_t done_here_ = 0;
+    bool open_line_ = false;
+};
+
+// --- Stored records ------------------------------------------------------------
+
+std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, const p::ScheduledTrial& t,
+                          const std::vector<double>& frame_times) {
+    const p::Stimulus& stim = t.stimulus;
+    std::string j = "{";
+    j += fmt::format("\"task\":{},\"presentation\":{},", json_string(p::to_string(c.task)),
+                     json_string(p::to_string(c.presentation)));
+    j += fmt::format("\"level_key\":{},\"level_scale\":{},\"level_on\":{},\"level\":{},\"scene_value\":{},",
+                     json_string(c.level_key), json_string(p::to_string(c.level_scale)),
+                     json_string(p::to_string(c.level_on)), json_number(stim.level), json_number(stim.scene_value));
+    j += fmt::format("\"scene\":{},", json_string(protocol.scene.string()));
+    j += "\"frames\":[";
+    for (std::size_t f = 0; f < stim.frames.size(); ++f) {
+        const p::Frame& fr = stim.frames[f];
+        if (f) j += ',';
+        j += fmt::format("{{\"role\":{},\"time_s\":{},\"overrides\":[",
+                         fr.role ? json_string(p::to_string(*fr.role)) : std::string("\"both\""),
+                         json_number(f < frame_times.size() ? frame_times[f] : 0.0));
+        for (std::size_t i = 0; i < fr.overrides.size(); ++i) j += (i ? "," : "") + json_string(fr.overrides[i]);
+        j += "]}";
+    }
+    j += "],\"views\":[";
+    for (std::size_t i = 0; i < stim.views.size(); ++i) {
+        const p::StimulusView& v = stim.views[i];
+        j += fmt::format("{}{{\"frame\":{},\"light\":{},\"role\":{}}}", i ? "," : "", v.frame, json_string(v.light),
+                         json_string(p::to_string(v.role)));
+    }
+    j += "]";
+    if (stim.adjusted_view) j += fmt::format(",\"adjusted_view\":{}", *stim.adjusted_view);
+    const p::Timing& tm = protocol.timing;
+    j += fmt::format(",\"timing\":{{\"stimulus_s\":{},\"inter_stimulus_s\":{},\"inter_trial_s\":{}}}",
+                     json_number(tm.stimulus_s), json_number(tm.inter_stimulus_s), json_number(tm.inter_trial_s));
+    return j + "}";
+}
+
+std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s) {
+    return fmt::format("{{\"schedule\":{},\"observer\":{},\"observer_seed\":{},\"answer_after_offset_s\":{}}}",
+                       json_string(schedule.state()), json_string(observer.model() ? "model" : "script"),
+                       observer.seed(), json_number(answer_rt_s));
+}
+
+/// The observer seed a session's first trial recorded, if any.
+std::optional<std::uint64_t> logged_observer_seed(const std::vector<st::TrialRecord>& trials) {
+    if (trials.empty()) return std::nullopt;
+    const std::string& j = trials.front().procedure_state_json;
+    const std::string tag = "\"observer_seed\":";
+    const auto at = j.find(tag);
+    if (at == std::string::npos) return std::nullopt;
+    std::size_t end = at + tag.size();
+    std::uint64_t v = 0;
+    bool any = false;
+    for (; end < j.size() && j[end] >= '0' && j[end] <= '9'; ++end) {
+        v = v * 10 + static_cast<std::uint64_t>(j[end] - '0');
+        any = true;
+    }
+    return any ? std::optional<std::uint64_t>(v) : std::nullopt;
+}
+
+/// The display the session shows on, as a calibration row: the scene's
+/// nominal display model (the geometry is the protocol's). Reused when the
+/// latest row of that display says the same.
+st::CalibrationId record_display(st::Store& store, const s::Scene& scene, const std::filesystem::path& scene_file) {
+    const s::DisplayModel& d = scene.output.display;
+    std::string channels;
+    for (const s::ChannelTransfer& ch : d.channels) {
+        const char* kind = ch.kind == s::TransferKind::srgb  ? "srgb"
+                           : ch.kind == s::TransferKind::gog ? "gog"
+                           : ch.kind == s::TransferKind::lut ? "lut"
+                                                             : "pq";
+        channels +=
+            fmt::format("{}{{\"transfer\":\"{}\",\"black_cd_m2\":{},\"white_cd_m2\":{}}}", channels.empty() ? "" : ",",
+                        kind, json_number(ch.min_cd_m2()), json_number(ch.max_cd_m2()));
+    }
+    st::Calibration c;
+    c.display_name = d.name.empty() ? "display" : d.name;
+    c.width_px = scene.display.width_px;
+    c.height_px = scene.display.height_px;
+    c.width_m = scene.display.width_m;
+    c.height_m = scene.display.height_m();
+    c.viewing_distance_m = scene.display.viewing_distance_m;
+    c.fit_json = fmt::format(
+        "{{\"model\":\"nominal\",\"peak_cd_m2\":{},\"black_cd_m2\":{},\"bits\":{},\"dither\":{},\"channels\":[{}]}}",
+        json_number(d.peak_cd_m2), json_number(d.black_cd_m2), scene.output.encode.bits,
+        scene.output.encode.dither == s::Dither::spatiotemporal ? "true" : "false", channels);
+    c.source = fmt::format("the [display] table of the scene {} (not measured)", scene_file.string());
+    if (const auto last = store.latest_calibration(c.display_name)) {
+        if (last->width_px == c.width_px && last->height_px == c.height_px && last->width_m == c.width_m &&
+            last->height_m == c.height_m && last->viewing_distance_m == c.viewing_distance_m &&
+            last->fit_json == c.fit_json && last->source == c.source)
+            return last->id;
+    }
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    gmtime_r(&now, &utc);
+    char date[16];
+    std::strftime(date, sizeof date, "%Y-%m-%d", &utc);
+    c.measured_at = date;
+    return store.put_calibration(c);
+}
+
+/// One EXR of the condition's first trial: its frames stacked top to bottom
+/// in presentation order, scene-referred (cd/m²), as the file's bytes.
+std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c,
+                                    const p::ScheduledTrial& t, std::int64_t session) {
+    s::ImageRGBA32F stacked;
+    double dpp = 0.0;
+    std::string frames_note;
+    for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
+        const s::ImageRGBA32F img = renderer.hdr(t.stimulus.frames[f], judged_lights(t.stimulus, f), dpp);
+        if (f == 0) {
+            stacked.width = img.width;
+        } else if (img.width != stacked.width) {
+            break;  // frames of different sizes (a condition overriding the display) are not stacked
+        }
+        frames_note +=
+            fmt::format("{}rows {}-{}: frame {} ({})", f ? "; " : "", stacked.height, stacked.height + img.height - 1,
+                        f, t.stimulus.frames[f].role ? p::to_string(*t.stimulus.frames[f].role) : "both");
+        stacked.height += img.height;
+        stacked.rgba.insert(stacked.rgba.end(), img.rgba.begin(), img.rgba.end());
+    }
+    s::ExrMetadata meta;
+    meta.units = "cd/m2";
+    meta.degrees_per_pixel = dpp;
+    meta.strings["software"] = "atonlab " ATONLAB_VERSION;
+    meta.strings["protocol"] = protocol.file;
+    meta.strings["condition"] = c.name;
+    meta.strings["frames"] = frames_note;
+    meta.strings["level"] = fmt::format("{} ({} = {})", t.stimulus.level, c.level_key, t.stimulus.scene_value);
+    const std::filesystem::path tmp =
+        std::filesystem::temp_directory_path() / fmt::format("atonlab-snapshot-{}-{}.exr", getpid(), session);
+    s::write_exr(tmp, stacked, meta);
+    std::string bytes;
+    try {
+        bytes = read_text(tmp, "snapshot");
+    } catch (...) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw;
+    }
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    std::vector<std::byte> out(bytes.size());
+    std::transform(bytes.begin(), bytes.end(), out.begin(), [](char ch) { return static_cast<std::byte>(ch); });
+    return out;
+}
+
+// --- Summary ----------------------------------------------------------------------
+
+/// The levels the true value is searched in: the procedure's bounds, or its starts ± 3 log10 units.
+std::pair<double, double> level_range(const p::ProcedureSpec& spec) {
+    return std::visit(
+        [&](const auto& params) -> std::pair<double, double> {
+            using T = std::decay_t<decltype(params)>;
+            if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
+                const auto [lo, hi] = std::minmax_element(params.levels.begin(), params.levels.end());
+                return {*lo - 1.0, *hi + 1.0};
+            } else if constexpr (std::is_same_v<T, p::AdjustmentParams>) {
+                return {params.min_level.value_or(params.start_min - 2.0),
+                        params.max_level.value_or(params.start_max + 2.0)};
+            } else {
+                double first = 0.0;
+                if constexpr (std::is_same_v<T, p::QuestParams>)
+                    first = params.t_guess;
+                else
+                    first = params.start;
+                double lo = first, hi = first;
+                for (const double v : spec.track_starts) {
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+                return {params.min_level.value_or(lo - 3.0), params.max_level.value_or(hi + 3.0)};
+            }
+        },
+        spec.params);
+}
+
+/// The P(Yes) a procedure converges on, when it has one.
+std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
+    return std::visit(
+        [](const auto& params) -> std::optional<double> {
+            using T = std::decay_t<decltype(params)>;
+            if constexpr (std::is_same_v<T, p::WeightedStaircaseParams>) {
+                return params.target;
+            } else if constexpr (std::is_same_v<T, p::StaircaseParams>) {
+                // Levitt 1971: 1-up/n-down converges on p^n = 0.5.
+                if (params.n_up == 1 && params.up_step_ratio == 1.0)
+                    return std::pow(0.5, 1.0 / static_cast<double>(params.n_down));
+                return std::nullopt;
+            } else if constexpr (std::is_same_v<T, p::QuestParams>) {
+                return params.p_threshold;
+            } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
+                return params.criterion;
+            } else {
+                return 0.5;
+            }
+        },
+        spec.params);
+}
+
+/// The model observer's true value for a condition: the level its procedure
+/// should converge on (2AFC and adjust: where the level stimulus is chosen
+/// with the procedure's target probability, 0.5 = the PSE; yes-no: the
+/// detection threshold at the target P(yes)). Renders the level stimulus at
+/// each level the root finder asks for.
+std::string true_value(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c,
+                       const p::ModelObserverParams& params, double& value) {
+    const std::optional<double> p_yes = target_p_yes(c.procedure);
+    if (!p_yes) return "no target probability for this procedure";
+    const auto [lo, hi] = level_range(c.procedure);
+    auto stimulus_at = [&](double level) {
+        p::Proposal proposal;
+        proposal.level = level;
+        if (c.task == p::Task::TwoAfc) proposal.test_on_left = true;
+        return p::make_stimulus(protocol, c, proposal);
+    };
+    // The window around view `i` of the stimulus at `level`. Levels are rounded
+    // to 0.001: the display's integer codes make the brightness a step function
+    // of the level, on which the root finder would otherwise bisect down to
+    // 1e-14 with a render per step; once its bracket is inside one 0.001 cell
+    // every further call is a cache hit. So the true value is resolved to
+    // ±0.001 (log10 units with level_scale = "log10").
+    auto window_at = [&](double level, std::size_t i) {
+        const p::Stimulus stim = stimulus_at(std::round(level * 1000.0) / 1000.0);
+        const std::vector<std::string> lights = judged_lights(stim, stim.views[i].frame);
+        std::size_t j = 0;
+        for (std::size_t k = 0; k < i; ++k) j += stim.views[k].frame == stim.views[i].frame ? 1 : 0;
+        return renderer.views(stim.frames[stim.views[i].frame], lights)->windows[j];
+    };
+    const double mid = 0.5 * (lo + hi);
+    // Where the model's brightness of the level stimulus stands against the
+    // other's (log10), to say why no crossing was found.
+    auto no_crossing = [&](const LightWindow& other, std::size_t view) {
+        const double r = params.window_radius_deg, e = params.exponent;
+        const double b_other = std::log10(p::brightness(other.image, other.light_px, r, e));
+        const LightWindow at_lo = window_at(lo, view), at_hi = window_at(hi, view);
+        const double d_lo = std::log10(p::brightness(at_lo.image, at_lo.light_px, r, e)) - b_other;
+        const double d_hi = std::log10(p::brightness(at_hi.image, at_hi.light_px, r, e)) - b_other;
+        return fmt::format(
+            "none in [{:.4g}, {:.4g}]: the level stimulus is {:+.3f} log10 brightness from the other "
+            "at {:.4g} and {:+.3f} at {:.4g}{}",
+            lo, hi, d_lo, lo, d_hi, hi,
+            std::abs(d_hi - d_lo) < 1e-6 ? " (unchanged by the level: the display clips it)" : "");
+    };
+    try {
+        if (c.task == p::Task::YesNo) {
+            const LightWindow w = window_at(mid, 0);
+            const LightWindow at_lo = window_at(lo, 0), at_hi = window_at(hi, 0);
+            if ((p::model_p_yes(params, p::View{&at_lo.image, at_lo.light_px}) - *p_yes) *
+                    (p::model_p_yes(params, p::View{&at_hi.image, at_hi.light_px}) - *p_yes) >
+                0)
+                return fmt::format("none in [{:.4g}, {:.4g}]: P(yes) does not cross {:.3f} there", lo, hi, *p_yes);
+            value = p::true_threshold([&](double level) { return window_at(level, 0).image; }, w.light_px, *p_yes, lo,
+                                      hi, params);
+            return {};
+        }
+        const p::Stimulus probe = stimulus_at(mid);
+        std::size_t level_view = probe.views.size(), other_view = probe.views.size();
+        for (std::size_t i = 0; i < probe.views.size(); ++i)
+            (probe.views[i].role == c.level_on ? level_view : other_view) = i;
+        if (level_view >= probe.views.size() || other_view >= probe.views.size())
+            return "the stimulus has no two views to compare";
+        // Yes means "chose the level stimulus" when the choice and level_on name the same role.
+        const bool yes_is_level = c.task == p::Task::Adjust || ((c.choice == p::ChoiceMapping::ChoseReference) ==
+                                                                (c.level_on == p::Role::Reference));
+        const double p_level = yes_is_level ? *p_yes : 1.0 - *p_yes;
+        const LightWindow level_w = window_at(mid, level_view);
+        const LightWindow other_w = window_at(mid, other_view);
+        {
+            const LightWindow at_lo = window_at(lo, level_view), at_hi = window_at(hi, level_view);
+            const double p_lo = p::model_p_first(params, p::View{&at_lo.image, at_lo.light_px},
+                                                 p::View{&other_w.image, other_w.light_px});
+            const double p_hi = p::model_p_first(params, p::View{&at_hi.image, at_hi.light_px},
+                                                 p::View{&other_w.image, other_w.light_px});
+            if ((p_lo - p_level) * (p_hi - p_level) > 0) return no_crossing(other_w, level_view);
+        }
+        value = p::true_matching_level([&](double level) { return window_at(level, level_view).image; },
+                                       level_w.light_px, other_w.image, other_w.light_px, p_level, lo, hi, params);
+        return {};
+    } catch (const std::exception& e) {
+        return fmt::format("not found in [{:.4g}, {:.4g}]: {}", lo, hi, e.what());
+    }
+}
+
+void print_summary(const p::Protocol& protocol, const p::Schedule& schedule, StimulusRenderer* renderer,
+                   const SessionObserver& observer, bool compute_true) {
+    struct Row {
+        std::vector<double> values;
+        std::string method;
+        std::size_t tracks = 0, finished = 0, responses = 0;
+    };
+    std::map<std::string, Row> rows;
+    for (const p::TrackResult& r : schedule.results()) {
+        Row& row = rows[r.condition_id];
+        ++row.tracks;
+        row.finished += r.finished ? 1 : 0;
+        row.responses += r.responses;
+        if (std::isfinite(r.estimate.value)) row.values.push_back(r.estimate.value);
+        if (row.method.empty()) row.method = r.estimate.method;
+    }
+    std::printf("\nper condition (levels in the procedure's units):\n");
+    for (const p::Block& b : protocol.blocks) {
+        for (const p::Condition& c : b.conditions) {
+            const auto it = rows.find(c.name);
+            if (it == rows.end()) continue;
+            const Row& row = it->second;
+            std::string est = "no estimate";
+            if (!row.values.empty()) {
+                const double mean =
+                    std::accumulate(row.values.begin(), row.values.end(), 0.0) / static_cast<double>(row.values.size());
+                std::string each;
+                for (const double v : row.values) each += fmt::format("{}{:.3f}", each.empty() ? "" : ", ", v);
+                est = fmt::format("{:.3f}", mean);
+                if (row.values.size() > 1) est += fmt::format(" (tracks {})", each);
+            }
+            std::string truth;
+            if (compute_true && renderer) {
+                double v = 0.0;
+                const std::string why = true_value(*renderer, protocol, c, observer.params(), v);
+                if (why.empty()) {
+                    const std::optional<double> pt = target_p_yes(c.procedure);
+                    const bool pse = c.task != p::Task::YesNo && pt && *pt == 0.5;
+                    truth = fmt::format("; model's true {} {:.3f}",
+                                        pse ? "PSE" : fmt::format("level at P = {:.3f}", *pt), v);
+                    if (!row.values.empty())
+                        truth += fmt::format(" (estimate − true = {:+.3f})",
+                                             std::accumulate(row.values.begin(), row.values.end(), 0.0) /
+                                                     static_cast<double>(row.values.size()) -
+                                                 v);
+                } else {
+                    truth = "; true value: " + why;
+                }
+            }
+            std::printf("  %-24s %s [%s; %zu of %zu tracks finished, %zu responses]%s\n", c.name.c_str(), est.c_str(),
+                        row.method.c_str(), row.finished, row.tracks, row.responses, truth.c_str());
+        }
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+
+int run_session(const RunOptions& o) {
+    // Installed first: a signal during the setup ends the session before its first trial.
+    StopSignals signals;
+    // --- Options that need no file.
+    if (!o.headless)
+        throw InputError(SourceLocation{"--headless", 0, 0, ""},
+                         "this build runs sessions headless only (the full-screen runner is not built yet): give "
+                         "--headless with --model-observer or --script FILE.");
+    if (!o.model_observer && o.script.empty())
+        throw InputError(SourceLocation{"--observer", 0, 0, ""},
+                         "a person's answers need the full-screen runner, which this build does not have: a headless "
+                         "run takes --model-observer or --script FILE.");
+    const std::string code = o.model_observer ? std::string("model") : (o.observer.empty() ? "script" : o.observer);
+    if (!valid_observer_code(code))
+        throw InputError(SourceLocation{"--observer", 0, 0, ""},
+                         fmt::format("the observer code \"{}\" must be 1 to 32 letters, digits, '_' or '-' (a code, "
+                                     "never a name).",
+                                     code));
+
+    // --- Load and validate everything before the first trial.
+    p::Protocol protocol;
+    std::optional<p::ScriptedObserver> script;
+    try {
+        protocol = p::load_protocol(o.protocol);
+        if (!o.script.empty()) script = p::ScriptedObserver::load(o.script);
+    } catch (const p::ProtocolError& e) {
+        throw input_error(e);
+    }
+    const std::string protocol_text = read_text(o.protocol, "protocol file");
+    const std::string protocol_sha = st::sha256_hex(protocol_text);
+    const std::filesystem::path scene_file = protocol.scene;
+    const std::string scene_text = read_text(scene_file, "scene template");
+    // The template alone first: its own errors name its file and line.
+    s::Scene display_scene;
+    {
+        std::vector<s::SceneOverride> display;
+        for (const std::string& d : protocol.display_overrides()) display.push_back(s::SceneOverride::parse(d));
+        display_scene = s::parse_scene(scene_text, scene_file.string(), display);
+    }
+    validate_conditions(protocol, scene_text, scene_file);
+    const double interval_s = protocol.timing.stimulus_s;
+
+    // --- The study file: its errors (newer schema, write-protected, ...) come
+    // before anything is rendered.
+    st::StoreOptions store_options;
+    store_options.max_size_bytes = o.db_max_bytes;
+    st::Store store = st::Store::create_or_open(o.db, store_options);
+    std::uint64_t seed = o.seed.value_or(protocol.seed);
+    st::SessionId session{};
+    std::vector<st::TrialRecord> logged;
+    bool resumed = false;
+    if (o.resume || o.resume_last) {
+        st::SessionRecord rec;
+        if (o.resume) {
+            try {
+                rec = store.session(st::SessionId{*o.resume});
+            } catch (const st::StoreError& e) {
+                if (e.kind() != st::StoreErrc::not_found) throw;
+                throw InputError(SourceLocation{"--resume", 0, 0, ""},
+                                 fmt::format("{} has no session {}.", o.db, *o.resume));
+            }
+        } else {
+            std::optional<st::SessionRecord> last;
+            for (const st::SessionRecord& r : store.sessions())
+                if (r.protocol_sha256 == protocol_sha && r.observer_code == code &&
+                    r.status != st::SessionStatus::completed && (!last || r.id > last->id))
+                    last = r;
+            if (!last)
+                throw InputError(SourceLocation{"--resume-last", 0, 0, ""},
+                                 fmt::format("{} has no unfinished session of {} for observer \"{}\" to continue.",
+                                             o.db, o.protocol, code));
+            rec = *last;
+        }
+        if (rec.status == st::SessionStatus::completed)
+            throw InputError(
+                SourceLocation{"--resume", 0, 0, ""},
+                fmt::format("session {} in {} is completed; there is nothing to continue.", rec.id.value, o.db));
+        if (rec.protocol_sha256 != protocol_sha)
+            throw InputError(SourceLocation{o.protocol, 0, 0, ""},
+                             fmt::format("session {} in {} ran a different text of this protocol (SHA-256 {}…); a "
+                                         "session continues only with the protocol it began with.",
+                                         rec.id.value, o.db, rec.protocol_sha256.substr(0, 12)));
+        if (rec.observer_code != code)
+            throw InputError(SourceLocation{"--observer", 0, 0, ""},
+                             fmt::format("session {} in {} is observer \"{}\"'s, not \"{}\".", rec.id.value, o.db,
+                                         rec.observer_code, code));
+        if (o.seed && *o.seed != rec.seed)
+            throw InputError(
+                SourceLocation{"--seed", 0, 0, ""},
+                fmt::format("session {} in {} runs with seed {}, not {}.", rec.id.value, o.db, rec.seed, *o.seed));
+        seed = rec.seed;
+        session = rec.id;
+        logged = store.resume_point(session).trials;
+        resumed = true;
+    }
+
+    std::uint64_t observer_seed = o.observer_seed.value_or(p::derive_seed(seed, 0x6f62736572766572ULL));  // "observer"
+    if (resumed) {
+        if (const auto stored = logged_observer_seed(logged)) {
+            if (o.observer_seed && *o.observer_seed != *stored)
+                throw InputError(SourceLocation{"--observer-seed", 0, 0, ""},
+                                 fmt::format("session {} in {} runs with observer seed {}, not {}.", session.value,
+                                             o.db, *stored, *o.observer_seed));
+            observer_seed = *stored;
+        }
+    }
+    SessionObserver observer(o, observer_seed, std::move(script));
+
+    // --- Replay the logged responses: the schedule's state, checked step by step
+    // against what was logged, and where the observer stands.
+    std::vector<p::Response> responses;
+    std::vector<p::ScheduledTrial> open_match;  // an adjustment match the log stops inside
+    double clock_s = 0.0;                       // the simulated session clock: onset of the next stimulus
+    p::Schedule check(protocol, seed);
+    {
+        for (const st::TrialRecord& t : logged) {
+            const std::optional<p::ScheduledTrial> next = check.next();
+            const std::optional<p::Response> r = response_from_word(t.response);
+            if (!next || !r || next->condition_id != t.condition_id || next->procedure_id != t.procedure_id ||
+                next->proposal.level != t.level || next->proposal.test_on_left != t.test_on_left)
+                throw InputError(
+                    SourceLocation{o.db, 0, 0, ""},
+                    fmt::format("trial {} of session {} ({} at level {}, answered \"{}\") is not what "
+                                "this protocol and seed propose at that point ({}); the session cannot "
+                                "be continued.",
+                                t.trial_index, session.value, t.condition_id, t.level, t.response,
+                                next ? fmt::format("{} at level {}", next->condition_id, next->proposal.level)
+                                     : std::string("the schedule has ended")));
+            observer.skip(next->task, next->stimulus.adjusted_view);
+            if (next->task == p::Task::Adjust) {
+                if (!open_match.empty() && (open_match.front().procedure_id != next->procedure_id ||
+                                            open_match.front().proposal.trial != next->proposal.trial))
+                    open_match.clear();
+                open_match.push_back(*next);
+                if (*r == p::Response::Confirm) open_match.clear();
+            } else {
+                open_match.clear();
+            }
+            const bool ends_trial = next->task != p::Task::Adjust || *r == p::Response::Confirm;
+            clock_s = t.onset_time_s + t.response_time_s + (ends_trial ? protocol.timing.inter_trial_s : 0.0);
+            check.record(*r);
+            responses.push_back(*r);
+        }
+    }
+    p::Schedule schedule = p::Schedule::replay(protocol, seed, responses);
+    if (schedule.state() != check.state())
+        throw std::logic_error("Schedule::replay disagrees with the step-by-step replay of the same responses");
+
+    // --- GL before the session: a machine without GL leaves no empty session behind.
+    auto context = gl::create_headless_context();
+    StimulusRenderer renderer(scene_text, scene_file, observer.params().window_radius_deg, interval_s);
+
+    // --- Begin or reopen the session.
+    if (resumed) {
+        const st::ResumePoint rp = store.resume_session(session);
+        if (static_cast<std::size_t>(rp.next_trial_index) != logged.size())
+            throw st::StoreError(st::StoreErrc::busy, o.db,
+                                 fmt::format("{}: session {} gained trials while it was being resumed; another "
+                                             "process is running it.",
+                                             o.db, session.value));
+    } else {
+        st::SessionStart start;
+        start.observer_code = code;
+        start.protocol_text = protocol_text;
+        start.protocol_name = std::filesystem::path(o.protocol).filename().string();
+        start.seed = seed;
+        start.calibration = record_display(store, display_scene, scene_file);
+        session = store.begin_session(start);
+    }
+    // From here on a StoreError names the session to continue.
+    try {
+        std::set<std::string> snapshotted;
+        if (resumed) {
+            for (const p::Block& b : protocol.blocks)
+                for (const p::Condition& c : b.conditions)
+                    if (store.get_snapshot(session, c.name)) snapshotted.insert(c.name);
+        }
+        // A model observer inside an adjustment match when the log stopped:
+        // show it that match's steps again (they are in the frame cache after
+        // the first), so that it continues from the same state.
+        if (observer.model() && !open_match.empty()) {
+            for (std::size_t i = 0; i < open_match.size(); ++i) {
+                const p::Answer a = observer.answer(open_match[i], &renderer);
+                const std::string_view logged_word = logged[open_match[i].step].response;
+                if (response_word(a.response) != logged_word)
+                    std::fprintf(stderr,
+                                 "atonlab: warning: replaying step %zu of the open adjustment, the model observer "
+                                 "answered \"%s\" where the log has \"%s\" (has the scene file changed?)\n",
+                                 open_match[i].step, std::string(response_word(a.response)).c_str(),
+                                 std::string(logged_word).c_str());
+            }
+        }
+
+        Progress progress(o.quiet, o.progress_every, trial_bound(protocol, schedule));
+        if (!o.quiet) {
+            std::printf("atonlab run: %s, observer \"%s\", seed %llu: session %lld in %s (%s)\n", protocol.name.c_str(),
+                        code.c_str(), static_cast<unsigned long long>(seed), static_cast<long long>(session.value),
+                        o.db.c_str(), resumed ? fmt::format("resumed after trial {}", logged.size()).c_str() : "new");
+            std::fflush(stdout);
+        }
+
+        const std::size_t runs = schedule.block_runs().size();
+        double snapshot_s = 0.0, store_s = 0.0;
+        bool first_trial_here = true;
+        while (!schedule.finished() && g_stop_signal == 0) {
+            const p::ScheduledTrial t = *schedule.next();
+            const p::Condition& c = protocol.blocks[t.block].conditions[t.condition];
+            if (t.starts_run) clock_s += protocol.blocks[t.block].adaptation_s;
+            if (t.starts_run || first_trial_here) progress.block(protocol, t, runs);
+            first_trial_here = false;
+            if (!snapshotted.count(c.name)) {
+                const auto started = std::chrono::steady_clock::now();
+                store.put_snapshot(session, c.name, snapshot_exr(renderer, protocol, c, t, session.value));
+                snapshotted.insert(c.name);
+                snapshot_s += seconds_since(started);
+            }
+            p::Answer answer;
+            try {
+                answer = observer.answer(t, &renderer);
+            } catch (const p::ProtocolError& e) {
+                // The script ran out or does not fit: what is stored stays, and the session can go on.
+                throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()},
+                                 fmt::format("{} Session {} stays open: continue it with --resume {}.", e.message(),
+                                             session.value, session.value));
+            }
+            std::vector<double> frame_times;
+            for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
+                const s::Scene sc = renderer.scene(t.stimulus.frames[f].overrides);
+                frame_times.push_back(brightest_moment_s(sc, judged_lights(t.stimulus, f), interval_s));
+            }
+            try {
+                schedule.record(answer.response);
+            } catch (const p::ProcedureError& e) {
+                throw InputError(SourceLocation{o.script.empty() ? o.protocol : o.script, 0, 0, ""},
+                                 fmt::format("trial {} ({}) cannot take the answer \"{}\": {}", t.step + 1,
+                                             t.condition_id, response_word(answer.response), e.message()));
+            }
+            st::TrialRecord tr;
+            tr.trial_index = static_cast<std::int64_t>(t.step);
+            tr.block = static_cast<int>(t.block);
+            tr.condition_id = t.condition_id;
+            tr.procedure_id = t.procedure_id;
+            tr.level = t.proposal.level;
+            tr.test_on_left = t.proposal.test_on_left;
+            tr.stimulus_json = stimulus_json(protocol, c, t, frame_times);
+            tr.response = std::string(response_word(answer.response));
+            if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;
+            // Onset to answer: the presentation, then the observer's time after it.
+            tr.response_time_s = presentation_s(protocol, c) + std::max(0.0, answer.response_time_s);
+            tr.onset_time_s = clock_s;
+            tr.dropped_frames = 0;  // headless: no display, no frame to drop
+            tr.missed_deadline = false;
+            tr.procedure_state_json = state_json(schedule, observer, answer.response_time_s);
+            const auto storing = std::chrono::steady_clock::now();
+            store.record_trial(session, tr);  // durable before the next stimulus
+            store_s += seconds_since(storing);
+            const bool ends_trial = t.task != p::Task::Adjust || answer.response == p::Response::Confirm;
+            clock_s = tr.onset_time_s + tr.response_time_s + (ends_trial ? protocol.timing.inter_trial_s : 0.0);
+            progress.trial(protocol, t, t.step + 1);
+        }
+        progress.end_line();
+        const int stop = g_stop_signal;
+        const bool completed = schedule.finished();
+        store.finish_session(session, completed ? st::SessionStatus::completed : st::SessionStatus::quit);
+        signals.restore();
+
+        const std::size_t total = schedule.history().size();
+        if (!o.quiet) {
+            std::printf("%s after %zu trials (%zu in this run, %s)\n",
+                        completed ? "completed" : fmt::format("stopped by signal {}", stop).c_str(), total,
+                        progress.done_here(), clock_text(progress.seconds()).c_str());
+            std::printf(
+                "  %zu frames rendered for %zu shown (%.1f s, snapshots included); snapshots %.1f s; "
+                "study file %.1f s\n",
+                renderer.frames_rendered(), renderer.frames_requested(), renderer.render_seconds(), snapshot_s,
+                store_s);
+            const std::size_t frames_before = renderer.frames_rendered();
+            const auto summarising = std::chrono::steady_clock::now();
+            const bool with_true = completed && observer.model() && o.true_pse;
+            print_summary(protocol, schedule, &renderer, observer, with_true);
+            if (with_true)
+                std::printf("  (the true values took %zu more frames, %.1f s; --no-true-pse skips them)\n",
+                            renderer.frames_rendered() - frames_before, seconds_since(summarising));
+            std::printf("\nstudy file: %s, session %lld (%s)%s\n", o.db.c_str(), static_cast<long long>(session.value),
+                        completed ? "completed" : "quit",
+                        completed ? "" : fmt::format("; continue with --resume {}", session.value).c_str());
+        }
+        return completed ? 0 : 128 + stop;
+    } catch (const st::StoreError& e) {
+        throw st::StoreError(
+            e.kind(), e.file(),
+            fmt::format("{}; session {} stays open: continue it with --resume {} (or --resume-last) once the "
+                        "cause is fixed",
+                        e.what(), session.value, session.value),
+            e.sqlite_code());
+    }
+}
+
+}  // namespace atonlab::runner

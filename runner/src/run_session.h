@@ -1,0 +1,105 @@
+#pragma once
+// The engine of `atonlab run` (docs/running.md): a protocol's trials rendered
+// headless, answered by a model or scripted observer, each committed to the
+// study file before the next is shown. run_command.cpp is the command line
+// around it.
+//
+// Two parts:
+//  - StimulusRenderer: a frame (a list of scene overrides) → the displayed
+//    luminance (cd/m²) that the screen would emit around each judged light,
+//    with an LRU cache keyed by the exact override list, so that a frame shown
+//    twice is rendered once;
+//  - run_session(): load and validate everything, open the store, begin or
+//    resume a session, run the trials, summarise.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <glm/vec2.hpp>
+#include <list>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "atonlab/protocols/observer.h"
+#include "atonlab/protocols/protocol.h"
+#include "atonlab/stimuli/display_pipeline.h"
+#include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/scene.h"
+#include "commands.h"
+
+namespace atonlab::runner {
+
+/// The displayed luminance around one judged light: a square window of the
+/// screen centred on the light (pixels beyond the screen's edge are black,
+/// 0 cd/m²), and the light's position in it (pixels, row 0 at the top, the
+/// DisplayedImage convention).
+struct LightWindow {
+    protocols::DisplayedImage image;
+    glm::dvec2 light_px{0.0};
+};
+
+/// One rendered frame, as the observer sees it: a window per judged light.
+struct FrameViews {
+    double time_s = 0.0;               ///< the scene time it was rendered at (rhythms), s
+    std::vector<LightWindow> windows;  ///< one per light asked for, in that order
+};
+
+class StimulusRenderer {
+public:
+    /// scene_text: the scene template's text (read once: a session renders the
+    /// file as it was when it began); scene_file resolves its relative paths and
+    /// names it in errors. window_radius_deg: the radius (degrees of visual
+    /// angle) around a light that the observer looks at; the windows kept are
+    /// 2 × that (the yes-no annulus) plus a margin. interval_s: how long a frame
+    /// is shown (a frame is rendered at the moment in it when its judged light
+    /// is brightest). Needs a current GL 4.5 context.
+    StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
+                     double interval_s, std::size_t cache_frames = 4096);
+
+    /// The scene a frame's overrides give. Throws InputError (the scene's own
+    /// errors, or "--set KEY" for an override).
+    stimuli::Scene scene(const std::vector<std::string>& overrides) const;
+
+    /// The frame seen around `lights` (scene light names; "" = the screen's
+    /// centre), from the cache or rendered.
+    std::shared_ptr<const FrameViews> views(const protocols::Frame& frame, const std::vector<std::string>& lights);
+
+    /// Renders the frame afresh (also filling the cache) and returns its
+    /// scene-referred HDR image (cd/m²) and the degrees per pixel at its centre.
+    stimuli::ImageRGBA32F hdr(const protocols::Frame& frame, const std::vector<std::string>& lights,
+                              double& degrees_per_pixel);
+
+    std::size_t frames_rendered() const noexcept { return rendered_; }
+    std::size_t frames_requested() const noexcept { return requested_; }
+    /// Wall-clock seconds spent rendering and reading frames back.
+    double render_seconds() const noexcept { return render_s_; }
+
+private:
+    std::shared_ptr<const FrameViews> render(const protocols::Frame& frame, const std::vector<std::string>& lights,
+                                             stimuli::ImageRGBA32F* hdr, double* degrees_per_pixel);
+    void remember(const std::string& key, std::shared_ptr<const FrameViews> views);
+
+    std::string scene_text_;
+    std::filesystem::path scene_file_;
+    double window_radius_deg_;
+    double interval_s_;
+    std::size_t capacity_;
+    stimuli::FrameRenderer frame_;
+    stimuli::DisplayPipeline display_;
+    // LRU: most recent at the front.
+    std::list<std::pair<std::string, std::shared_ptr<const FrameViews>>> lru_;
+    std::unordered_map<std::string, decltype(lru_)::iterator> index_;
+    std::size_t rendered_ = 0;
+    std::size_t requested_ = 0;
+    double render_s_ = 0.0;
+};
+
+/// Runs `atonlab run` (RunOptions in commands.h). Returns the exit status: 0
+/// when the session completed, 128 + N when signal N stopped it between trials.
+/// Throws InputError (bad protocol, scene, script or options),
+/// gl::ContextUnavailable, store::StoreError.
+int run_session(const RunOptions& options);
+
+}  // namespace atonlab::runner

@@ -1,0 +1,477 @@
+// `atonlab run` end to end: the binary (ATONLAB_BINARY, set by
+// tests/e2e/CMakeLists.txt) runs tests/data/run/small_2afc.toml (24 trials on a
+// 320 x 180 display) with the model observer, headless, and these tests read
+// the study file back through the store (read-only) and through SQLite itself.
+//
+//  - the stored trials are the schedule's, step by step (Schedule replayed
+//    with the stored answers), every override in the stimulus JSON, a
+//    snapshot per condition;
+//  - SIGKILL at random moments, 20 times: after each kill integrity_check is
+//    ok, the trials are a prefix of an uninterrupted run's and cover every
+//    trial the child reported committed; --resume-last continues and the
+//    finished sessions equal the uninterrupted run, trial for trial;
+//  - SIGTERM between trials: status "quit", exit status 143, resumable;
+//  - a full disk (--db-max-bytes), a write-protected file, a newer schema:
+//    exit status 4, one sentence, nothing stored lost (bytes unchanged where
+//    nothing may be written).
+// Skips where the binary finds no GL 4.5 context (exit status 3).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../store/store_test_support.h"
+#include "atonlab/protocols/protocol_file.h"
+#include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/store/store.h"
+
+#ifndef ATONLAB_BINARY
+#error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
+#endif
+
+namespace atonlab {
+namespace {
+
+namespace fs = std::filesystem;
+using store::Store;
+using store::TrialRecord;
+using store::test_support::file_bytes;
+using store::test_support::RawDb;
+using store::test_support::TempDir;
+
+const fs::path kProtocol = fs::path(ATONLAB_SOURCE_DIR) / "tests/data/run/small_2afc.toml";
+constexpr int kTrials = 24;
+
+/// Exit status, or 128 + N for a child killed by signal N (as a shell reports it).
+int status_code(int status) {
+    if (WIFEXITED(status)) return WEXITSTATUS(status);
+    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+    return -1;
+}
+
+/// Starts `atonlab run PROTOCOL --db DB --model-observer --headless ARGS...`,
+/// stdout and stderr to files. drop_root: as root, run as "nobody" (root
+/// ignores file permissions).
+pid_t spawn(const fs::path& db, const std::vector<std::string>& args, const fs::path& out, const fs::path& err,
+            bool drop_root = false) {
+    std::vector<std::string> argv{ATONLAB_BINARY, "run", kProtocol.string(), "--db", db.string(), "--headless"};
+    if (std::find(args.begin(), args.end(), "--script") == args.end()) argv.push_back("--model-observer");
+    argv.insert(argv.end(), args.begin(), args.end());
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (o < 0 || e < 0 || dup2(o, 1) < 0 || dup2(e, 2) < 0) _exit(120);
+        if (drop_root && geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(121);
+        std::vector<char*> cargs;
+        for (std::string& a : argv) cargs.push_back(a.data());
+        cargs.push_back(nullptr);
+        execv(cargs[0], cargs.data());
+        _exit(122);
+    }
+    return pid;
+}
+
+int wait_for(pid_t pid) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return status_code(status);
+}
+
+std::string text_of(const fs::path& p) {
+    return file_bytes(p);
+}
+
+/// The largest "trial N" the child's progress lines reported (0 if none).
+long last_reported(const fs::path& out) {
+    // (Not std::regex: GCC 12's <regex> trips -Wmaybe-uninitialized under the sanitizers.)
+    const std::string text = text_of(out);
+    const std::string tag = "trial ";
+    long last = 0;
+    for (auto at = text.find(tag); at != std::string::npos; at = text.find(tag, at + 1)) {
+        long n = 0;
+        bool digits = false;
+        for (std::size_t i = at + tag.size(); i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i) {
+            n = n * 10 + (text[i] - '0');
+            digits = true;
+        }
+        if (digits) last = std::max(last, n);
+    }
+    return last;
+}
+
+std::vector<TrialRecord> trials_of(const fs::path& db, store::SessionId session) {
+    return Store::open_read_only(db).trials(session);
+}
+
+/// Same trial, as far as the schedule and the observer go: every field but
+/// recorded_at; response and onset times within 1e-9 (they come from a
+/// rendering, which a GPU need not reproduce to the last bit).
+void expect_same_trial(const TrialRecord& got, const TrialRecord& want) {
+    SCOPED_TRACE("trial " + std::to_string(want.trial_index));
+    EXPECT_EQ(got.trial_index, want.trial_index);
+    EXPECT_EQ(got.block, want.block);
+    EXPECT_EQ(got.condition_id, want.condition_id);
+    EXPECT_EQ(got.procedure_id, want.procedure_id);
+    EXPECT_EQ(got.level, want.level);
+    EXPECT_EQ(got.test_on_left, want.test_on_left);
+    EXPECT_EQ(got.response, want.response);
+    EXPECT_EQ(got.response_value, want.response_value);
+    EXPECT_EQ(got.stimulus_json, want.stimulus_json);
+    EXPECT_NEAR(got.response_time_s, want.response_time_s, 1e-9);
+    EXPECT_NEAR(got.onset_time_s, want.onset_time_s, 1e-9);
+    EXPECT_EQ(got.dropped_frames, 0);
+}
+
+void expect_prefix(const std::vector<TrialRecord>& got, const std::vector<TrialRecord>& reference) {
+    ASSERT_LE(got.size(), reference.size());
+    for (std::size_t i = 0; i < got.size(); ++i) expect_same_trial(got[i], reference[i]);
+}
+
+std::string json_escaped(const std::string& s) {
+    std::string out;
+    for (const char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        out += c;
+    }
+    return out;
+}
+
+// Lower case, unlike the other suites, so that `ctest -R run` selects these
+// with the e2e.run.* tests (CTest names: GL.run.<Test>).
+class run : public ::testing::Test {
+protected:
+    /// One uninterrupted run, shared by the tests: the sequence every other run must reproduce.
+    static void SetUpTestSuite() {
+        ref_dir_ = new TempDir;
+        const fs::path db = ref_dir_->path() / "reference.db";
+        const auto started = std::chrono::steady_clock::now();
+        const int code = wait_for(spawn(db, {"--quiet"}, ref_dir_->path() / "out", ref_dir_->path() / "err"));
+        ref_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        if (code == 3) {
+            skip_ = "no GL 4.5 context: " + text_of(ref_dir_->path() / "err");
+            return;
+        }
+        ref_code_ = code;
+        ref_err_ = text_of(ref_dir_->path() / "err");
+        if (code == 0) reference_ = trials_of(db, store::SessionId{1});
+    }
+    static void TearDownTestSuite() {
+        delete ref_dir_;
+        ref_dir_ = nullptr;
+    }
+    void SetUp() override {
+        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        ASSERT_EQ(ref_code_, 0) << ref_err_;
+        ASSERT_EQ(reference_.size(), static_cast<std::size_t>(kTrials));
+    }
+
+    int run_atonlab(const std::vector<std::string>& args, bool drop_root = false) {
+        return wait_for(spawn(db(), args, out(), err(), drop_root));
+    }
+    fs::path db() const { return dir_.path() / "study.db"; }
+    fs::path out() const { return dir_.path() / "stdout"; }
+    fs::path err() const { return dir_.path() / "stderr"; }
+
+    TempDir dir_;
+    static inline TempDir* ref_dir_ = nullptr;
+    static inline std::string skip_;
+    static inline int ref_code_ = -1;
+    static inline double ref_ms_ = 0.0;  ///< wall time of the uninterrupted run, ms
+    static inline std::string ref_err_;
+    static inline std::vector<TrialRecord> reference_;
+};
+
+TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
+    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    EXPECT_EQ(text_of(out()), "") << "--quiet prints nothing";
+    Store s = Store::open_read_only(db());
+    EXPECT_EQ(s.integrity_check(), "ok");
+    const auto sessions = s.sessions();
+    ASSERT_EQ(sessions.size(), 1u);
+    EXPECT_EQ(sessions[0].status, store::SessionStatus::completed);
+    EXPECT_EQ(sessions[0].observer_code, "model");
+    EXPECT_EQ(sessions[0].seed, 7u);
+    EXPECT_TRUE(sessions[0].calibration.has_value()) << "the display is recorded";
+    EXPECT_EQ(s.protocol_text(sessions[0].id), text_of(kProtocol));
+
+    // Replay the stored answers through a fresh schedule: each stored trial is
+    // what the schedule proposed at that step.
+    const protocols::Protocol protocol = protocols::load_protocol(kProtocol);
+    protocols::Schedule schedule(protocol, 7);
+    const std::vector<TrialRecord> trials = s.trials(sessions[0].id);
+    ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+    double last_onset = -1.0;
+    for (const TrialRecord& t : trials) {
+        SCOPED_TRACE("trial " + std::to_string(t.trial_index));
+        const auto next = schedule.next();
+        ASSERT_TRUE(next.has_value());
+        EXPECT_EQ(t.trial_index, static_cast<std::int64_t>(next->step));
+        EXPECT_EQ(t.block, static_cast<int>(next->block));
+        EXPECT_EQ(t.condition_id, next->condition_id);
+        EXPECT_EQ(t.procedure_id, next->procedure_id);
+        EXPECT_EQ(t.level, next->proposal.level);
+        EXPECT_EQ(t.test_on_left, next->proposal.test_on_left);
+        for (const auto& frame : next->stimulus.frames)
+            for (const std::string& o : frame.overrides)
+                EXPECT_NE(t.stimulus_json.find("\"" + json_escaped(o) + "\""), std::string::npos) << o;
+        EXPECT_TRUE(t.response == "left" || t.response == "right") << t.response;
+        // Two intervals of 0.5 s with 0.5 s between, then the model's answer.
+        EXPECT_GE(t.response_time_s, 1.5);
+        EXPECT_GT(t.onset_time_s, last_onset);
+        last_onset = t.onset_time_s;
+        EXPECT_EQ(t.dropped_frames, 0);
+        EXPECT_NE(t.procedure_state_json.find("\"observer_seed\":"), std::string::npos);
+        schedule.record(t.response == "left" ? protocols::Response::Left : protocols::Response::Right);
+    }
+    EXPECT_TRUE(schedule.finished());
+    // The first block adapts 30 s (simulated) before its first trial.
+    EXPECT_DOUBLE_EQ(trials.front().onset_time_s, 30.0);
+    // Both answers occur: the staircases reverse.
+    EXPECT_NE(std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.response == "left"; }), 0);
+    EXPECT_NE(std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.response == "right"; }), 0);
+
+    // One scene-referred EXR per condition.
+    for (const char* condition : {"dark-empirical", "dusk-perceptual"}) {
+        const auto snap = s.get_snapshot(sessions[0].id, condition);
+        ASSERT_TRUE(snap.has_value()) << condition;
+        EXPECT_EQ(snap->format, "exr");
+        ASSERT_GE(snap->data.size(), 4u);
+        EXPECT_EQ(std::to_integer<int>(snap->data[0]), 0x76);  // OpenEXR magic 76 2f 31 01
+        EXPECT_EQ(std::to_integer<int>(snap->data[1]), 0x2f);
+    }
+    // The same seeds give the same session.
+    for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
+}
+
+TEST_F(run, KilledTwentyTimesEachResumeContinuesTheUninterruptedSequence) {
+    // Kills every 0.3-1.5 s, or within the time a whole run takes where that
+    // is shorter (a fast GPU), so that most land while a run is going on.
+    std::mt19937 rng(20240611);
+    std::uniform_int_distribution<int> delay_ms(static_cast<int>(std::min(300.0, 0.3 * ref_ms_)),
+                                                static_cast<int>(std::min(1500.0, 0.9 * ref_ms_)));
+    int kills = 0, completed = 0, runs = 0, mid_session = 0;
+    std::size_t stored_before = 0;
+    while (kills < 20) {
+        ASSERT_LT(++runs, 400) << "the runs finish before they can be killed";
+        // Continue the unfinished session if there is one, else begin one.
+        bool unfinished = false;
+        if (fs::exists(db())) {
+            for (const auto& r : Store::open_read_only(db()).sessions())
+                unfinished = unfinished || r.status != store::SessionStatus::completed;
+        }
+        std::vector<std::string> args{"--progress-every", "1"};
+        if (unfinished) args.push_back("--resume-last");
+        const pid_t pid = spawn(db(), args, out(), err());
+        std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+        kill(pid, SIGKILL);
+        const int code = wait_for(pid);
+        if (code == 128 + SIGKILL) {
+            ++kills;
+        } else {
+            ASSERT_EQ(code, 0) << text_of(err());
+        }
+        if (!fs::exists(db())) continue;  // killed before the study file was created
+        // After each run: the file is sound, and each session is a prefix of
+        // the uninterrupted run covering every trial the child reported.
+        Store s = Store::open_read_only(db());
+        ASSERT_EQ(s.integrity_check(), "ok");
+        const auto sessions = s.sessions();
+        for (const auto& r : sessions) {
+            const auto trials = s.trials(r.id);
+            expect_prefix(trials, reference_);
+            if (r.status == store::SessionStatus::completed) {
+                EXPECT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+            } else {
+                EXPECT_EQ(r.status, store::SessionStatus::running) << "a killed session stays running";
+            }
+        }
+        if (!sessions.empty() && code == 128 + SIGKILL) {
+            const auto n = static_cast<long>(s.trials(sessions.back().id).size());
+            if (static_cast<std::size_t>(n) > stored_before) ++mid_session;  // it had committed trials when killed
+            stored_before = static_cast<std::size_t>(n);
+            const long reported = last_reported(out());
+            EXPECT_GE(n, reported) << "a trial reported committed is missing";
+            EXPECT_LE(n, reported + 1) << "at most the trial being reported when killed";
+        }
+        if (code == 0) {
+            ++completed;
+            stored_before = 0;
+        }
+        if (testing::Test::HasFailure()) return;
+    }
+    // Finish the last session.
+    bool unfinished = false;
+    for (const auto& r : Store::open_read_only(db()).sessions())
+        unfinished = unfinished || r.status != store::SessionStatus::completed;
+    if (unfinished) {
+        ASSERT_EQ(run_atonlab({"--resume-last", "--quiet"}), 0) << text_of(err());
+        ++completed;
+    }
+    Store s = Store::open_read_only(db());
+    EXPECT_EQ(s.integrity_check(), "ok");
+    for (const auto& r : s.sessions()) {
+        SCOPED_TRACE("session " + std::to_string(r.id.value));
+        EXPECT_EQ(r.status, store::SessionStatus::completed);
+        const auto trials = s.trials(r.id);
+        ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+        for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
+    }
+    std::printf(
+        "[ run ] %d kills over %d runs (%d after the run had committed trials); %d sessions completed, each "
+        "equal to the uninterrupted run\n",
+        kills, runs, mid_session, completed);
+}
+
+TEST_F(run, SigtermQuitsBetweenTrialsAndTheSessionContinues) {
+    const pid_t pid = spawn(db(), {"--progress-every", "1"}, out(), err());
+    for (int i = 0; i < 600 && last_reported(out()) < 3; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    kill(pid, SIGTERM);
+    const int code = wait_for(pid);
+    if (code == 0) GTEST_SKIP() << "the session finished before SIGTERM arrived";
+    ASSERT_EQ(code, 128 + SIGTERM) << text_of(err());
+    {
+        Store s = Store::open_read_only(db());
+        const auto sessions = s.sessions();
+        ASSERT_EQ(sessions.size(), 1u);
+        EXPECT_EQ(sessions[0].status, store::SessionStatus::quit);
+        const auto trials = s.trials(sessions[0].id);
+        EXPECT_GE(trials.size(), 3u);
+        expect_prefix(trials, reference_);
+        EXPECT_NE(text_of(out()).find("--resume 1"), std::string::npos) << "says how to continue";
+    }
+    ASSERT_EQ(run_atonlab({"--resume", "1", "--quiet"}), 0) << text_of(err());
+    Store s = Store::open_read_only(db());
+    const auto sessions = s.sessions();
+    ASSERT_EQ(sessions.size(), 1u);
+    EXPECT_EQ(sessions[0].status, store::SessionStatus::completed);
+    EXPECT_EQ(sessions[0].resume_count, 1);
+    const auto trials = s.trials(sessions[0].id);
+    ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+    for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
+}
+
+TEST_F(run, DiskFullStopsWithStatus4AndLosesNothing) {
+    // Session 1 completes; session 2 may grow the file by the first
+    // condition's snapshot and a few pages, and hits the limit.
+    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    std::int64_t logical = 0, snapshot = 0;
+    {
+        RawDb raw(db());
+        logical = raw.integer("PRAGMA page_count") * raw.integer("PRAGMA page_size");
+        snapshot = raw.integer("SELECT length(data) FROM snapshots WHERE condition_id = 'dark-empirical'");
+    }
+    const std::vector<TrialRecord> first = trials_of(db(), store::SessionId{1});
+    const std::int64_t limit = logical + snapshot + 24 * 1024;
+    ASSERT_EQ(run_atonlab({"--quiet", "--db-max-bytes", std::to_string(limit)}), 4) << text_of(err());
+    const std::string message = text_of(err());
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_NE(message.find("full"), std::string::npos) << message;
+    EXPECT_NE(message.find("--resume 2"), std::string::npos) << message;
+    std::size_t stored = 0;
+    {
+        Store s = Store::open_read_only(db());
+        EXPECT_EQ(s.integrity_check(), "ok");
+        const auto sessions = s.sessions();
+        ASSERT_EQ(sessions.size(), 2u);
+        EXPECT_EQ(sessions[0].status, store::SessionStatus::completed);
+        EXPECT_EQ(sessions[1].status, store::SessionStatus::running);
+        const auto again = s.trials(sessions[0].id);
+        ASSERT_EQ(again.size(), first.size());
+        for (std::size_t i = 0; i < first.size(); ++i) expect_same_trial(again[i], first[i]);
+        const auto partial = s.trials(sessions[1].id);
+        stored = partial.size();
+        EXPECT_LT(partial.size(), static_cast<std::size_t>(kTrials));
+        expect_prefix(partial, reference_);
+    }
+    // With room again, the session continues where it stopped.
+    ASSERT_EQ(run_atonlab({"--quiet", "--resume-last"}), 0) << text_of(err());
+    const auto trials = trials_of(db(), store::SessionId{2});
+    ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+    for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
+    std::printf("[ run ] limit %lld bytes: %zu trials stored before the file was full; message: %s",
+                static_cast<long long>(limit), stored, message.c_str());
+}
+
+TEST_F(run, WriteProtectedFileStopsWithStatus4AndIsUnchanged) {
+    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    const std::string before = file_bytes(db());
+    ASSERT_EQ(chmod(db().c_str(), 0444), 0);
+    // "nobody" must reach the directory (not write it) to be told the file is protected.
+    ASSERT_EQ(chmod(dir_.path().c_str(), 0755), 0);
+    const int code = run_atonlab({"--quiet"}, /*drop_root=*/true);
+    if (code == 121) GTEST_SKIP() << "running as root and cannot drop to nobody, for whom permissions apply";
+    EXPECT_EQ(code, 4) << text_of(err());
+    const std::string message = text_of(err());
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_NE(message.find("write-protected"), std::string::npos) << message;
+    EXPECT_EQ(file_bytes(db()), before) << "a write-protected study file is not changed";
+    Store s = Store::open_read_only(db());
+    ASSERT_EQ(s.sessions().size(), 1u);
+    EXPECT_EQ(s.trials(store::SessionId{1}).size(), static_cast<std::size_t>(kTrials));
+}
+
+TEST_F(run, NewerSchemaStopsWithStatus4AndIsUnchanged) {
+    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    {
+        RawDb raw(db());
+        ASSERT_EQ(raw.exec("PRAGMA user_version = 99"), "");
+    }
+    const std::string before = file_bytes(db());
+    EXPECT_EQ(run_atonlab({"--quiet"}), 4) << text_of(err());
+    const std::string message = text_of(err());
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+    EXPECT_NE(message.find("newer atonlab"), std::string::npos) << message;
+    EXPECT_EQ(file_bytes(db()), before);
+    RawDb raw(db());
+    EXPECT_EQ(raw.integer("SELECT count(*) FROM trials"), kTrials);
+}
+
+TEST_F(run, ScriptedObserverAnswersFromItsFile) {
+    {
+        std::ofstream script(dir_.path() / "answers.txt");
+        script << "# the first interval, always\n";
+        for (int i = 0; i < kTrials; ++i) script << "left 0.5\n";
+    }
+    ASSERT_EQ(run_atonlab({"--quiet", "--script", (dir_.path() / "answers.txt").string(), "--observer", "S01"}), 0)
+        << text_of(err());
+    Store s = Store::open_read_only(db());
+    const auto sessions = s.sessions();
+    ASSERT_EQ(sessions.size(), 1u);
+    EXPECT_EQ(sessions[0].observer_code, "S01");
+    const auto trials = s.trials(sessions[0].id);
+    ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
+    for (const auto& t : trials) {
+        EXPECT_EQ(t.response, "left");
+        EXPECT_DOUBLE_EQ(t.response_time_s, 1.5 + 0.5);
+    }
+}
+
+TEST_F(run, ScriptRunningOutLeavesTheSessionToContinue) {
+    const fs::path script = dir_.path() / "answers.txt";
+    {
+        std::ofstream f(script);
+        for (int i = 0; i < 5; ++i) f << "right\n";
+    }
+    EXPECT_EQ(run_atonlab({"--quiet", "--script", script.string()}), 2);
+    const std::string message = text_of(err());
+    EXPECT_NE(message.find("answers.txt"), std::string::npos) << message;
+    EXPECT_NE(message.find("used up"), std::string::npos) << message;
+    EXPECT_EQ(trials_of(db(), store::SessionId{1}).size(), 5u);
+}
+
+}  // namespace
+}  // namespace atonlab
