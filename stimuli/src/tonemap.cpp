@@ -60,10 +60,6 @@ double inverse_square(double w) {
     return std::isinf(w) ? 0.0 : 1.0 / (w * w);
 }
 
-// The linear operators' scene white (cd/m²).
-double linear_white_cd_m2(double adaptation, const ToneMapSettings& s) {
-    return s.white_cd_m2 ? *s.white_cd_m2 : adaptation * s.display_peak_cd_m2 / display_adaptation_cd_m2(s);
-}
 
 void require_positive(double v, const char* key, const char* what) {
     if (!(v > 0.0) || !std::isfinite(v)) {
@@ -152,6 +148,10 @@ void validate_tonemap_settings(const ToneMapSettings& s) {
 double display_adaptation_cd_m2(const ToneMapSettings& s) {
     // K2012 §4.4: "the viewer is assumed to be adapted to half the display's maximum luminance".
     return s.display_adaptation_cd_m2 ? *s.display_adaptation_cd_m2 : 0.5 * s.display_peak_cd_m2;
+}
+
+double linear_white_cd_m2(double adaptation_cd_m2, const ToneMapSettings& s) {
+    return s.white_cd_m2 ? *s.white_cd_m2 : adaptation_cd_m2 * s.display_peak_cd_m2 / display_adaptation_cd_m2(s);
 }
 
 double rod_sensitivity(double luminance_cd_m2) {

@@ -123,6 +123,9 @@ void validate_tonemap_settings(const ToneMapSettings& s);
 
 /// L_da: display_adaptation_cd_m2 or, unset, display_peak_cd_m2 / 2 (cd/m²).
 double display_adaptation_cd_m2(const ToneMapSettings& s);
+/// The scene luminance (cd/m²) the linear and clamp operators show as display
+/// white at adaptation L_wa: white_cd_m2, or unset L_wa · L_dmax / L_da.
+double linear_white_cd_m2(double adaptation_cd_m2, const ToneMapSettings& s);
 
 // ---------------------------------------------------------------------------
 // The pieces, each with its equation.
