@@ -17,6 +17,7 @@ layout(binding = 0) uniform sampler2D hdr;  // RGBA32F, cd/m²
 uniform ivec2 size;
 uniform int stride;
 uniform float epsilon_cd_m2;
+uniform float inv_pre_exposure;  // the frame holds cd/m² × pre-exposure (frame_renderer.h)
 shared double sums[256];
 
 void main() {
@@ -28,7 +29,12 @@ void main() {
     double s = 0.0LF;
     for (uint i = begin + t; i < end; i += 256u) {
         ivec2 p = ivec2(int(i) % grid.x, int(i) / grid.x) * stride;
-        vec3 c = max(texelFetch(hdr, p, 0).rgb, vec3(0.0));
+        // As log_average_luminance() (tonemap.cpp): NaN and negatives count as 0 and values are
+        // capped at kMaxInputCdM2, so a +inf texel (an overflowed RGBA16F frame) or a NaN cannot
+        // make the adapted luminance inf or NaN for good (max() leaves NaN undefined).
+        vec3 v = texelFetch(hdr, p, 0).rgb * inv_pre_exposure;
+        vec3 c = vec3(v.r > 0.0 ? min(v.r, 1e15) : 0.0, v.g > 0.0 ? min(v.g, 1e15) : 0.0,
+                      v.b > 0.0 ? min(v.b, 1e15) : 0.0);
         float y = dot(c, vec3(0.2126, 0.7152, 0.0722));
         s += double(log(y + epsilon_cd_m2));
     }

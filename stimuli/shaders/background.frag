@@ -13,6 +13,7 @@ uniform vec3 eye_position_m;
 uniform float sky_luminance;    // cd/m²
 uniform float sea_f0;           // Schlick R_F(0°)
 uniform int sky_sea;            // 0: uniform field
+uniform float pre_exposure;     // the HDR target stores luminance × pre_exposure (frame_renderer.h)
 
 void main() {
     vec3 dir_view = normalize(vec3((gl_FragCoord.xy - principal_px) / focal_px, -1.0));
@@ -26,6 +27,6 @@ void main() {
         float t = eye_position_m.y / cos_i;
         depth = t * -dir_view.z;
     }
-    radiance = vec4(vec3(L), 1.0);
+    radiance = vec4(vec3(L * pre_exposure), 1.0);
     view_depth = depth;
 }

@@ -175,7 +175,9 @@ double display_drive_for(DisplayChannel c, double L) {
     double v = 0.0LF;
     if (c.kind == DISPLAY_SRGB) {
         double t = (L - c.black_cd_m2) / (c.white_cd_m2 - c.black_cd_m2);
-        v = t <= 0.0031308049535603713LF ? 12.92LF * t : 1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF;
+        // max(): the power branch dips 3e-8 below the break just above it (display_model.cpp).
+        v = t <= 0.0031308049535603713LF ? 12.92LF * t
+                                          : max(1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF, 0.04045LF);
     } else if (c.kind == DISPLAY_GOG) {
         v = (display_pow(L - c.a, c.inv_gamma) - c.b) / c.k;
     } else if (c.kind == DISPLAY_LUT) {

@@ -21,6 +21,9 @@ layout(std430, binding = 8) writeonly buffer Codes { uvec2 codes[]; };  // (r | 
 
 uniform ivec2 size;
 uniform uint frame_index;
+#if !defined(LDR_PATH)
+uniform float inv_pre_exposure;  // the frame holds cd/m² × pre-exposure (frame_renderer.h)
+#endif
 #if defined(LDR_PATH)
 // 0: frame_in is display-referred (relative to white); > 0: frame_in is an HDR
 // frame in cd/m² that an LDR renderer would show by exposure, times this scale,
@@ -37,7 +40,7 @@ void main() {
     if (ldr_scale > 0.0) scene = min(scene * ldr_scale, vec3(1.0));
     vec3 relative = scene + tonemap_pixel(texelFetch(glare_hdr, p, 0).rgb, adaptation, tone);
 #else
-    vec3 relative = tonemap_pixel(texelFetch(frame_in, p, 0).rgb, adaptation, tone);
+    vec3 relative = tonemap_pixel(texelFetch(frame_in, p, 0).rgb * inv_pre_exposure, adaptation, tone);
 #endif
     uvec3 c = encode_pixel(relative, p, frame_index, display);
     codes[p.y * size.x + p.x] = uvec2(c.r | (c.g << 16), c.b);

@@ -13,6 +13,7 @@ uniform vec2 image_size;
 uniform float focal_px;
 uniform int layer_size;
 uniform float layer_half_px;
+uniform float pre_exposure;  // the HDR target stores luminance × pre_exposure (frame_renderer.h)
 
 flat in vec2 g_centre;
 flat in vec3 g_illuminance;
@@ -42,5 +43,5 @@ void main() {
     if (all(lessThanEqual(K, vec3(0.0)))) discard;
     vec2 p0 = floor(gl_FragCoord.xy);
     float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);
-    radiance = vec4(g_illuminance * K / omega, 0.0);
+    radiance = vec4(g_illuminance * K / omega * pre_exposure, 0.0);
 }

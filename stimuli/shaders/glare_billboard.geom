@@ -13,6 +13,7 @@ struct LightDraw {
     vec4 centre;       // xy: px (window coordinates); z: view depth (m); w: footprint area (px², 0 = not drawn)
     vec4 illuminance;  // rgb: lux at the eye
     vec4 factors;
+    vec4 skip;         // x: cropped half-extent (px, 0 = uncropped; light_eval.comp)
 };
 layout(std430, binding = 3) readonly buffer Draws { LightDraw draws[]; };
 
@@ -36,6 +37,7 @@ void main() {
     float radius_px = sqrt(d.centre.w / PI);
     float layer = layer_step_px > 0.0 ? min(radius_px / layer_step_px, float(layer_count - 1)) : 0.0;
     float extent = min(kernel_half_px + ceil(radius_px) + 1.0, layer_half_px) + 1.0;
+    if (d.skip.x > 0.0) extent = min(extent, d.skip.x);  // the display crop (frame_renderer.h DisplaySkips)
     vec2 c = d.centre.xy;
     if (any(lessThan(c + extent, vec2(0.0))) || any(greaterThan(c - extent, image_size))) return;
     for (int k = 0; k < 4; ++k) {

@@ -10,6 +10,7 @@ flat in vec3 v_illuminance;
 
 uniform vec2 image_size;
 uniform float focal_px;
+uniform float pre_exposure;  // the HDR target stores luminance × pre_exposure (frame_renderer.h)
 
 layout(location = 0) out vec4 radiance;
 
@@ -20,5 +21,5 @@ void main() {
     if (c <= 0.0) discard;
     float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);
     // The footprint holds max(A, 1) px² in all: A for a disc, 1 for the box.
-    radiance = vec4(v_illuminance * (c / (max(v_area, 1.0) * omega)), 0.0);
+    radiance = vec4(v_illuminance * (c / (max(v_area, 1.0) * omega)) * pre_exposure, 0.0);
 }

@@ -4,6 +4,7 @@ struct LightDraw {
     vec4 centre;
     vec4 illuminance;
     vec4 factors;
+    vec4 skip;
 };
 layout(std430, binding = 3) readonly buffer Draws { LightDraw draws[]; };
 

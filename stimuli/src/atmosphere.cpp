@@ -85,6 +85,9 @@ double extinction_per_m_from_visibility_m(double visibility_m) {
 
 double bouguer_transmittance(double extinction_per_m, double distance_m) {
     assert(extinction_per_m >= 0 && distance_m >= 0);
+    // No path, no extinction: T(0) = 1 even for sigma = inf (visibility 0), where
+    // exp(-inf * 0) would be NaN (docs/numerical-behaviour.md).
+    if (distance_m == 0) return 1.0;
     return std::exp(-extinction_per_m * distance_m);  // K2012 eq 4.14
 }
 

@@ -358,6 +358,10 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
     };
     const std::size_t i_r = field_index("RGB_R"), i_g = field_index("RGB_G"), i_b = field_index("RGB_B"),
                       i_y = field_index("XYZ_Y");
+    // X and Z are optional: kept with the reading when both are there.
+    const auto i_x = std::find(fields.begin(), fields.end(), "XYZ_X"),
+               i_z = std::find(fields.begin(), fields.end(), "XYZ_Z");
+    const bool has_xz = i_x != fields.end() && i_z != fields.end();
 
     if (const auto it = keywords.find("DEVICE_CLASS"); it != keywords.end() && it->second.value != "DISPLAY")
         throw error(it->second.line, 1, "DEVICE_CLASS",
@@ -418,6 +422,10 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
             channel = Channel::blue;
         }
         out.push_back(Measurement{level, channel, Y * scale, line_no, rgb, file_name});
+        if (has_xz)
+            out.back().xyz_cd_m2 = glm::dvec3(number(static_cast<std::size_t>(i_x - fields.begin())), Y,
+                                              number(static_cast<std::size_t>(i_z - fields.begin()))) *
+                                   scale;
     }
     if (number_of_sets && static_cast<std::size_t>(number_of_sets->first) != rows.size())
         throw error(number_of_sets->second, 1, "NUMBER_OF_SETS",

@@ -249,7 +249,11 @@ Vec3 xyz_to_xyY(Vec3 xyz) {
 double srgb_encode(double linear) {
     // IEC 61966-2-1 / K2012 eq 3.13. NaN is treated as black so the encoder never emits NaN.
     const double v = std::isnan(linear) ? 0.0 : std::clamp(linear, 0.0, 1.0);
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    if (v <= 0.0031308) return 12.92 * v;
+    // The standard's rounded constants put the power segment 2.9e-8 below the linear one's
+    // end just above the switch (they meet at 0.00313067, not 0.0031308): hold it at that end
+    // until it catches up (within 2.2e-9 of the switch), so the encoder never decreases.
+    return std::max(1.055 * std::pow(v, 1.0 / 2.4) - 0.055, 12.92 * 0.0031308);
 }
 
 double srgb_decode(double encoded) {
@@ -264,14 +268,15 @@ double srgb_decode(double encoded) {
 Vec3 normalised_rgb_from_xy(glm::dvec2 xy, bool clip_to_gamut) {
     check_chromaticity(xy, "the light's");
     // K2012 §4.1: xyY with Y = 1 -> XYZ (eq 3.10) -> RGB (eq 3.12).
-    Vec3 rgb = xyz_to_linear_rgb(xyz_of_unit_luminance(xy));
     if (clip_to_gamut) {
         // Dropping negative (unrealisable) amounts of a primary can only add luminance, so the
-        // luminance after clamping is >= 1 and the renormalisation is well defined.
-        rgb = glm::max(rgb, Vec3(0.0));
-        rgb /= luminance_of_linear_rgb(rgb);
+        // luminance after clamping is >= y > 0 and the renormalisation is well defined. Clipping
+        // and renormalising are scale-free, so start from XYZ = (x, y, 1 - x - y), Y = y: going
+        // through Y = 1 first divides by y, which overflows to inf (then NaN) as y -> 0.
+        Vec3 rgb = glm::max(xyz_to_linear_rgb(Vec3(xy.x, xy.y, 1.0 - xy.x - xy.y)), Vec3(0.0));
+        return rgb / luminance_of_linear_rgb(rgb);
     }
-    return rgb;
+    return xyz_to_linear_rgb(xyz_of_unit_luminance(xy));
 }
 
 Vec3 normalised_rgb_from_spectrum(const Spectrum& spd) {
@@ -280,7 +285,10 @@ Vec3 normalised_rgb_from_spectrum(const Spectrum& spd) {
     if (!(xyz.y > 0.0) || !std::isfinite(sum)) {
         throw InputError("the spectrum has no luminance between 360 and 830 nm, so it has no colour");
     }
-    return normalised_rgb_from_xy(glm::dvec2(xyz.x / sum, xyz.y / sum), true);
+    // Z >= 0 puts x + y <= 1, but the two divisions can round it an ulp above 1 (a 10 nm
+    // LED at 723 nm has Z/X ~ 1e-70), which check_chromaticity would refuse: cap x at 1 - y.
+    const double y = xyz.y / sum;
+    return normalised_rgb_from_xy(glm::dvec2(std::min(xyz.x / sum, 1.0 - y), y), true);
 }
 
 std::optional<glm::dvec2> iala_colour_xy(std::string_view name) {

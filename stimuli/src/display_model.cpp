@@ -40,8 +40,11 @@ double rec709_weight(int c) {
 }
 
 double srgb_encode_exact(double t) {
-    // The inverse of srgb_decode (colour.cpp) branch by branch.
-    return t <= kSrgbLinearBreak ? 12.92 * t : 1.055 * std::pow(t, kSrgbInvGamma) - 0.055;
+    // The inverse of srgb_decode (colour.cpp) branch by branch. srgb_decode jumps up by
+    // 2.3e-9 at V = 0.04045 (IEC 61966-2-1's rounded constants), so just above the break the
+    // power branch's inverse is 3e-8 below 0.04045: the smallest drive reaching those L is
+    // 0.04045 itself (issue 8; the drive must never decrease as L rises).
+    return t <= kSrgbLinearBreak ? 12.92 * t : std::max(1.055 * std::pow(t, kSrgbInvGamma) - 0.055, 0.04045);
 }
 
 // ---------------------------------------------------------------------------

@@ -93,11 +93,16 @@ void DisplayPipeline::reset_adaptation() {
     impl_->reset();
 }
 
-void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame) {
+void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame,
+                              double pre_exposure) {
     Impl& m = *impl_;
     if (!(dt_s >= 0) || !std::isfinite(dt_s))
         throw InputError(SourceLocation{"", 0, 0, "dt_s"},
                          fmt::format("the frame time must be a finite number of seconds ≥ 0, not {}.", dt_s));
+    if (!(pre_exposure > 0) || !std::isfinite(pre_exposure))
+        throw InputError(SourceLocation{"", 0, 0, "pre_exposure"},
+                         fmt::format("the HDR frame's pre-exposure must be a positive number, not {}.", pre_exposure));
+    const auto inv_pre_exposure = static_cast<float>(1.0 / pre_exposure);
     m.upload_settings(s);
     m.size_for(hdr);
     const bool dynamic = s.adaptation.mode == AdaptationMode::dynamic;
@@ -113,6 +118,7 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
         m.partial.set("size", m.width, m.height);
         m.partial.set("stride", stride);
         m.partial.set("epsilon_cd_m2", static_cast<float>(s.adaptation.epsilon_cd_m2));
+        m.partial.set("inv_pre_exposure", inv_pre_exposure);
         m.partial.use();
         glDispatchCompute(kPartialGroups, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -129,6 +135,7 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
     m.final_pass.use();
     glDispatchCompute(1, 1, 1);
     hdr.bind(0);
+    m.encode.set("inv_pre_exposure", inv_pre_exposure);
     m.run_encode(m.encode, frame);
 }
 

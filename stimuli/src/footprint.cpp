@@ -74,7 +74,10 @@ double pixel_solid_angle_sr(double x0, double y0, double f) {
 Footprint light_footprint(glm::dvec3 v, double radius_m, double focal_px, int width, int height) {
     Footprint fp;
     const double d = glm::length(v);
-    if (!(v.z < 0.0) || !(d > radius_m)) return fp;  // behind the camera, or the eye inside the light
+    // Only a sphere wholly in front of the camera's plane (depth > radius) has a bounded
+    // image: nearer that plane the centre and the area (1/cos³α) overflow. Behind the
+    // camera, beside it, or the eye inside the light (d <= radius): not visible.
+    if (!(-v.z > radius_m) || !(d > radius_m)) return fp;
     const double depth = -v.z;
     fp.centre_px = {0.5 * width + focal_px * v.x / depth, 0.5 * height + focal_px * v.y / depth};
     const double cos_alpha = depth / d;

@@ -2,19 +2,29 @@
 
 #include <epoxy/gl.h>
 
+#include <array>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <string>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "atonlab/stimuli/display_threshold.h"
+#include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/glare_stage.h"
 
 namespace atonlab::stimuli {
+
+namespace {
+constexpr std::size_t kDrawFloats = 16;  // struct LightDraw of light_eval.comp: 4 vec4
+}
 
 CameraProjection CameraProjection::from_scene(const Scene& scene) {
     CameraProjection p;
@@ -30,7 +40,8 @@ CameraProjection CameraProjection::from_scene(const Scene& scene) {
 
 double CameraProjection::degrees_per_pixel_at_centre() const { return 180.0 / std::numbers::pi / focal_px; }
 
-GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const unsigned> glare_groups) {
+GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const unsigned> glare_groups,
+                           std::span<const double> invisible_lux) {
     GpuLightTables t;
     // Profiles: every table once, lights refer to them by offset (K2012 §5.1 ids).
     std::vector<std::pair<std::uint32_t, std::uint32_t>> vert, hor;
@@ -46,6 +57,7 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
     for (std::size_t li = 0; li < scene.lights.size(); ++li) {
         const Light& L = scene.lights[li];
         const unsigned group = li < glare_groups.size() ? glare_groups[li] : 0u;
+        const double invisible = li < invisible_lux.size() ? invisible_lux[li] : 0.0;
         const auto knot_offset = static_cast<std::uint32_t>(t.rhythm_knots.size());
         for (const RhythmKnot& k : L.rhythm)
             t.rhythm_knots.emplace_back(static_cast<float>(k.t_s), static_cast<float>(k.level));
@@ -60,7 +72,7 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
             static_cast<float>(I.r), static_cast<float>(I.g), static_cast<float>(I.b), static_cast<float>(L.rhythm_phase_s),
             bits(v.first), bits(v.second), bits(h.first), bits(h.second),
             bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(group), bits(0),
-            static_cast<float>(L.rhythm_period_s), 0.0f, 0.0f, 0.0f};
+            static_cast<float>(L.rhythm_period_s), static_cast<float>(invisible), 0.0f, 0.0f};
         t.lights.insert(t.lights.end(), std::begin(rec), std::end(rec));
     }
     if (t.profile_values.empty()) t.profile_values.push_back(1.0f);
@@ -78,13 +90,28 @@ struct FrameRenderer::Impl {
     gl::Texture2D hdr, depth, glare_only;
     gl::Framebuffer fbo, glare_fbo;
     gl::Buffer lights, profiles, knots, draws;
+    gl::Buffer no_envelope{sizeof(float), nullptr, gl::BufferUsage::static_draw};
     int light_count = 0;
     GlareStage glare;
+    FrameOptions options;
+    double pre_exposure = 1.0;
+    gl::GpuTimer timers[3];
+    bool timed = false;
+    FrameTimings cpu_timings;
+    // ΔY (cd/m²) per display state and light colour (display_threshold.h): the
+    // search takes milliseconds, the answer is the same frame after frame.
+    std::map<std::string, std::map<std::array<double, 3>, double>> invisible_cache;
+
+    static gl::PixelFormat pixel_format(HdrFormat f) {
+        return f == HdrFormat::rgba16f ? gl::PixelFormat::rgba16f : gl::PixelFormat::rgba32f;
+    }
+    std::vector<double> invisible_lux(const Scene& scene, const CameraProjection& P);
 
     void resize(int w, int h) {
-        if (hdr && hdr.width() == w && hdr.height() == h) return;
+        const gl::PixelFormat format = pixel_format(options.hdr_format);
+        if (hdr && hdr.width() == w && hdr.height() == h && hdr.format() == format) return;
         fbo = {};
-        hdr = gl::Texture2D(w, h, gl::PixelFormat::rgba32f);
+        hdr = gl::Texture2D(w, h, format);
         depth = gl::Texture2D(w, h, gl::PixelFormat::r32f);
         fbo = gl::Framebuffer::create();
         fbo.attach_colour(hdr, 0);
@@ -102,6 +129,47 @@ struct FrameRenderer::Impl {
     }
 };
 
+// Each light's invisible illuminance (lux, Y): ΔY · Ω_min, ΔY the luminance
+// that moves no code by threshold_codes on the frame's darkest background, Ω_min
+// the smallest pixel solid angle (a corner's), so that E · K_peak < ΔY · Ω_min
+// keeps every pixel the light touches below ΔY. Empty when the skips are off or
+// cannot be bounded (dynamic adaptation, the LDR glare path).
+std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const CameraProjection& P) {
+    const DisplaySkips& k = options.skips;
+    const OutputSettings& out = scene.output;
+    if (!(k.cull_invisible_lights || k.crop_billboards) || !(k.threshold_codes > 0) ||
+        out.adaptation.mode != AdaptationMode::fixed || out.ldr_glare || scene.lights.empty())
+        return {};
+    const Environment& env = scene.environment;
+    double floor_cd_m2 = std::max(0.0, env.luminance_cd_m2);
+    if (env.background == Background::sky_sea) floor_cd_m2 *= std::clamp(env.sea_reflectance_f0, 0.0, 1.0);
+    const double omega_min = pixel_solid_angle_sr(-0.5 * P.width_px, -0.5 * P.height_px, P.focal_px);
+
+    std::string key;
+    auto bytes = [&key](const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); };
+    const ToneMapGpuParams tp = tonemap_gpu_params(out.tonemap);
+    const GpuDisplayParams dp = gpu_display_params(out.display, out.encode);
+    const std::vector<double> lut = gpu_display_lut(out.display);
+    const double state[3] = {out.adaptation.fixed_cd_m2, floor_cd_m2, k.threshold_codes};
+    bytes(&tp, sizeof(tp));
+    bytes(&dp, sizeof(dp));
+    bytes(lut.data(), lut.size() * sizeof(double));
+    bytes(state, sizeof(state));
+    if (invisible_cache.size() > 64) invisible_cache.clear();
+    auto& per_colour = invisible_cache[key];
+    if (per_colour.size() > 4096) per_colour.clear();
+
+    std::vector<double> result(scene.lights.size(), 0.0);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const glm::dvec3 c = scene.lights[i].rgb_per_cd;
+        auto [it, fresh] = per_colour.try_emplace({c.r, c.g, c.b}, 0.0);
+        if (fresh)
+            it->second = invisible_luminance_cd_m2(out, out.adaptation.fixed_cd_m2, floor_cd_m2, c, k.threshold_codes);
+        result[i] = it->second * omega_min;
+    }
+    return result;
+}
+
 namespace {
 // Per-frame data: keep the buffer and overwrite it while it is large enough,
 // so a steady scene allocates nothing frame to frame.
@@ -117,11 +185,49 @@ void upload(gl::Buffer& buffer, const void* data, std::size_t bytes, gl::BufferU
 FrameRenderer::FrameRenderer() : impl_(std::make_unique<Impl>()) {}
 FrameRenderer::~FrameRenderer() = default;
 
+void FrameRenderer::set_options(const FrameOptions& options) {
+    impl_->options = options;
+}
+const FrameOptions& FrameRenderer::options() const {
+    return impl_->options;
+}
+double FrameRenderer::pre_exposure() const {
+    return impl_->pre_exposure;
+}
+
+FrameTimings FrameRenderer::timings() const {
+    const Impl& m = *impl_;
+    FrameTimings t = m.cpu_timings;
+    if (m.timed) {
+        t.background_gpu_ms = m.timers[0].elapsed_ms().value_or(0);
+        t.light_eval_gpu_ms = m.timers[1].elapsed_ms().value_or(0);
+        t.lights_draw_gpu_ms = m.timers[2].elapsed_ms().value_or(0);
+    }
+    return t;
+}
+
 void FrameRenderer::render(const Scene& scene, double time_s) {
+    using Clock = std::chrono::steady_clock;
+    auto ms_since = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    const auto started = Clock::now();
     Impl& m = *impl_;
     projection_ = CameraProjection::from_scene(scene);
     const CameraProjection& P = projection_;
     m.resize(P.width_px, P.height_px);
+    m.pre_exposure = m.options.pre_exposure > 0 ? m.options.pre_exposure : 1.0 / scene.output.adaptation.fixed_cd_m2;
+    const auto pre = static_cast<float>(m.pre_exposure);
+    m.timed = m.options.gpu_timing;
+    if (m.timed && !m.timers[0])
+        for (auto& t : m.timers) t = gl::GpuTimer::create();
+    // Every timer is begun and ended every timed frame, so none is read unissued.
+    auto begin = [&m](int i) {
+        if (m.timed) m.timers[i].begin();
+    };
+    auto end = [&m](int i) {
+        if (m.timed) m.timers[i].end();
+    };
     const auto w = static_cast<float>(P.width_px), h = static_cast<float>(P.height_px);
     const auto f = static_cast<float>(P.focal_px);
     const glm::mat3 world_from_view(P.world_from_view);
@@ -141,27 +247,42 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     m.background.set("sky_luminance", static_cast<float>(env.luminance_cd_m2));
     m.background.set("sea_f0", static_cast<float>(env.sea_reflectance_f0));
     m.background.set("sky_sea", env.background == Background::sky_sea ? 1 : 0);
+    m.background.set("pre_exposure", pre);
     m.background.use();
     m.vao.bind();
+    begin(0);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    end(0);
 
     // 2. Per-light evaluation, projection and occlusion (compute).
     // The glare kernels first: the light pass culls with the billboard's extent.
+    const auto prepare_started = Clock::now();
     const double glare_extent_px = m.glare.prepare(scene, P, time_s);
+    m.cpu_timings.glare_prepare_cpu_ms = ms_since(prepare_started);
     const bool glare = scene.glare.model != GlareModel::none;
-    const GpuLightTables tables = pack_lights(scene, P.eye_position_m, m.glare.light_groups());
+    const std::vector<double> invisible = m.invisible_lux(scene, P);
+    const GpuLightTables tables = pack_lights(scene, P.eye_position_m, m.glare.light_groups(), invisible);
     m.light_count = static_cast<int>(scene.lights.size());
     upload(m.lights, tables.lights.data(), tables.lights.size() * sizeof(float), gl::BufferUsage::stream_draw);
     upload(m.profiles, tables.profile_values.data(), tables.profile_values.size() * sizeof(float),
            gl::BufferUsage::stream_draw);
     upload(m.knots, tables.rhythm_knots.data(), tables.rhythm_knots.size() * sizeof(glm::vec2),
            gl::BufferUsage::stream_draw);
-    upload(m.draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * 12 * sizeof(float),
+    upload(m.draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * kDrawFloats * sizeof(float),
            gl::BufferUsage::dynamic_read);
     m.lights.bind_storage(0);
     m.profiles.bind_storage(1);
     m.knots.bind_storage(2);
     m.draws.bind_storage(3);
+    const bool skips = !invisible.empty();
+    const bool crop = skips && glare && m.options.skips.crop_billboards && m.glare.envelope_stride() > 0;
+    (glare && m.glare.envelope_stride() > 0 ? m.glare.envelope_buffer() : m.no_envelope).bind_storage(4);
+    if (m.light_count == 0 && m.timed) {
+        begin(1);
+        end(1);
+        begin(2);
+        end(2);
+    }
     if (m.light_count > 0) {
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
         m.depth.bind(0);
@@ -172,8 +293,13 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         m.light_eval.set("time_s", time_s);
         m.light_eval.set("extinction_per_m", static_cast<float>(env.extinction_per_m));
         m.light_eval.set("glare_extent_px", static_cast<float>(glare_extent_px));
+        m.light_eval.set("cull_invisible", skips && m.options.skips.cull_invisible_lights ? 1 : 0);
+        m.light_eval.set("crop_billboards", crop ? 1 : 0);
+        m.light_eval.set("envelope_stride", glare ? m.glare.envelope_stride() : 0u);
         m.light_eval.use();
+        begin(1);
         glDispatchCompute(static_cast<unsigned>((m.light_count + 63) / 64), 1, 1);
+        end(1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
         // 3. Direct images, additively (the background already holds its radiance).
@@ -184,12 +310,14 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         glBlendFunc(GL_ONE, GL_ONE);
         glBlendEquation(GL_FUNC_ADD);
         const bool ldr = glare && scene.output.ldr_glare;
+        begin(2);
         if (glare && !ldr) {
             // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
-            m.glare.draw(m.light_count, P);
+            m.glare.draw(m.light_count, P, m.pre_exposure);
         } else {
             m.light_direct.set("image_size", w, h);
             m.light_direct.set("focal_px", f);
+            m.light_direct.set("pre_exposure", pre);
             m.light_direct.use();
             m.vao.bind();
             glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
@@ -200,14 +328,16 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
             m.glare_fbo.bind();
             const float zero[4] = {0, 0, 0, 0};
             glClearBufferfv(GL_COLOR, 0, zero);
-            m.glare.draw(m.light_count, P);
+            m.glare.draw(m.light_count, P, 1.0);  // the glare buffer stays in cd/m²
             m.fbo.bind();
         }
+        end(2);
         glDisable(GL_BLEND);
         const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
         glNamedFramebufferDrawBuffers(m.fbo.id(), 2, both);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    m.cpu_timings.total_cpu_ms = ms_since(started);
 }
 
 namespace {
@@ -227,6 +357,10 @@ ImageRGBA32F FrameRenderer::read_hdr() const {
     img.width = impl_->hdr.width();
     img.height = impl_->hdr.height();
     img.rgba = flip_rows(impl_->hdr.download_floats(), img.width, img.height, 4);
+    if (impl_->pre_exposure != 1.0) {
+        const auto inv = static_cast<float>(1.0 / impl_->pre_exposure);
+        for (float& v : img.rgba) v *= inv;
+    }
     return img;
 }
 
@@ -236,11 +370,11 @@ std::vector<float> FrameRenderer::read_view_depth() const {
 
 std::vector<LightDrawRecord> FrameRenderer::read_light_draws() const {
     const Impl& m = *impl_;
-    std::vector<float> raw(static_cast<std::size_t>(m.light_count) * 12);
+    std::vector<float> raw(static_cast<std::size_t>(m.light_count) * kDrawFloats);
     m.draws.download(0, raw.size() * sizeof(float), raw.data());
     std::vector<LightDrawRecord> out(static_cast<std::size_t>(m.light_count));
     for (std::size_t i = 0; i < out.size(); ++i) {
-        const float* r = &raw[i * 12];
+        const float* r = &raw[i * kDrawFloats];
         LightDrawRecord& d = out[i];
         d.centre_px = {r[0], r[1]};
         d.view_depth_m = r[2];
@@ -251,6 +385,8 @@ std::vector<LightDrawRecord> FrameRenderer::read_light_draws() const {
         d.horizontal = r[9];
         d.rhythm = r[10];
         d.transmittance = r[11];
+        d.crop_half_extent_px = r[12];
+        d.invisible_lux = r[13];
     }
     return out;
 }

@@ -44,6 +44,11 @@ double glare_pupil_mm(const Scene& scene) {
     return scene.glare.pupil_mm ? *scene.glare.pupil_mm : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
 }
 
+double cached_pupil_mm(double pupil_mm, double tolerance_mm) {
+    if (!(tolerance_mm > 0)) return pupil_mm;
+    return std::max(1.0, std::round(pupil_mm / tolerance_mm)) * tolerance_mm;
+}
+
 SpencerVision spencer_vision_for(const Scene& scene) {
     if (scene.glare.spencer_vision) return *scene.glare.spencer_vision;
     if (scene.adaptation_cd_m2 >= 3.0) return SpencerVision::photopic;
@@ -140,6 +145,7 @@ struct GlareStage::Impl {
         int layers_max = 0;
         gl::Buffer layer_buffer;
         GlareGroupReport report;
+        std::vector<float> envelope;  // billboard crop table (see envelope_buffer())
     };
     std::map<std::string, Group> groups;  // by SPD name, kept between frames
     std::vector<std::string> order;       // this frame's groups, index = group id
@@ -148,6 +154,9 @@ struct GlareStage::Impl {
     std::unique_ptr<GpuPsfGenerator> generator;
     gl::Program billboard;
     gl::VertexArray vao;
+    gl::Buffer envelope_buffer;
+    unsigned envelope_stride = 0;
+    GlareBuildCounts counts;
 
     GpuPsfGenerator& generator_for(int n) {
         if (!generator || generator->size() != n) generator = std::make_unique<GpuPsfGenerator>(n);
@@ -165,6 +174,8 @@ struct GlareStage::Impl {
             case GlareModel::wave_optics: {
                 EyeModel eye = gs.eye;
                 eye.pupil_diameter_mm = pupil_mm;
+                // pupil_mm already holds the hippus of time_s (prepare()); applied once.
+                eye.hippus.enabled = false;
                 eye.validate(gs.psf_size);
                 const double dpt = psf_degrees_per_texel(eye);
                 const auto field = pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
@@ -207,7 +218,27 @@ struct GlareStage::Impl {
         g.report.kernel_size_px = g.kernel.size;
         g.report.radius_deg = radius;
         g.report.window_cut = g.kernel.window_cut;
+        g.envelope = crop_envelope(g.kernel);
+        g.report.kernel_peak = g.envelope.empty() ? 0.0 : g.envelope[0];
         g.layers_radius_px = -1;  // rebuild the layers from the new kernel
+        ++counts.kernels;
+    }
+
+    // Largest texel (any channel) at Chebyshev distance ≥ e from the centre,
+    // e = 0 … half, then a 0 sentinel: the table light_eval.comp crops with.
+    static std::vector<float> crop_envelope(const GlareKernel& k) {
+        const int h = k.half();
+        std::vector<float> ring(static_cast<std::size_t>(h) + 2, 0.0f);
+        for (int j = 0; j < k.size; ++j)
+            for (int i = 0; i < k.size; ++i) {
+                const auto d = static_cast<std::size_t>(std::max(std::abs(i - h), std::abs(j - h)));
+                const glm::vec4& v = k.at(i, j);
+                ring[d] = std::max({ring[d], v.r, v.g, v.b});
+            }
+        for (int d = h - 1; d >= 0; --d)
+            ring[static_cast<std::size_t>(d)] =
+                std::max(ring[static_cast<std::size_t>(d)], ring[static_cast<std::size_t>(d) + 1]);
+        return ring;
     }
 };
 
@@ -227,6 +258,16 @@ const RgbPsf* GlareStage::psf(std::size_t group) const {
     return g.psf ? &*g.psf : nullptr;
 }
 
+const gl::Buffer& GlareStage::envelope_buffer() const {
+    return impl_->envelope_buffer;
+}
+unsigned GlareStage::envelope_stride() const {
+    return impl_->envelope_stride;
+}
+GlareBuildCounts GlareStage::build_counts() const {
+    return impl_->counts;
+}
+
 const GlareKernel* GlareStage::kernel(std::size_t group) const {
     if (group >= impl_->order.size()) return nullptr;
     return &impl_->groups.at(impl_->order[group]).kernel;
@@ -238,6 +279,7 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     m.order.clear();
     m.reports.clear();
     m.light_groups.assign(scene.lights.size(), 0u);
+    m.envelope_stride = 0;
     if (gs.model == GlareModel::none) return 0.0;
 
     // SPD groups in order of first appearance.
@@ -254,18 +296,18 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     // The kernel depends on these, and only these: rebuilt when one changes.
     const double ppd = scene.display.pixels_per_degree_at_centre();
     const double pupil = glare_pupil_mm(scene);
-    const bool hippus = gs.model == GlareModel::wave_optics && gs.eye.hippus.enabled;
-    const double pupil_now = gs.model == GlareModel::wave_optics ? [&] {
+    const double pupil_now = cached_pupil_mm(gs.model == GlareModel::wave_optics ? [&] {
         EyeModel eye = gs.eye;
         eye.pupil_diameter_mm = pupil;
         return pupil_diameter_mm_at(eye, time_s);
-    }() : pupil;
+    }() : pupil, gs.pupil_tolerance_mm);
     const EyeModel& e = gs.eye;
     std::string common;
     auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
     add(glare_model_name(gs.model), gs.psf_size, gs.spectral_samples, glare_window_name(gs.window),
         gs.radius_deg.value_or(-1), gs.bloom_sigma_deg, static_cast<int>(spencer_vision_for(scene)));
-    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd, pupil, hippus ? time_s : 0.0);
+    // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
+    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd, pupil_now);
     add(e.hippus.enabled, e.hippus.amplitude, e.hippus.max_pupil_mm);
     add(e.gratings.enabled, e.gratings.count, e.gratings.inner_radius_mm, e.gratings.width_um, e.gratings.opacity,
         e.gratings.angle_jitter);
@@ -309,16 +351,34 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
             g.layers_max = gs.area_layers;
             g.layer_buffer = gl::Buffer(g.layers.rgba.size() * sizeof(glm::vec4), g.layers.rgba.data(),
                                         gl::BufferUsage::static_draw);
+            ++m.counts.layers;
         }
         g.report.area_layers = g.layers.layers;
         g.report.area_max_radius_px = g.layers.max_radius_px();
         m.reports.push_back(g.report);
         extent = std::max(extent, static_cast<double>(g.kernel.half()) + 1.0);
     }
+
+    // The crop tables of this frame's groups, one stride apart: the envelope
+    // zero-padded, then the group's area-layer step (px).
+    std::size_t stride = 0;
+    for (const auto& name : m.order) stride = std::max(stride, m.groups.at(name).envelope.size() + 1);
+    std::vector<float> table(std::max<std::size_t>(1, stride * m.order.size()), 0.0f);
+    for (std::size_t gi = 0; gi < m.order.size(); ++gi) {
+        const auto& g = m.groups.at(m.order[gi]);
+        std::copy(g.envelope.begin(), g.envelope.end(), table.begin() + static_cast<std::ptrdiff_t>(gi * stride));
+        table[gi * stride + stride - 1] = static_cast<float>(g.layers.radius_step_px);
+    }
+    const std::size_t bytes = table.size() * sizeof(float);
+    if (!m.envelope_buffer || m.envelope_buffer.size() < bytes)
+        m.envelope_buffer = gl::Buffer(bytes, table.data(), gl::BufferUsage::dynamic_draw);
+    else
+        m.envelope_buffer.upload(0, bytes, table.data());
+    m.envelope_stride = static_cast<unsigned>(stride);
     return extent;
 }
 
-void GlareStage::draw(int light_count, const CameraProjection& P) {
+void GlareStage::draw(int light_count, const CameraProjection& P, double pre_exposure) {
     Impl& m = *impl_;
     if (m.order.empty() || light_count == 0) return;
     if (!m.billboard) {
@@ -330,6 +390,7 @@ void GlareStage::draw(int light_count, const CameraProjection& P) {
     const auto w = static_cast<float>(P.width_px), h = static_cast<float>(P.height_px);
     m.billboard.set("image_size", w, h);
     m.billboard.set("focal_px", static_cast<float>(P.focal_px));
+    m.billboard.set("pre_exposure", static_cast<float>(pre_exposure));
     m.billboard.use();
     m.vao.bind();
     for (std::size_t gi = 0; gi < m.order.size(); ++gi) {

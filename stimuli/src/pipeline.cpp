@@ -4,6 +4,13 @@
 
 namespace atonlab::stimuli {
 
+Pipeline::Pipeline() {
+    FrameOptions o;
+    o.skips.cull_invisible_lights = true;
+    o.skips.crop_billboards = true;
+    frame_.set_options(o);
+}
+
 void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
     validate_output_settings(scene.output);
     frame_.render(scene, time_s);
@@ -14,9 +21,9 @@ void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
         // operator's white (the adaptation luminance at the display's own
         // adaptation level), clipped; the glare is tone-mapped and added.
         const double white = linear_white_cd_m2(out.adaptation.fixed_cd_m2, out.tonemap);
-        display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index_, 1.0 / white);
+        display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index_, 1.0 / (white * frame_.pre_exposure()));
     } else {
-        display_.process(frame_.hdr_texture(), out, dt_s, frame_index_);
+        display_.process(frame_.hdr_texture(), out, dt_s, frame_index_, frame_.pre_exposure());
     }
     ++frame_index_;
 }

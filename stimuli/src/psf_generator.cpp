@@ -3,6 +3,11 @@
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
+#include <chrono>
+#include <complex>
+#include <optional>
+#include <string>
+
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::stimuli {
@@ -13,11 +18,25 @@ constexpr int kMaxSpectralSamples = 128;  // psf_spectral.comp MAX_SAMPLES
 unsigned groups_for(std::size_t count) {
     return static_cast<unsigned>((count + 255) / 256);
 }
+
+// The same rule as gl::ContextInfo::software, for the current context.
+bool software_renderer() {
+    const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string renderer = r ? r : "";
+    return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
+           renderer.find("swrast") != std::string::npos;
+}
+
+PsfFftPlacement resolve(PsfFftPlacement p) {
+    if (p != PsfFftPlacement::automatic) return p;
+    return software_renderer() ? PsfFftPlacement::cpu : PsfFftPlacement::gpu;
+}
 }  // namespace
 
 struct GpuPsfGenerator::Impl {
     int n;
-    GpuFft fft;
+    PsfFftPlacement placement;
+    std::optional<GpuFft> fft;  // empty when the FFT runs on the CPU
     gl::Program magnitude = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_MAGNITUDE"});
     gl::Program scale_mono = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_SCALE_MONO"});
     gl::Program downsample = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_DOWNSAMPLE"});
@@ -30,7 +49,13 @@ struct GpuPsfGenerator::Impl {
     PsfGpuTimings last;
     double degrees_per_texel = 0;
 
-    Impl(int size, TwiddleSource twiddles) : n(size), fft(size, twiddles) {
+    Impl(int size, TwiddleSource twiddles, PsfFftPlacement where) : n(size), placement(resolve(where)) {
+        if (placement == PsfFftPlacement::gpu)
+            fft.emplace(size, twiddles);
+        else if (!is_power_of_two(n) || n < kGpuFftMinSize || n > kGpuFftMaxSize)  // the GPU path's sizes either way
+            throw InputError(SourceLocation{"", 0, 0, "size"},
+                             fmt::format("the PSF size must be a power of two from {} to {}, not {}.", kGpuFftMinSize,
+                                         kGpuFftMaxSize, n));
         const auto texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
         field = gl::Buffer(texels * 2 * sizeof(float), nullptr, gl::BufferUsage::dynamic_draw);
         mono = gl::Buffer(texels * sizeof(float), nullptr, gl::BufferUsage::dynamic_read);
@@ -49,7 +74,8 @@ struct GpuPsfGenerator::Impl {
     static void barrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT); }
 };
 
-GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles) : impl_(std::make_unique<Impl>(n, twiddles)) {}
+GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles, PsfFftPlacement fft)
+    : impl_(std::make_unique<Impl>(n, twiddles, fft)) {}
 GpuPsfGenerator::~GpuPsfGenerator() = default;
 GpuPsfGenerator::GpuPsfGenerator(GpuPsfGenerator&&) noexcept = default;
 GpuPsfGenerator& GpuPsfGenerator::operator=(GpuPsfGenerator&&) noexcept = default;
@@ -59,6 +85,9 @@ int GpuPsfGenerator::size() const {
 }
 PsfGpuTimings GpuPsfGenerator::timings() const {
     return impl_->last;
+}
+PsfFftPlacement GpuPsfGenerator::fft_placement() const {
+    return impl_->placement;
 }
 
 void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees_per_texel,
@@ -77,17 +106,27 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
     const auto texels = static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n);
     const auto n = static_cast<unsigned>(m.n);
 
+    const bool cpu_fft = m.placement == PsfFftPlacement::cpu;
+    double cpu_fft_ms = 0;
     m.timers[0].begin();
-    std::vector<float> packed(texels * 2);
-    for (std::size_t i = 0; i < texels; ++i) {
-        packed[2 * i] = static_cast<float>(pupil.data[i].real());
-        packed[2 * i + 1] = static_cast<float>(pupil.data[i].imag());
+    ComplexImage<float> packed(m.n);
+    if (cpu_fft) {
+        // FFTW double, rounded once to float for the upload: as fast as FFTW
+        // float on the machines measured (bench fft_nN) and exact.
+        const auto t0 = std::chrono::steady_clock::now();
+        ComplexImage<double> spectrum = pupil;
+        fftw_forward(spectrum);
+        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(spectrum.data[i]);
+        cpu_fft_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    } else {
+        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(pupil.data[i]);
     }
-    m.field.upload(0, packed.size() * sizeof(float), packed.data());
+    // std::complex<float> is two floats (re, im): the std430 layout of vec2.
+    m.field.upload(0, texels * sizeof(std::complex<float>), packed.data.data());
     m.timers[0].end();
 
     m.timers[1].begin();
-    m.fft.forward(m.field);
+    if (!cpu_fft) m.fft->forward(m.field);
     m.timers[1].end();
 
     // |F|², shift, sum, unit sum, level 1.
@@ -138,7 +177,7 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
     m.timers[3].end();
 
     m.last.upload_ms = m.timers[0].elapsed_ms().value_or(0);
-    m.last.fft_ms = m.timers[1].elapsed_ms().value_or(0);
+    m.last.fft_ms = cpu_fft ? cpu_fft_ms : m.timers[1].elapsed_ms().value_or(0);
     m.last.mono_ms = m.timers[2].elapsed_ms().value_or(0);
     m.last.spectral_ms = m.timers[3].elapsed_ms().value_or(0);
 }

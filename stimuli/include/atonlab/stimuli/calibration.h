@@ -4,6 +4,7 @@
 // (docs/display-calibration.md). Luminance in cd/m²; drive levels in [0, 1].
 #include <filesystem>
 #include <glm/glm.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,9 @@ struct Measurement {
     int line;                ///< 1-based line in the file it came from (0 if none)
     glm::dvec3 rgb{};        ///< the patch's drive levels in [0, 1] (R, G, B)
     std::string file{};      ///< the file it came from, for error messages
+    /// CIE 1931 XYZ on the absolute scale of luminance_cd_m2 (Y = luminance), when
+    /// the file has them (a .ti3 with XYZ_X and XYZ_Z); none for a CSV.
+    std::optional<glm::dvec3> xyz_cd_m2{};
 };
 
 // ---------------------------------------------------------------------------

@@ -101,6 +101,8 @@ double srgb_decode(double encoded);
 
 /// Linear RGB normalised to Y = 1 for chromaticity xy. Out-of-gamut chromaticities
 /// give negative components; pass clip_to_gamut to clamp them at 0 and renormalise to Y = 1.
+/// Clipped results are finite for every valid xy; unclipped components grow as 1/y and
+/// overflow to ±inf for y below ~1e-307 (docs/numerical-behaviour.md).
 Vec3 normalised_rgb_from_xy(glm::dvec2 xy, bool clip_to_gamut = false);
 
 /// Linear RGB normalised to Y = 1 for an SPD (clipped to the gamut as above).

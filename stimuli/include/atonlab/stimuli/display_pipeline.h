@@ -28,9 +28,11 @@ public:
     DisplayPipeline(const DisplayPipeline&) = delete;
     DisplayPipeline& operator=(const DisplayPipeline&) = delete;
 
-    /// hdr: RGBA32F in cd/m². dt_s: seconds since the previous frame (≥ 0; the
-    /// first frame adopts its log-average at once). frame: dither frame index.
-    void process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame);
+    /// hdr: RGBA32F (or RGBA16F) holding cd/m² × pre_exposure (FrameRenderer::
+    /// pre_exposure()). dt_s: seconds since the previous frame (≥ 0; the first
+    /// frame adopts its log-average at once). frame: dither frame index.
+    void process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame,
+                 double pre_exposure = 1.0);
     /// The LDR integration path (K2012 §6.2.2): `ldr` is display-referred linear
     /// RGB relative to the display's white (what an LDR renderer produced) when
     /// hdr_scale = 0, or an HDR frame (cd/m²) that is shown by exposure

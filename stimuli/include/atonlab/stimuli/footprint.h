@@ -36,7 +36,7 @@ double pixel_solid_angle_sr(double x0, double y0, double focal_px);
 
 /// A light's image on the pixel grid.
 struct Footprint {
-    bool visible = false;      ///< in front of the camera and outside the light's sphere
+    bool visible = false;      ///< the light's whole sphere in front of the camera's plane (view depth > radius)
     glm::dvec2 centre_px{0};   ///< projected centre, pixel coordinates (origin at the image's lower-left corner)
     double area_px2 = 0;       ///< footprint area A
     double radius_px = 0;      ///< disc radius sqrt(A/π) (disc footprints)

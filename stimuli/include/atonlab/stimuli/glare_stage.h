@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/stimuli/gl/objects.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/psf.h"
 #include "atonlab/stimuli/scene.h"
@@ -26,6 +27,15 @@ struct GlareGroupReport {
     glm::dvec3 window_cut{0.0};  ///< energy fraction the window cut (then restored by renormalisation)
     int area_layers = 1;
     double area_max_radius_px = 0;
+    double kernel_peak = 0;  ///< the kernel's largest texel value (any channel; fraction of the light's energy)
+};
+
+/// How often the stage rebuilt what it caches (since it was made): the glare
+/// kernel (the PSF with its spectral integration, once per SPD group and
+/// pupil/eye state) and the area layers.
+struct GlareBuildCounts {
+    int kernels = 0;
+    int layers = 0;
 };
 
 /// Default billboard radius (degrees) of a model: for the FFT models the part
@@ -35,6 +45,11 @@ double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_p
 
 /// Pupil diameter (mm) a scene's glare uses: the given one, or eq 3.15 from the adaptation.
 double glare_pupil_mm(const Scene& scene);
+
+/// The pupil (mm) the PSF is computed for: pupil_mm rounded to the nearest
+/// multiple of tolerance_mm (GlareSettings::pupil_tolerance_mm; at least one
+/// step), or pupil_mm itself when the tolerance is 0.
+double cached_pupil_mm(double pupil_mm, double tolerance_mm);
 
 /// Spencer's vision class from the adaptation luminance when not given:
 /// photopic ≥ 3 cd/m², scotopic ≤ 0.001 cd/m², mesopic between (CIE 191 limits).
@@ -50,9 +65,20 @@ public:
     /// Builds (or reuses) kernels and layers for the scene at time_s. Returns
     /// the billboard half-extent (px) the light pass must cull with.
     double prepare(const Scene& scene, const CameraProjection& projection, double time_s);
-    /// Draws the billboards additively into the bound framebuffer (colour 0).
+    /// Draws the billboards additively into the bound framebuffer (colour 0),
+    /// each pixel's luminance times pre_exposure (frame_renderer.h FrameOptions).
     /// Expects the light SSBOs at bindings 0-3 as FrameRenderer binds them.
-    void draw(int light_count, const CameraProjection& projection);
+    void draw(int light_count, const CameraProjection& projection, double pre_exposure = 1.0);
+
+    /// The billboard crop table of the last prepared frame, for light_eval.comp:
+    /// per SPD group g, entry e < stride - 1 (at g · envelope_stride() + e) is
+    /// the largest value of any channel of the kernel over the texels at
+    /// Chebyshev distance ≥ e from its centre (non-increasing in e, ending in
+    /// 0); entry stride - 1 is the group's area-layer step (px). Stride 0
+    /// without glare.
+    const gl::Buffer& envelope_buffer() const;
+    unsigned envelope_stride() const;
+    GlareBuildCounts build_counts() const;
 
     const std::vector<GlareGroupReport>& report() const;
     /// The RGB PSF of group g (wave-optics, aperture), for files and tests.

@@ -22,7 +22,11 @@ namespace atonlab::stimuli {
 
 class Pipeline {
 public:
-    Pipeline() = default;
+    /// The frame renderer's display skips are on here (frame_renderer.h
+    /// DisplaySkips; docs/bench.md "Skips"): this path ends in code values, so
+    /// what cannot move a code by the threshold is left out.
+    Pipeline();
+    void set_frame_options(const FrameOptions& options) { frame_.set_options(options); }
 
     /// Renders the scene at time_s (s) and runs adaptation over dt_s (s since
     /// the previous frame; 0 for the first). Validates scene.output first.

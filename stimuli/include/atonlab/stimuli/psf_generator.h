@@ -12,15 +12,28 @@
 
 namespace atonlab::stimuli {
 
-/// GPU time of the last generate() per stage (ms), from timer queries.
+/// GPU time of the last generate() per stage (ms), from timer queries (fft_ms:
+/// the CPU's steady clock when the FFT ran on the CPU).
 struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
+};
+
+/// Where the generator's FFT runs. The pupil plane is drawn on the CPU anyway,
+/// so transforming it there (FFTW double, rounded once to float) and uploading
+/// the spectrum replaces the compute-shader FFT: far cheaper where the "GPU" is
+/// the CPU (a software rasteriser; `atonlab bench`, fft_n512 on llvmpipe: 18 ms
+/// against 190 ms, and exact), far dearer than a real GPU's.
+enum class PsfFftPlacement {
+    automatic,  ///< the CPU on a software rasteriser (llvmpipe, softpipe, swrast), else the GPU
+    gpu,        ///< fp32 compute shaders (GpuFft)
+    cpu,        ///< FFTW double, rounded to float, then upload
 };
 
 class GpuPsfGenerator {
 public:
     /// n: a power of two in [kGpuFftMinSize, kGpuFftMaxSize] (InputError, key "size", otherwise).
-    explicit GpuPsfGenerator(int n, TwiddleSource twiddles = TwiddleSource::table_from_double);
+    explicit GpuPsfGenerator(int n, TwiddleSource twiddles = TwiddleSource::table_from_double,
+                             PsfFftPlacement fft = PsfFftPlacement::automatic);
     ~GpuPsfGenerator();
     GpuPsfGenerator(GpuPsfGenerator&&) noexcept;
     GpuPsfGenerator& operator=(GpuPsfGenerator&&) noexcept;
@@ -32,6 +45,8 @@ public:
     MonoPsf read_mono() const;
     RgbPsf read_rgb() const;
     PsfGpuTimings timings() const;
+    /// Where the FFT runs (automatic resolved).
+    PsfFftPlacement fft_placement() const;
 
 private:
     struct Impl;

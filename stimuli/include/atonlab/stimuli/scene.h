@@ -108,6 +108,11 @@ struct GlareSettings {
     std::string aperture_image;         ///< aperture: PNG or EXR, transmittance = luminance (white = clear)
     double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
     bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
+    /// The PSF cache's pupil step (mm): the kernel is computed for the pupil
+    /// diameter rounded to a multiple of this step, so a pupil that moves by
+    /// less (hippus, a drifting adaptation level) reuses the cached PSF. 0: the
+    /// exact pupil, rebuilt on any change. docs/bench.md measures the error.
+    double pupil_tolerance_mm = 0.0;
 };
 
 struct Scene {
