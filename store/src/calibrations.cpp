@@ -22,6 +22,61 @@ bool iso_date_prefix(std::string_view s) {
     return true;
 }
 
+bool unit_interval(double v) {
+    return std::isfinite(v) && v >= 0.0 && v <= 1.0;
+}
+
+// Why a reading cannot be stored ("" when it can): the schema's CHECKs, said
+// in words before anything is written.
+std::string reading_problem(const CalibrationReading& r) {
+    if (r.patch.empty()) return "has no patch name";
+    if (r.channel != "red" && r.channel != "green" && r.channel != "blue" && r.channel != "grey" &&
+        r.channel != "other")
+        return fmt::format("has channel \"{}\"; it must be red, green, blue, grey or other", r.channel);
+    if (!unit_interval(r.level)) return fmt::format("has level {}, outside [0, 1]", r.level);
+    if (!unit_interval(r.drive_r) || !unit_interval(r.drive_g) || !unit_interval(r.drive_b))
+        return "has a drive level outside [0, 1]";
+    if (!std::isfinite(r.luminance_cd_m2) || r.luminance_cd_m2 < 0.0)
+        return fmt::format("has luminance {} cd/m2; it must be a finite number >= 0", r.luminance_cd_m2);
+    if (r.code.has_value() != r.bits.has_value()) return "has a code value without its bits, or bits without a code";
+    if (r.bits && (*r.bits < 1 || *r.bits > 16)) return fmt::format("has {} bits; 1 to 16 are possible", *r.bits);
+    if (r.code && (*r.code < 0 || *r.code > (1 << *r.bits) - 1))
+        return fmt::format("has code {}, outside 0..{} for {} bits", *r.code, (1 << *r.bits) - 1, *r.bits);
+    if (r.xyz_x_cd_m2.has_value() != r.xyz_z_cd_m2.has_value()) return "has X without Z or Z without X";
+    if (r.xyz_x_cd_m2 && !(std::isfinite(*r.xyz_x_cd_m2) && std::isfinite(*r.xyz_z_cd_m2)))
+        return "has an X or Z that is not a finite number";
+    if (r.source_line && *r.source_line < 1)
+        return fmt::format("has source line {}; lines count from 1", *r.source_line);
+    return {};
+}
+
+void insert_readings(sql::Connection& db, CalibrationId id, std::span<const CalibrationReading> readings,
+                     std::string_view doing) {
+    static constexpr const char* sql_insert =
+        "INSERT INTO calibration_readings (calibration_id, seq, patch, channel, level, code, bits, drive_r, "
+        "drive_g, drive_b, luminance_cd_m2, xyz_x_cd_m2, xyz_z_cd_m2, source_line) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)";
+    for (std::size_t i = 0; i < readings.size(); ++i) {
+        const CalibrationReading& r = readings[i];
+        sql::Use s(db.cached(sql_insert));
+        s->bind(1, id.value);
+        s->bind(2, static_cast<std::int64_t>(i));
+        s->bind(3, r.patch);
+        s->bind(4, r.channel);
+        s->bind(5, r.level);
+        s->bind(6, r.code);
+        s->bind(7, r.bits);
+        s->bind(8, r.drive_r);
+        s->bind(9, r.drive_g);
+        s->bind(10, r.drive_b);
+        s->bind(11, r.luminance_cd_m2);
+        s->bind(12, r.xyz_x_cd_m2);
+        s->bind(13, r.xyz_z_cd_m2);
+        s->bind(14, r.source_line);
+        s->run(doing);
+    }
+}
+
 Calibration calibration_from_row(const sql::Statement& s) {
     Calibration c;
     c.id = CalibrationId{s.int64(0)};
@@ -40,7 +95,7 @@ Calibration calibration_from_row(const sql::Statement& s) {
 
 }  // namespace
 
-CalibrationId Store::put_calibration(const Calibration& c) {
+CalibrationId Store::put_calibration(const Calibration& c, std::span<const CalibrationReading> readings) {
     const std::string doing = fmt::format("store a calibration of display \"{}\"", c.display_name);
     impl_->require_writable(doing);
     if (c.display_name.empty()) impl_->invalid(doing, "the display name is empty");
@@ -49,6 +104,9 @@ CalibrationId Store::put_calibration(const Calibration& c) {
         impl_->invalid(doing, "the width, height and viewing distance must be positive metres");
     }
     if (!iso_date_prefix(c.measured_at)) impl_->invalid(doing, "measured_at is not an ISO 8601 date (YYYY-MM-DD...)");
+    for (std::size_t i = 0; i < readings.size(); ++i)
+        if (const std::string why = reading_problem(readings[i]); !why.empty())
+            impl_->invalid(doing, fmt::format("reading {} (patch \"{}\") {}", i, readings[i].patch, why));
     sql::Connection& db = *impl_->db;
     sql::Transaction tx(db, sql::Transaction::Kind::write, doing);
     if (!json_valid(db, c.fit_json, doing)) impl_->invalid(doing, "fit_json is not valid JSON");
@@ -78,6 +136,7 @@ CalibrationId Store::put_calibration(const Calibration& c) {
     s->run(doing);
     const CalibrationId id{sqlite3_last_insert_rowid(db.get())};
     s->reset();
+    insert_readings(db, id, readings, doing);
     tx.commit();
     return id;
 }
@@ -91,6 +150,19 @@ std::optional<Calibration> Store::latest_calibration(std::string_view display_na
     s->bind(1, display_name);
     if (!s->step(fmt::format("read the latest calibration of display \"{}\"", display_name))) return std::nullopt;
     return calibration_from_row(*s);
+}
+
+std::vector<Calibration> Store::calibrations(std::string_view display_name) const {
+    static constexpr const char* sql_all =
+        "SELECT c.id, d.name, c.width_px, c.height_px, c.width_m, c.height_m, c.viewing_distance_m, c.fit_json, "
+        "c.source, c.measured_at, c.recorded_at FROM calibrations c JOIN displays d ON d.id = c.display_id "
+        "WHERE d.name = ?1 ORDER BY c.measured_at DESC, c.id DESC";
+    const std::string doing = fmt::format("read the calibrations of display \"{}\"", display_name);
+    sql::Use s(impl_->db->cached(sql_all));
+    s->bind(1, display_name);
+    std::vector<Calibration> out;
+    while (s->step(doing)) out.push_back(calibration_from_row(*s));
+    return out;
 }
 
 Calibration Store::calibration(CalibrationId id) const {

@@ -138,8 +138,65 @@ JOIN observers o ON o.id = s.observer_id
 JOIN protocols p ON p.id = s.protocol_id;
 )sql";
 
-constexpr std::array<Migration, 1> migrations = {
+// Version 2: the photometer readings behind a calibration and the checks of a
+// calibration against fresh readings (docs/calibration.md). Calibrations
+// become append-only in the file itself, as they always were by convention.
+constexpr std::string_view schema_v2 = R"sql(
+-- The photometer readings a calibration was fitted to, in the order they were
+-- measured (or listed in the imported file): the evidence behind its fit_json.
+CREATE TABLE calibration_readings (
+    id              INTEGER PRIMARY KEY,
+    calibration_id  INTEGER NOT NULL REFERENCES calibrations(id),
+    seq             INTEGER NOT NULL CHECK (seq >= 0),          -- 0, 1, 2, ... in measuring order
+    patch           TEXT NOT NULL CHECK (length(patch) > 0),   -- "black", "grey-128", "red-064", ...
+    channel         TEXT NOT NULL CHECK (channel IN ('red', 'green', 'blue', 'grey', 'other')),
+    level           REAL NOT NULL CHECK (level BETWEEN 0 AND 1),  -- drive of the lit channel(s)
+    code            INTEGER CHECK (code >= 0),                  -- the integer code value sent; NULL for imports
+    bits            INTEGER CHECK (bits BETWEEN 1 AND 16),      -- bits per channel of code
+    drive_r         REAL NOT NULL CHECK (drive_r BETWEEN 0 AND 1),  -- the patch's drive levels
+    drive_g         REAL NOT NULL CHECK (drive_g BETWEEN 0 AND 1),
+    drive_b         REAL NOT NULL CHECK (drive_b BETWEEN 0 AND 1),
+    luminance_cd_m2 REAL NOT NULL CHECK (luminance_cd_m2 >= 0), -- the reading: Y, cd/m2
+    xyz_x_cd_m2     REAL,                                       -- CIE 1931 X on the same scale as Y; NULL if not read
+    xyz_z_cd_m2     REAL,                                       -- CIE 1931 Z likewise
+    source_line     INTEGER CHECK (source_line > 0),            -- line of the readings file; NULL when typed
+    CHECK ((code IS NULL) = (bits IS NULL)),
+    CHECK ((xyz_x_cd_m2 IS NULL) = (xyz_z_cd_m2 IS NULL)),
+    UNIQUE (calibration_id, seq)
+);
+
+-- A calibration re-measured on a few patches and compared with its model:
+-- pass or fail, with every tolerance, value and patch in results_json.
+CREATE TABLE calibration_checks (
+    id             INTEGER PRIMARY KEY,
+    calibration_id INTEGER NOT NULL REFERENCES calibrations(id),
+    checked_at     TEXT NOT NULL,                 -- ISO 8601 date (or date-time) of the measurement
+    passed         INTEGER NOT NULL CHECK (passed IN (0, 1)),
+    results_json   TEXT NOT NULL CHECK (json_valid(results_json)),
+    source         TEXT NOT NULL,                 -- "measured", "readings FILE", ...
+    recorded_at    TEXT NOT NULL
+);
+CREATE INDEX calibration_checks_by_calibration ON calibration_checks (calibration_id, checked_at);
+
+-- Nothing stored is lost: calibrations, their readings and their checks are
+-- never changed or deleted (a new calibration is a new row).
+CREATE TRIGGER calibrations_append_only_update BEFORE UPDATE ON calibrations
+BEGIN SELECT RAISE(ABORT, 'calibrations are append-only: a stored calibration cannot be changed'); END;
+CREATE TRIGGER calibrations_append_only_delete BEFORE DELETE ON calibrations
+BEGIN SELECT RAISE(ABORT, 'calibrations are append-only: a stored calibration cannot be deleted'); END;
+CREATE TRIGGER calibration_readings_append_only_update BEFORE UPDATE ON calibration_readings
+BEGIN SELECT RAISE(ABORT, 'calibration readings are append-only: a stored reading cannot be changed'); END;
+CREATE TRIGGER calibration_readings_append_only_delete BEFORE DELETE ON calibration_readings
+BEGIN SELECT RAISE(ABORT, 'calibration readings are append-only: a stored reading cannot be deleted'); END;
+CREATE TRIGGER calibration_checks_append_only_update BEFORE UPDATE ON calibration_checks
+BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be changed'); END;
+CREATE TRIGGER calibration_checks_append_only_delete BEFORE DELETE ON calibration_checks
+BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be deleted'); END;
+)sql";
+
+constexpr std::array<Migration, 2> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
+    Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
 };
 
 }  // namespace

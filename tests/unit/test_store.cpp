@@ -74,7 +74,8 @@ TEST(Store, NewFileHasSchemaWalAndVersion) {
     EXPECT_EQ(raw.integer("PRAGMA application_id"), 0x41544F4E);
     EXPECT_EQ(raw.text("SELECT group_concat(name, ',') FROM (SELECT name FROM sqlite_schema WHERE type = 'table' "
                        "ORDER BY name)"),
-              "calibrations,displays,observers,protocols,schema_history,sessions,snapshots,trials");
+              "calibration_checks,calibration_readings,calibrations,displays,observers,protocols,schema_history,"
+              "sessions,snapshots,trials");
     EXPECT_EQ(raw.text("SELECT software_version FROM schema_history WHERE version = 1"), software_version());
     EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
     EXPECT_EQ(raw.text("PRAGMA foreign_key_check"), "");
@@ -373,13 +374,16 @@ TEST(StoreMigrations, OlderFileIsMigratedKeepingItsData) {
         const SessionId id = s.begin_session(make_start());
         for (int i = 0; i < 3; ++i) s.record_trial(id, make_trial(i));
     }
-    const std::vector<Migration> steps = {schema_migrations()[0], Migration{2, "session notes", add_notes_sql}};
+    // This build's steps, then one more (the file is at this build's version).
+    const int n = schema_version();
+    std::vector<Migration> steps(schema_migrations().begin(), schema_migrations().end());
+    steps.push_back(Migration{n + 1, "session notes", add_notes_sql});
     detail::migrate_file(path, steps);
 
     RawDb raw(path);
-    EXPECT_EQ(raw.integer("PRAGMA user_version"), 2);
+    EXPECT_EQ(raw.integer("PRAGMA user_version"), n + 1);
     EXPECT_EQ(raw.integer("SELECT count(*) FROM sessions WHERE notes = ''"), 1);
-    EXPECT_EQ(raw.integer("SELECT count(*) FROM schema_history"), 2);
+    EXPECT_EQ(raw.integer("SELECT count(*) FROM schema_history"), n + 1);
     EXPECT_EQ(raw.text("SELECT stimulus_json FROM trials WHERE trial_index = 2"), make_trial(2).stimulus_json);
     EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
 }
@@ -392,15 +396,17 @@ TEST(StoreMigrations, FailingStepLeavesTheFileAsItWas) {
         s.record_trial(s.begin_session(make_start()), make_trial(0));
     }
     const std::string before = test_support::file_bytes(path);
-    // Step 2 succeeds, step 3 fails: neither may remain.
-    const std::vector<Migration> steps = {schema_migrations()[0], Migration{2, "session notes", add_notes_sql},
-                                          Migration{3, "broken", "ALTER TABLE no_such_table ADD COLUMN x;"}};
+    // Step N+1 succeeds, step N+2 fails: neither may remain.
+    const int n = schema_version();
+    std::vector<Migration> steps(schema_migrations().begin(), schema_migrations().end());
+    steps.push_back(Migration{n + 1, "session notes", add_notes_sql});
+    steps.push_back(Migration{n + 2, "broken", "ALTER TABLE no_such_table ADD COLUMN x;"});
     const std::string msg = expect_store_error(StoreErrc::other, [&] { detail::migrate_file(path, steps); });
-    EXPECT_NE(msg.find("migrate the schema to version 3"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("migrate the schema to version " + std::to_string(n + 2)), std::string::npos) << msg;
     EXPECT_NE(msg.find("no_such_table"), std::string::npos) << msg;
     EXPECT_EQ(test_support::file_bytes(path), before);
     RawDb raw(path);
-    EXPECT_EQ(raw.integer("PRAGMA user_version"), 1);
+    EXPECT_EQ(raw.integer("PRAGMA user_version"), n);
     EXPECT_EQ(raw.integer("SELECT count(*) FROM pragma_table_info('sessions') WHERE name = 'notes'"), 0);
 }
 

@@ -50,6 +50,45 @@ struct Calibration {
     std::string recorded_at;  ///< when the store wrote the row
 };
 
+/// One photometer reading behind a calibration (table calibration_readings):
+/// the patch shown and what the meter read. Luminance in cd/m².
+struct CalibrationReading {
+    std::string patch;    ///< the patch's name: "black", "grey-128", "red-064", ... (not empty)
+    std::string channel;  ///< "red", "green", "blue", "grey" (R = G = B, black and white included) or "other"
+    double level = 0.0;   ///< drive of the lit channel(s) in [0, 1]; for "other" the largest of R, G, B
+    /// The integer code value sent for the lit channel(s), at `bits` per channel;
+    /// none when only a fraction is known (an imported file).
+    std::optional<int> code;
+    std::optional<int> bits;                             ///< with `code`: bits per channel, 1..16
+    double drive_r = 0.0, drive_g = 0.0, drive_b = 0.0;  ///< the patch's drive levels, [0, 1]
+    double luminance_cd_m2 = 0.0;                        ///< the reading, Y in cd/m², >= 0
+    /// CIE 1931 X and Z on the same absolute scale as Y (cd/m²), when the meter gave them.
+    std::optional<double> xyz_x_cd_m2, xyz_z_cd_m2;
+    std::optional<int> source_line;  ///< 1-based line of the file it came from; none when typed
+
+    friend bool operator==(const CalibrationReading&, const CalibrationReading&) = default;
+};
+
+/// The row id of a calibration check.
+struct CalibrationCheckId {
+    std::int64_t value = 0;
+    friend auto operator<=>(const CalibrationCheckId&, const CalibrationCheckId&) = default;
+};
+
+/// A calibration re-measured on a few patches and compared with its model
+/// (table calibration_checks). Never updated: a new check is a new row.
+struct CalibrationCheck {
+    CalibrationId calibration{};      ///< the calibration that was checked
+    std::string checked_at;           ///< ISO 8601 date or date-time of the measurement (YYYY-MM-DD...)
+    bool passed = false;              ///< every tolerance held
+    std::string results_json = "{}";  ///< tolerances, measured values and patches, JSON text (docs/calibration.md)
+    std::string source;               ///< how the readings were taken: "measured", "readings FILE", ...
+
+    // Filled by the store on read.
+    CalibrationCheckId id{};
+    std::string recorded_at;
+};
+
 /// What begin_session() needs.
 struct SessionStart {
     std::string observer_code;                 ///< 1-32 of [A-Za-z0-9_-]: a code, never a name

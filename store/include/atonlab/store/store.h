@@ -56,12 +56,27 @@ public:
     bool read_only() const noexcept;
 
     // --- Displays -----------------------------------------------------------
-    /// Stores a calibration (and its display, by name, if new).
-    CalibrationId put_calibration(const Calibration& calibration);
+    /// Stores a calibration (and its display, by name, if new) with the
+    /// photometer readings it was fitted to, in one transaction: all or nothing.
+    /// Readings are checked (names, channels, ranges) before anything is written.
+    CalibrationId put_calibration(const Calibration& calibration, std::span<const CalibrationReading> readings = {});
     /// The display's calibration with the latest measured_at (then the latest
     /// stored), or std::nullopt when the display has none.
     std::optional<Calibration> latest_calibration(std::string_view display_name) const;
     Calibration calibration(CalibrationId id) const;
+    /// Every calibration of the display, latest first (as latest_calibration orders them).
+    std::vector<Calibration> calibrations(std::string_view display_name) const;
+    /// The readings stored with a calibration, in measuring order (none for a
+    /// calibration stored without readings). not_found for an unknown id.
+    std::vector<CalibrationReading> calibration_readings(CalibrationId id) const;
+
+    /// Stores a check of a calibration (the calibration must exist).
+    CalibrationCheckId put_calibration_check(const CalibrationCheck& check);
+    /// The calibration's check with the latest checked_at (then the latest
+    /// stored), or std::nullopt when it has never been checked.
+    std::optional<CalibrationCheck> latest_calibration_check(CalibrationId id) const;
+    /// Every check of the calibration, latest first.
+    std::vector<CalibrationCheck> calibration_checks(CalibrationId id) const;
 
     // --- Sessions -----------------------------------------------------------
     /// Records the observer and the protocol (once per text hash) if new and
