@@ -14,7 +14,9 @@ packages=(
   libtomlplusplus-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev libnlopt-cxx-dev libstb-dev fonts-dejavu-core
+  gnuplot-nox
   xvfb xauth
+  xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
 )
 
 missing=()

@@ -27,9 +27,13 @@ using detail::Section;
 
 constexpr std::string_view kRootKeys[] = {"protocol", "display", "timing", "responses", "screens", "defaults", "block"};
 constexpr std::string_view kProtocolKeys[] = {"name", "description", "scene", "seed", "adaptation_s"};
-constexpr std::string_view kDisplayKeys[] = {"width_px", "height_px", "width_m", "viewing_distance_m"};
-constexpr std::string_view kTimingKeys[] = {"stimulus_s", "inter_stimulus_s", "inter_trial_s", "response_timeout_s"};
-constexpr std::string_view kScreenKeys[] = {"instructions", "break", "end"};
+constexpr std::string_view kDisplayKeys[] = {"width_px",           "height_px", "width_m",
+                                             "viewing_distance_m", "name",      "max_calibration_age_days"};
+constexpr std::string_view kTimingKeys[] = {"stimulus_s",          "inter_stimulus_s", "inter_trial_s",
+                                            "response_timeout_s",  "repeat_missed",    "refresh_hz",
+                                            "adaptation_skippable"};
+constexpr std::string_view kScreenKeys[] = {"instructions", "break",         "end",     "text_cd_m2",
+                                            "cue_cd_m2",    "text_size_deg", "fixation"};
 constexpr std::string_view kResponseKeys[] = {"keys", "gamepad"};
 constexpr std::string_view kActionNames[] = {"left",    "right",     "yes",     "no",       "coarse_up", "coarse_down",
                                              "fine_up", "fine_down", "confirm", "continue", "quit"};
@@ -490,6 +494,15 @@ private:
         s.greater_than("width_m", p.display.width_m, 0.0);
         p.display.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen in metres");
         s.greater_than("viewing_distance_m", p.display.viewing_distance_m, 0.0);
+        // Optional: which calibrated display this is, and how old its calibration may be.
+        if (auto name = s.string("name")) {
+            if (name->empty()) s.fail("name", "the display's name must not be empty (leave the key out instead).");
+            p.display.name = *name;
+        }
+        if (auto days = s.number("max_calibration_age_days")) {
+            s.greater_than("max_calibration_age_days", *days, 0.0);
+            p.display.max_calibration_age_days = *days;
+        }
     }
 
     void read_timing(const Section& root, Protocol& p) {
@@ -513,6 +526,15 @@ private:
             s.greater_than("response_timeout_s", *v, 0.0);
             p.timing.response_timeout_s = *v;
         }
+        if (const toml::node* n = s.get("repeat_missed"))
+            p.timing.repeat_missed = doc_.boolean(n, s.key_path("repeat_missed"));
+        if (auto v = s.number("refresh_hz")) {
+            if (!(*v >= 1.0 && *v <= 1000.0))
+                s.fail("refresh_hz", fmt::format("the refresh rate must be 1 to 1000 Hz, not {}.", *v));
+            p.timing.refresh_hz = *v;
+        }
+        if (const toml::node* n = s.get("adaptation_skippable"))
+            p.timing.adaptation_skippable = doc_.boolean(n, s.key_path("adaptation_skippable"));
     }
 
     void read_screens(const Section& root, Protocol& p) {
@@ -523,6 +545,21 @@ private:
         p.screens.instructions = s.string("instructions").value_or("");
         p.screens.between = s.string("break").value_or("");
         p.screens.end = s.string("end").value_or("");
+        if (auto v = s.number("text_cd_m2")) {
+            s.greater_than("text_cd_m2", *v, 0.0);
+            p.screens.text_cd_m2 = *v;
+        }
+        if (auto v = s.number("cue_cd_m2")) {
+            s.greater_than("cue_cd_m2", *v, 0.0);
+            p.screens.cue_cd_m2 = *v;
+        }
+        if (auto v = s.number("text_size_deg")) {
+            if (!(*v >= 0.05 && *v <= 10.0))
+                s.fail("text_size_deg",
+                       fmt::format("a line of text must be 0.05 to 10 degrees of visual angle high, not {}.", *v));
+            p.screens.text_size_deg = *v;
+        }
+        if (const toml::node* n = s.get("fixation")) p.screens.fixation = doc_.boolean(n, s.key_path("fixation"));
     }
 
     void read_responses(const Section& root, Protocol& p) {

@@ -43,7 +43,8 @@ void add_psf_command(CLI::App& app, PsfOptions& options);
 int run_psf(const PsfOptions& options);
 
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
-/// GL, 4 the study file failed (StoreError), 128 + N stopped by signal N.
+/// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
+/// 6 the observer ended the session (quit key, confirmed), 128 + N stopped by signal N.
 struct RunOptions {
     std::string protocol;
     std::string db;
@@ -59,9 +60,57 @@ struct RunOptions {
     int progress_every = 0;         ///< 0: 25 when stdout is not a terminal (a terminal gets one updating line)
     bool true_pse = true;           ///< model observer: compute the true PSE / threshold for the summary
     std::int64_t db_max_bytes = 0;  ///< > 0: the study file may not grow past this (StoreOptions::max_size_bytes)
+
+    // On screen (without --headless; docs/running.md "On screen").
+    int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary
+    std::optional<double> software_vsync_hz;  ///< pace flips by a timer (a display without vblank, e.g. Xvfb)
+    bool skip_sync_test = false;              ///< start even when the refresh measurement fails
+    double sync_sd_max_ms = 1.0;              ///< the flip intervals' SD must be below this, ms
+    double refresh_tolerance = 0.02;          ///< measured vs nominal refresh rate, relative
+    std::string font;                         ///< TrueType font (default DejaVu Sans)
+    bool trace = false;                       ///< print what each screen waits for (tests drive keys from it)
+
+    // Test-only (docs/running.md "Testing").
+    int inject_stall_frames = 0;                        ///< stall this many refreshes after a stimulus onset ...
+    std::optional<std::int64_t> inject_stall_at_trial;  ///< ... of this trial (the store's trial_index)
+    std::optional<std::int64_t> capture_trial;          ///< capture each frame of this trial as shown ...
+    std::string capture_dir;                            ///< ... into this folder
+    std::string capture_screen_file;                    ///< ... copying this file (Xvfb -fbdir's screen) instead of
+                                                        ///< reading the GL back buffer
 };
 
 void add_run_command(CLI::App& app, RunOptions& options);
 int run_run(const RunOptions& options);
+
+/// `atonlab analyze` (docs/analysis.md). Exit status: 0 done, 2 bad input, 4 a
+/// study file could not be read, 5 the report was written without some figures.
+struct AnalyzeOptions {
+    std::vector<std::string> studies;  ///< study files, opened read-only
+    std::vector<std::string> csv;      ///< long-format CSVs of trials (--csv)
+    std::string out;                   ///< output folder
+    std::optional<int> bootstrap;      ///< resamples per fit (default 999)
+    std::optional<std::uint64_t> seed;
+    std::string family;                ///< normal, logistic, weibull, gumbel (default normal)
+    int last_reversals = 6;
+    std::optional<int> threads;
+    std::string gnuplot = "gnuplot";
+    bool quiet = false;
+};
+
+void add_analyze_command(CLI::App& app, AnalyzeOptions& options);
+int run_analyze(const AnalyzeOptions& options);
+
+/// `atonlab bench` (docs/bench.md).
+struct BenchCommandOptions {
+    bool quick = false;
+    std::string out_dir;
+    std::vector<std::string> only;
+    std::string device_label;
+    bool no_plots = false;
+    bool quiet = false;
+};
+
+void add_bench_command(CLI::App& app, BenchCommandOptions& options);
+int run_bench(const BenchCommandOptions& options);
 
 }  // namespace atonlab::runner

@@ -1,7 +1,8 @@
 // atonlab: one binary, subcommands (DESIGN.md "Command line").
 // Bad input: one sentence on stderr naming file, line and key; exit status 2.
 // No usable GL: one sentence saying why; exit status 3.
-// `atonlab run`: the study file failed (StoreError): exit status 4 (run_command.cpp).
+// `atonlab run`: the study file failed (StoreError): exit status 4 (run_command.cpp); on screen,
+// the display's timing refused: 5; the observer ended the session (quit key, confirmed): 6.
 #include <cstdio>
 #include <exception>
 
@@ -9,7 +10,9 @@
 
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
+#include "calibrate_command.h"
 #include "commands.h"
+#include "view_command.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"atonlab: a psychophysics harness for Aids-to-Navigation lights", "atonlab"};
@@ -21,6 +24,14 @@ int main(int argc, char** argv) {
     atonlab::runner::add_psf_command(app, psf);
     atonlab::runner::RunOptions run;
     atonlab::runner::add_run_command(app, run);
+    atonlab::runner::AnalyzeOptions analyze;
+    atonlab::runner::add_analyze_command(app, analyze);
+    atonlab::runner::CalibrateOptions calibrate;
+    atonlab::runner::add_calibrate_command(app, calibrate);
+    atonlab::runner::ViewOptions view;
+    atonlab::runner::add_view_command(app, view);
+    atonlab::runner::BenchCommandOptions bench;
+    atonlab::runner::add_bench_command(app, bench);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -30,6 +41,10 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);
         if (app.got_subcommand("psf")) return atonlab::runner::run_psf(psf);
         if (app.got_subcommand("run")) return atonlab::runner::run_run(run);
+        if (app.got_subcommand("analyze")) return atonlab::runner::run_analyze(analyze);
+        if (app.got_subcommand("calibrate")) return atonlab::runner::run_calibrate(calibrate);
+        if (app.got_subcommand("view")) return atonlab::runner::run_view(view);
+        if (app.got_subcommand("bench")) return atonlab::runner::run_bench(bench);
     } catch (const atonlab::InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;

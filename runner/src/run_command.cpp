@@ -1,12 +1,15 @@
-// `atonlab run PROTOCOL.toml --db STUDY.db (--model-observer | --script FILE [--observer ID]) --headless
-//      [--resume SESSION_ID | --resume-last] [--seed N] [--observer-seed N] [--quiet]`
-// A protocol's session, headless, each trial committed to the study file before
-// the next is shown (docs/running.md). The engine is run_session.cpp; this file
-// is the command line and the exit status of a study-file failure (4).
+// `atonlab run PROTOCOL.toml --db STUDY.db (--observer ID | --headless (--model-observer | --script FILE))
+//      [--resume SESSION_ID | --resume-last] [--seed N] [--observer-seed N] [--quiet] [on-screen options]`
+// A protocol's session, full screen with a person (or an observer) or headless,
+// each trial committed to the study file before the next is shown
+// (docs/running.md). The engine is run_session.cpp; this file is the command
+// line and the exit statuses of a study-file failure (4) and of a display whose
+// timing is refused (5).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
 #include "atonlab/protocols/protocol.h"
+#include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/error.h"
 #include "commands.h"
 #include "run_session.h"
@@ -16,7 +19,8 @@ namespace atonlab::runner {
 void add_run_command(CLI::App& app, RunOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "run",
-        "Run a protocol's session headless with a model or scripted observer, logging every trial to a study file");
+        "Run a protocol's session, full screen for a person (--observer ID) or headless with a model or scripted "
+        "observer, logging every trial to a study file");
     cmd->add_option("protocol", o.protocol, "Protocol file (TOML; see docs/protocol-file.md)")->required();
     cmd->add_option("--db", o.db, "Study file (SQLite; created if absent; see docs/store.md)")->required();
     auto* model =
@@ -24,10 +28,12 @@ void add_run_command(CLI::App& app, RunOptions& o) {
     auto* script = cmd->add_option("--script", o.script,
                                    "Answer from a file, one answer per line (docs/protocol-file.md, Observers)");
     auto* observer = cmd->add_option("--observer", o.observer,
-                                     "Observer code (1-32 of A-Z a-z 0-9 _ -); with --script (default \"script\")");
+                                     "Observer code (1-32 of A-Z a-z 0-9 _ -): the person at the screen, or with "
+                                     "--script the code stored (default \"script\")");
     model->excludes(script);
     model->excludes(observer);
-    cmd->add_flag("--headless", o.headless, "Render off-screen; no window (required in this build)");
+    cmd->add_flag("--headless", o.headless,
+                  "Render off-screen (EGL) on a virtual display; needs --model-observer or --script");
     auto* resume = cmd->add_option("--resume", o.resume, "Continue this session (its id in the study file)");
     auto* last = cmd->add_flag("--resume-last", o.resume_last,
                                "Continue the latest unfinished session of this protocol and observer");
@@ -46,6 +52,53 @@ void add_run_command(CLI::App& app, RunOptions& o) {
     cmd->add_flag_callback(
         "--no-true-pse", [&o] { o.true_pse = false; },
         "Model observer: skip computing its true PSE / threshold for the summary");
+
+    // On screen (docs/running.md, "On screen" and "Timing").
+    const char* screen = "On screen";
+    cmd->add_option("--monitor", o.monitor,
+                    "Full screen on this monitor (GLFW's order; 0, the default, is the primary)")
+        ->check(CLI::NonNegativeNumber)
+        ->group(screen);
+    cmd->add_option("--software-vsync", o.software_vsync_hz,
+                    "A display with no vertical blank (Xvfb, some virtual machines): pace flips with a timer at this "
+                    "rate, Hz. For testing only")
+        ->check(CLI::Range(1.0, 1000.0))
+        ->group(screen);
+    cmd->add_flag("--skip-sync-test", o.skip_sync_test,
+                  "Start even when the refresh measurement fails (reported, not enforced). For testing only")
+        ->group(screen);
+    cmd->add_option("--sync-sd-max-ms", o.sync_sd_max_ms,
+                    "The start-up measurement's flip intervals must have an SD below this, ms (default 1)")
+        ->check(CLI::Range(0.001, 100.0))
+        ->group(screen);
+    cmd->add_option("--refresh-tolerance", o.refresh_tolerance,
+                    "The measured refresh rate may differ from the nominal by this fraction (default 0.02)")
+        ->check(CLI::Range(0.0001, 1.0))
+        ->group(screen);
+    cmd->add_option("--font", o.font, "TrueType font for the screens (default DejaVu Sans, fonts-dejavu-core)")
+        ->group(screen);
+    cmd->add_flag("--trace", o.trace, "Print what each screen waits for (\"trace: ...\" lines on stdout)")
+        ->group(screen);
+
+    // Test-only hooks (docs/running.md, "Testing").
+    const char* testing = "Testing (not for studies)";
+    cmd->add_option("--inject-stall-frames", o.inject_stall_frames,
+                    "Stall this many refreshes after the stimulus onset of the trial --inject-stall-at-trial names")
+        ->check(CLI::Range(1, 600))
+        ->group(testing);
+    cmd->add_option("--inject-stall-at-trial", o.inject_stall_at_trial,
+                    "The trial (the study file's trial_index, from 0) whose stimulus stalls")
+        ->check(CLI::NonNegativeNumber)
+        ->group(testing);
+    cmd->add_option("--capture-trial", o.capture_trial,
+                    "Capture every frame of this trial (trial_index) as it is shown, into --capture-dir (PNG: the drawn back buffer)")
+        ->check(CLI::NonNegativeNumber)
+        ->group(testing);
+    cmd->add_option("--capture-dir", o.capture_dir, "Folder for --capture-trial's images")->group(testing);
+    cmd->add_option("--capture-screen-file", o.capture_screen_file,
+                    "Capture by copying this file (the screen Xvfb -fbdir maps) after a round trip to the X server, "
+                    "instead of reading the GL back buffer")
+        ->group(testing);
 }
 
 int run_run(const RunOptions& o) {
@@ -56,6 +109,10 @@ int run_run(const RunOptions& o) {
         // error, ...): what is stored stays as it was; one sentence, status 4.
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 4;
+    } catch (const DisplayTimingRefused& e) {
+        // The refresh measurement failed before any session began: nothing stored.
+        std::fprintf(stderr, "atonlab: %s\n", e.what());
+        return 5;
     } catch (const protocols::ProtocolError& e) {
         // A protocol or script error the engine did not already turn into an InputError.
         std::fprintf(stderr, "atonlab: %s\n", e.what());

@@ -1,6 +1,8 @@
 // The engine of `atonlab run` (run_session.h; docs/running.md).
 #include "run_session.h"
 
+#include "json_text.h"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -24,6 +26,9 @@
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/rng.h"
+#include "atonlab/runner/presenter.h"
+#include "atonlab/runner/screen_presenter.h"
+#include "atonlab/runner/text.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -31,6 +36,8 @@
 #include "atonlab/stimuli/tonemap.h"
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
+#include "calibration_policy.h"
+#include "session_display.h"
 
 namespace atonlab::runner {
 
@@ -81,41 +88,6 @@ private:
 // ---------------------------------------------------------------------------
 // Small helpers
 
-std::string json_string(std::string_view text) {
-    std::string out = "\"";
-    for (const char ch : text) {
-        const auto c = static_cast<unsigned char>(ch);
-        switch (ch) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\r':
-                out += "\\r";
-                break;
-            case '\t':
-                out += "\\t";
-                break;
-            default:
-                if (c < 0x20)
-                    out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-                else
-                    out += ch;
-        }
-    }
-    return out + "\"";
-}
-
-/// Shortest round-trip text of a finite double (JSON has no NaN or infinity: null then).
-std::string json_number(double v) {
-    return std::isfinite(v) ? fmt::format("{}", v) : std::string("null");
-}
-
 std::string read_text(const std::filesystem::path& file, std::string_view what) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(SourceLocation{file.string(), 0, 0, ""}, fmt::format("cannot read the {}.", what));
@@ -159,6 +131,12 @@ std::optional<p::Response> response_from_word(std::string_view w) {
     return std::nullopt;
 }
 
+/// The response codes of trials the procedure never saw (docs/running.md,
+/// "Missed frames and timeouts"): shown again, skipped on replay.
+bool is_uncounted(std::string_view response) {
+    return response == "missed" || response == "timeout";
+}
+
 bool valid_observer_code(std::string_view code) {
     if (code.empty() || code.size() > 32) return false;
     return std::all_of(code.begin(), code.end(), [](char c) {
@@ -174,13 +152,6 @@ std::string clock_text(double seconds) {
     const auto total = static_cast<long long>(std::llround(std::max(0.0, seconds)));
     if (total >= 3600) return fmt::format("{}:{:02}:{:02}", total / 3600, total / 60 % 60, total % 60);
     return fmt::format("{}:{:02}", total / 60, total % 60);
-}
-
-/// How long a trial's stimulus is on the screen: one interval, or two with the blank between (s).
-double presentation_s(const p::Protocol& protocol, const p::Condition& condition) {
-    const p::Timing& t = protocol.timing;
-    return condition.presentation == p::Presentation::TwoInterval ? 2.0 * t.stimulus_s + t.inter_stimulus_s
-                                                                  : t.stimulus_s;
 }
 
 /// The lights judged in frame `f` of a stimulus, in view order.
@@ -259,6 +230,7 @@ s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) cons
     parsed.reserve(overrides.size());
     for (const std::string& o : overrides) parsed.push_back(s::SceneOverride::parse(o));
     s::Scene scene = s::parse_scene(scene_text_, scene_file_.string(), parsed);
+    if (display_model_) apply_display_model(scene, *display_model_);
     s::validate_output_settings(scene.output);
     return scene;
 }
@@ -295,21 +267,19 @@ void StimulusRenderer::remember(const std::string& key, std::shared_ptr<const Fr
     }
 }
 
-std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
-                                                           const std::vector<std::string>& lights, s::ImageRGBA32F* hdr,
-                                                           double* degrees_per_pixel) {
-    const auto started = std::chrono::steady_clock::now();
-    const s::Scene sc = scene(frame.overrides);
-    auto out = std::make_shared<FrameViews>();
-    out->time_s = brightest_moment_s(sc, lights, interval_s_);
+s::EncodedImage StimulusRenderer::render_codes(const s::Scene& sc, double time_s) {
+    encode_scene(sc, time_s);
+    return display_.read_codes();
+}
 
+void StimulusRenderer::encode_scene(const s::Scene& sc, double time_s) {
     // stimuli::Pipeline::render, with two differences that make a frame a pure
     // function of its overrides (so a cached frame, and a resumed session, see
     // exactly what an uninterrupted run saw): each frame adapts afresh
     // (reset_adaptation, dt = 0: a dynamic scene adopts its own log-average; a
     // fixed one is unaffected), and the dither pattern is that of frame 0
     // instead of advancing with the number of frames rendered so far.
-    frame_.render(sc, out->time_s);
+    frame_.render(sc, time_s);
     const s::OutputSettings& os = sc.output;
     display_.reset_adaptation();
     if (const gl::Texture2D* glare = frame_.glare_texture();
@@ -323,28 +293,121 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         display_.process(frame_.hdr_texture(), os, 0.0, 0);
     }
     ++rendered_;
+}
 
-    const s::EncodedImage codes = display_.read_codes();
+std::shared_ptr<const s::EncodedImage> StimulusRenderer::codes(const p::Frame& frame,
+                                                               const std::vector<std::string>& lights) {
+    const std::string key = cache_key(frame, lights);
+    for (auto it = codes_lru_.begin(); it != codes_lru_.end(); ++it)
+        if (it->first == key) {
+            codes_lru_.splice(codes_lru_.begin(), codes_lru_, it);
+            return codes_lru_.front().second;
+        }
+    const auto started = std::chrono::steady_clock::now();
+    const s::Scene sc = scene(frame.overrides);
+    auto out = std::make_shared<const s::EncodedImage>(render_codes(sc, brightest_moment_s(sc, lights, interval_s_)));
+    render_s_ += seconds_since(started);
+    codes_lru_.emplace_front(key, out);
+    constexpr std::size_t kKeep = 8;  // a trial's frames and its background, with room to spare
+    while (codes_lru_.size() > kKeep) codes_lru_.pop_back();
+    return out;
+}
+
+bool StimulusRenderer::animated(const p::Frame& frame) {
+    const s::Scene sc = scene(frame.overrides);
+    return std::any_of(sc.lights.begin(), sc.lights.end(), [](const s::Light& l) { return l.rhythm_period_s > 0; });
+}
+
+void StimulusRenderer::encode(const p::Frame& frame, double time_s) {
+    // Parsed once per frame, not once per flip.
+    const std::string key = cache_key(frame, {});
+    if (!last_scene_.second || last_scene_.first != key)
+        last_scene_ = {key, std::make_shared<const s::Scene>(scene(frame.overrides))};
+    encode_scene(*last_scene_.second, time_s);
+}
+
+void StimulusRenderer::present(int x, int y) const {
+    display_.present(x, y);
+}
+
+std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::string>& overrides) const {
+    std::vector<std::string> names;
+    for (const s::Light& l : scene(overrides).lights) names.push_back(l.name);
+    return names;
+}
+
+const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame, const std::vector<std::string>& lights,
+                                                          double time_s) {
+    // The frame with every judged light off, at the same moment: what the
+    // screen shows around the lights without them. In a glare / no-glare
+    // comparison it is the same for every level of a condition, so a few
+    // cached frames serve a whole session.
+    p::Frame off = frame;
+    for (const std::string& name : lights)
+        if (!name.empty()) off.overrides.push_back(fmt::format("light.{}.intensity_cd=0", name));
+    const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
+    for (auto it = background_lru_.begin(); it != background_lru_.end(); ++it)
+        if (it->first == key) {
+            background_lru_.splice(background_lru_.begin(), background_lru_, it);
+            return background_lru_.front().second;
+        }
+    background_lru_.emplace_front(key, render_codes(scene(off.overrides), time_s));
+    constexpr std::size_t kBackgroundFrames = 8;
+    while (background_lru_.size() > kBackgroundFrames) background_lru_.pop_back();
+    return background_lru_.front().second;
+}
+
+namespace {
+
+/// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
+/// (row 0 at the top) for the codes given: the display model's luminance,
+/// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
+std::vector<float> emitted_window(const s::EncodedImage& codes, const s::DisplayModel& display, int x0, int y0, int n) {
+    std::map<std::uint64_t, float> emitted;
+    std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
+    for (int v = 0; v < n; ++v) {
+        const int y = y0 + v;
+        if (y < 0 || y >= codes.height) continue;
+        for (int u = 0; u < n; ++u) {
+            const int x = x0 + u;
+            if (x < 0 || x >= codes.width) continue;
+            const std::size_t i =
+                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
+                3;
+            const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
+            const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
+                                    (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
+            auto [it, fresh] = emitted.try_emplace(k, 0.0f);
+            if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(display, code, codes.bits));
+            out[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)] = it->second;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
+                                                           const std::vector<std::string>& lights, s::ImageRGBA32F* hdr,
+                                                           double* degrees_per_pixel) {
+    const auto started = std::chrono::steady_clock::now();
+    const s::Scene sc = scene(frame.overrides);
+    auto out = std::make_shared<FrameViews>();
+    out->time_s = brightest_moment_s(sc, lights, interval_s_);
+
+    const s::EncodedImage codes = render_codes(sc, out->time_s);
     const std::vector<s::LightDrawRecord> draws = frame_.read_light_draws();
-    const s::CameraProjection& proj = frame_.projection();
+    const s::CameraProjection proj = frame_.projection();
     const double dpp = proj.degrees_per_pixel_at_centre();
+    if (hdr) *hdr = frame_.read_hdr();
     const int half = static_cast<int>(std::ceil(2.0 * window_radius_deg_ / dpp)) + 2;
     const int n = 2 * half + 1;
 
-    // What the screen emits for each code triple: the display model's
-    // luminance (cd/m²), memoised per distinct code (a frame has few).
-    std::map<std::uint64_t, float> emitted;
-    auto luminance_at = [&](int x, int y) -> float {
-        const std::size_t i =
-            (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) * 3;
-        const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
-        const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
-                                (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
-        auto [it, fresh] = emitted.try_emplace(k, 0.0f);
-        if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(os.display, code, codes.bits));
-        return it->second;
+    struct Placed {
+        glm::ivec2 origin{0};
+        bool on_screen = false;
     };
-
+    std::vector<Placed> placed;
     for (const std::string& name : lights) {
         // The light's centre in window coordinates (origin lower-left): the GPU's
         // own projection when it drew the light, else the same pinhole on the CPU
@@ -373,25 +436,28 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         w.image.width = n;
         w.image.height = n;
         w.image.deg_per_px = dpp;
-        w.image.luminance_cd_m2.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
         const int x0 = static_cast<int>(std::floor(centre.x)) - half;
         const int y0 = static_cast<int>(std::floor(centre.y)) - half;
         w.light_px = centre - glm::dvec2(x0, y0);
-        if (!behind && std::isfinite(centre.x) && std::isfinite(centre.y)) {
-            for (int v = 0; v < n; ++v) {
-                const int y = y0 + v;
-                if (y < 0 || y >= codes.height) continue;
-                for (int u = 0; u < n; ++u) {
-                    const int x = x0 + u;
-                    if (x < 0 || x >= codes.width) continue;
-                    w.image.luminance_cd_m2[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) +
-                                            static_cast<std::size_t>(u)] = luminance_at(x, y);
-                }
-            }
-        }
+        const bool on_screen = !behind && std::isfinite(centre.x) && std::isfinite(centre.y);
+        w.image.luminance_cd_m2 = on_screen ? emitted_window(codes, sc.output.display, x0, y0, n)
+                                            : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+        placed.push_back({{x0, y0}, on_screen});
         out->windows.push_back(std::move(w));
     }
-    if (hdr) *hdr = frame_.read_hdr();
+    // What each window shows with the judged lights off, at the same pixels, so
+    // that the model observer judges what a light adds to its surround
+    // (observer.h window_light_lux), not the surround itself.
+    bool any_named = false;
+    for (const std::string& name : lights) any_named = any_named || !name.empty();
+    if (any_named) {
+        const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
+        for (std::size_t i = 0; i < out->windows.size(); ++i)
+            out->windows[i].image.background_cd_m2 =
+                placed[i].on_screen
+                    ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
+                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+    }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
     remember(cache_key(frame, lights), out);
     render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -558,6 +624,26 @@ std::optional<std::size_t> trial_bound(const p::Protocol& protocol, const p::Sch
     return total;
 }
 
+}  // namespace
+
+p::Shown shown_for(const p::ScheduledTrial& t, StimulusRenderer& renderer,
+                   std::vector<std::shared_ptr<const FrameViews>>& frames) {
+    frames.assign(t.stimulus.frames.size(), nullptr);
+    p::Shown shown;
+    shown.task = t.task;
+    shown.adjusted_view = t.stimulus.adjusted_view;
+    for (std::size_t f = 0; f < frames.size(); ++f)
+        frames[f] = renderer.views(t.stimulus.frames[f], judged_lights(t.stimulus, f));
+    std::vector<std::size_t> seen(frames.size(), 0);
+    for (const p::StimulusView& v : t.stimulus.views) {
+        const LightWindow& w = frames[v.frame]->windows[seen[v.frame]++];
+        shown.views.push_back(p::View{&w.image, w.light_px});
+    }
+    return shown;
+}
+
+namespace {
+
 // --- The observer ------------------------------------------------------------
 
 /// A model observer's answers are a pure function of (observer seed, the
@@ -570,6 +656,7 @@ public:
         : model_(o.model_observer), seed_(observer_seed), script_(std::move(script)) {}
 
     bool model() const noexcept { return model_; }
+    bool person() const noexcept { return !model_ && !script_; }  ///< a person answers at the screen
     std::uint64_t seed() const noexcept { return seed_; }
     const p::ModelObserverParams& params() const noexcept { return params_; }
 
@@ -581,18 +668,8 @@ public:
             current_ = std::make_unique<p::ModelObserver>(params_, p::derive_seed(seed_, t.step));
             match_ = match;
         }
-        std::vector<std::shared_ptr<const FrameViews>> frames(t.stimulus.frames.size());
-        p::Shown shown;
-        shown.task = t.task;
-        shown.adjusted_view = t.stimulus.adjusted_view;
-        for (std::size_t f = 0; f < frames.size(); ++f)
-            frames[f] = renderer->views(t.stimulus.frames[f], judged_lights(t.stimulus, f));
-        std::vector<std::size_t> seen(frames.size(), 0);
-        for (const p::StimulusView& v : t.stimulus.views) {
-            const LightWindow& w = frames[v.frame]->windows[seen[v.frame]++];
-            shown.views.push_back(p::View{&w.image, w.light_px});
-        }
-        return current_->answer(shown);
+        std::vector<std::shared_ptr<const FrameViews>> frames;
+        return current_->answer(shown_for(t, *renderer, frames));
     }
 
     /// A scripted observer skips the lines the logged trials used.
@@ -620,12 +697,13 @@ public:
           bound_(bound),
           start_(std::chrono::steady_clock::now()) {}
 
-    void block(const p::Protocol& protocol, const p::ScheduledTrial& t, std::size_t runs) {
+    void block(const p::Protocol& protocol, const p::ScheduledTrial& t, std::size_t runs, bool on_screen) {
         if (quiet_) return;
         end_line();
         const p::Block& b = protocol.blocks[t.block];
-        std::printf("block \"%s\" (run %zu of %zu, repetition %d of %d): adaptation %s simulated\n", b.name.c_str(),
-                    t.run + 1, runs, t.repetition + 1, b.repetitions, clock_text(b.adaptation_s).c_str());
+        std::printf("block \"%s\" (run %zu of %zu, repetition %d of %d): adaptation %s%s\n", b.name.c_str(), t.run + 1,
+                    runs, t.repetition + 1, b.repetitions, clock_text(b.adaptation_s).c_str(),
+                    on_screen ? "" : " simulated");
         std::fflush(stdout);
     }
 
@@ -669,7 +747,7 @@ private:
 // --- Stored records ------------------------------------------------------------
 
 std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, const p::ScheduledTrial& t,
-                          const std::vector<double>& frame_times) {
+                          const std::vector<double>& frame_times, const std::string& frames_shown_json) {
     const p::Stimulus& stim = t.stimulus;
     std::string j = "{";
     j += fmt::format("\"task\":{},\"presentation\":{},", json_string(p::to_string(c.task)),
@@ -697,15 +775,29 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
     j += "]";
     if (stim.adjusted_view) j += fmt::format(",\"adjusted_view\":{}", *stim.adjusted_view);
     const p::Timing& tm = protocol.timing;
-    j += fmt::format(",\"timing\":{{\"stimulus_s\":{},\"inter_stimulus_s\":{},\"inter_trial_s\":{}}}",
-                     json_number(tm.stimulus_s), json_number(tm.inter_stimulus_s), json_number(tm.inter_trial_s));
+    // The durations asked for (s) and, in "frames", what the flips gave:
+    // whole refreshes at the measured (on screen) or nominal (headless) rate.
+    j += fmt::format(",\"timing\":{{\"stimulus_s\":{},\"inter_stimulus_s\":{},\"inter_trial_s\":{},\"frames\":{}}}",
+                     json_number(tm.stimulus_s), json_number(tm.inter_stimulus_s), json_number(tm.inter_trial_s),
+                     frames_shown_json.empty() ? std::string("null") : frames_shown_json);
     return j + "}";
 }
 
-std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s) {
-    return fmt::format("{{\"schedule\":{},\"observer\":{},\"observer_seed\":{},\"answer_after_offset_s\":{}}}",
-                       json_string(schedule.state()), json_string(observer.model() ? "model" : "script"),
-                       observer.seed(), json_number(answer_rt_s));
+/// The procedure's state after the trial, who answered, and what: `answer` is
+/// the answer given (kept for a "missed" trial, whose response column says it
+/// was repeated), `input` the key or button, `step` the schedule's step.
+std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s,
+                       const std::optional<p::Response>& answer, const std::string& input, std::size_t step) {
+    std::string j =
+        fmt::format("{{\"schedule\":{},\"observer\":{},\"observer_seed\":{},\"answer_after_offset_s\":{},\"step\":{}",
+                    json_string(schedule.state()),
+                    json_string(observer.person()  ? "person"
+                                : observer.model() ? "model"
+                                                   : "script"),
+                    observer.seed(), json_number(answer_rt_s), step);
+    if (answer) j += fmt::format(",\"answer\":{}", json_string(response_word(*answer)));
+    if (!input.empty()) j += fmt::format(",\"input\":{}", json_string(input));
+    return j + "}";
 }
 
 /// The observer seed a session's first trial recorded, if any.
@@ -866,6 +958,8 @@ std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
         spec.params);
 }
 
+}  // namespace
+
 /// The model observer's true value for a condition: the level its procedure
 /// should converge on (2AFC and adjust: where the level stimulus is chosen
 /// with the procedure's target probability, 0.5 = the PSE; yes-no: the
@@ -950,6 +1044,8 @@ std::string true_value(StimulusRenderer& renderer, const p::Protocol& protocol, 
     }
 }
 
+namespace {
+
 void print_summary(const p::Protocol& protocol, const p::Schedule& schedule, StimulusRenderer* renderer,
                    const SessionObserver& observer, bool compute_true) {
     struct Row {
@@ -1013,14 +1109,21 @@ int run_session(const RunOptions& o) {
     // Installed first: a signal during the setup ends the session before its first trial.
     StopSignals signals;
     // --- Options that need no file.
-    if (!o.headless)
+    // A person answers at the screen; the model or a script answer anywhere.
+    const bool person = !o.model_observer && o.script.empty();
+    if (person && o.headless)
         throw InputError(SourceLocation{"--headless", 0, 0, ""},
-                         "this build runs sessions headless only (the full-screen runner is not built yet): give "
-                         "--headless with --model-observer or --script FILE.");
-    if (!o.model_observer && o.script.empty())
+                         "a headless run has no screen for a person: give --model-observer or --script FILE with "
+                         "--headless, or leave --headless out to run full screen.");
+    if (person && o.observer.empty())
         throw InputError(SourceLocation{"--observer", 0, 0, ""},
-                         "a person's answers need the full-screen runner, which this build does not have: a headless "
-                         "run takes --model-observer or --script FILE.");
+                         "give the observer's code with --observer ID (or answer with --model-observer or --script "
+                         "FILE).");
+    if (o.inject_stall_frames > 0 && !o.inject_stall_at_trial)
+        throw InputError(SourceLocation{"--inject-stall-frames", 0, 0, ""},
+                         "name the trial to stall with --inject-stall-at-trial N.");
+    if (o.capture_trial && o.capture_dir.empty())
+        throw InputError(SourceLocation{"--capture-trial", 0, 0, ""}, "give the folder with --capture-dir DIR.");
     const std::string code = o.model_observer ? std::string("model") : (o.observer.empty() ? "script" : o.observer);
     if (!valid_observer_code(code))
         throw InputError(SourceLocation{"--observer", 0, 0, ""},
@@ -1118,17 +1221,24 @@ int run_session(const RunOptions& o) {
     SessionObserver observer(o, observer_seed, std::move(script));
 
     // --- Replay the logged responses: the schedule's state, checked step by step
-    // against what was logged, and where the observer stands.
+    // against what was logged, and where the observer stands. A trial stored as
+    // "missed" (repeated: its stimulus missed a refresh) or "timeout" was never
+    // shown to the procedure: it is checked, then skipped, as the live session
+    // skipped it and showed the same proposal again.
     std::vector<p::Response> responses;
-    std::vector<p::ScheduledTrial> open_match;  // an adjustment match the log stops inside
-    double clock_s = 0.0;                       // the simulated session clock: onset of the next stimulus
+    std::vector<std::pair<p::ScheduledTrial, std::size_t>> open_match;  // an adjustment match the log stops inside
+    double clock_s = 0.0;                                               // the session clock at the last stored answer
+    bool previous_ended_trial = true;                                   // the next trial gets the inter-trial fixation
     p::Schedule check(protocol, seed);
     {
-        for (const st::TrialRecord& t : logged) {
+        for (std::size_t row = 0; row < logged.size(); ++row) {
+            const st::TrialRecord& t = logged[row];
             const std::optional<p::ScheduledTrial> next = check.next();
-            const std::optional<p::Response> r = response_from_word(t.response);
-            if (!next || !r || next->condition_id != t.condition_id || next->procedure_id != t.procedure_id ||
-                next->proposal.level != t.level || next->proposal.test_on_left != t.test_on_left)
+            const bool uncounted = is_uncounted(t.response);
+            const std::optional<p::Response> r = uncounted ? std::nullopt : response_from_word(t.response);
+            if (!next || (!uncounted && !r) || next->condition_id != t.condition_id ||
+                next->procedure_id != t.procedure_id || next->proposal.level != t.level ||
+                next->proposal.test_on_left != t.test_on_left)
                 throw InputError(
                     SourceLocation{o.db, 0, 0, ""},
                     fmt::format("trial {} of session {} ({} at level {}, answered \"{}\") is not what "
@@ -1138,17 +1248,21 @@ int run_session(const RunOptions& o) {
                                 next ? fmt::format("{} at level {}", next->condition_id, next->proposal.level)
                                      : std::string("the schedule has ended")));
             observer.skip(next->task, next->stimulus.adjusted_view);
+            clock_s = t.onset_time_s + t.response_time_s;
+            if (uncounted) {
+                previous_ended_trial = true;
+                continue;
+            }
             if (next->task == p::Task::Adjust) {
-                if (!open_match.empty() && (open_match.front().procedure_id != next->procedure_id ||
-                                            open_match.front().proposal.trial != next->proposal.trial))
+                if (!open_match.empty() && (open_match.front().first.procedure_id != next->procedure_id ||
+                                            open_match.front().first.proposal.trial != next->proposal.trial))
                     open_match.clear();
-                open_match.push_back(*next);
+                open_match.emplace_back(*next, row);
                 if (*r == p::Response::Confirm) open_match.clear();
             } else {
                 open_match.clear();
             }
-            const bool ends_trial = next->task != p::Task::Adjust || *r == p::Response::Confirm;
-            clock_s = t.onset_time_s + t.response_time_s + (ends_trial ? protocol.timing.inter_trial_s : 0.0);
+            previous_ended_trial = next->task != p::Task::Adjust || *r == p::Response::Confirm;
             check.record(*r);
             responses.push_back(*r);
         }
@@ -1157,9 +1271,30 @@ int run_session(const RunOptions& o) {
     if (schedule.state() != check.state())
         throw std::logic_error("Schedule::replay disagrees with the step-by-step replay of the same responses");
 
-    // --- GL before the session: a machine without GL leaves no empty session behind.
-    auto context = gl::create_headless_context();
+    // --- The display's calibration (calibration_policy.h): warnings before the
+    // session; a measured calibration's model encodes every frame.
+    const SessionCalibration calibration = session_calibration(
+        store, protocol.display, resumed ? store.session(session).calibration : std::nullopt, utc_today(), o.db);
+    print_calibration_warnings(calibration, o.quiet);
+    if (calibration.display) apply_display_model(display_scene, *calibration.display);
+
+    // --- GL (and the screen, measured) before the session: a machine without GL,
+    // or a display whose timing is refused, leaves no empty session behind.
+    std::optional<Font> font;
+    if (!o.headless)
+        font = Font::load(o.font.empty() ? std::filesystem::path(kDefaultFontFile) : std::filesystem::path(o.font));
+    std::unique_ptr<gl::Context> context;
+    std::unique_ptr<Presenter> presenter;
+    ScreenPresenter* screen = nullptr;
+    if (o.headless) {
+        context = gl::create_headless_context();
+        presenter = std::make_unique<VirtualPresenter>(protocol.timing.refresh_hz.value_or(60.0),
+                                                       protocol.display.width_px, protocol.display.height_px);
+    } else {
+        presenter = open_screen(o, protocol, display_scene, screen);
+    }
     StimulusRenderer renderer(scene_text, scene_file, observer.params().window_radius_deg, interval_s);
+    if (calibration.display) renderer.use_display_model(*calibration.display);
 
     // --- Begin or reopen the session.
     if (resumed) {
@@ -1175,7 +1310,8 @@ int run_session(const RunOptions& o) {
         start.protocol_text = protocol_text;
         start.protocol_name = std::filesystem::path(o.protocol).filename().string();
         start.seed = seed;
-        start.calibration = record_display(store, display_scene, scene_file);
+        start.calibration =
+            calibration.calibration ? *calibration.calibration : record_display(store, display_scene, scene_file);
         session = store.begin_session(start);
     }
     // From here on a StoreError names the session to continue.
@@ -1190,14 +1326,14 @@ int run_session(const RunOptions& o) {
         // show it that match's steps again (they are in the frame cache after
         // the first), so that it continues from the same state.
         if (observer.model() && !open_match.empty()) {
-            for (std::size_t i = 0; i < open_match.size(); ++i) {
-                const p::Answer a = observer.answer(open_match[i], &renderer);
-                const std::string_view logged_word = logged[open_match[i].step].response;
+            for (const auto& [step, row] : open_match) {
+                const p::Answer a = observer.answer(step, &renderer);
+                const std::string_view logged_word = logged[row].response;
                 if (response_word(a.response) != logged_word)
                     std::fprintf(stderr,
                                  "atonlab: warning: replaying step %zu of the open adjustment, the model observer "
                                  "answered \"%s\" where the log has \"%s\" (has the scene file changed?)\n",
-                                 open_match[i].step, std::string(response_word(a.response)).c_str(),
+                                 step.step, std::string(response_word(a.response)).c_str(),
                                  std::string(logged_word).c_str());
             }
         }
@@ -1210,14 +1346,67 @@ int run_session(const RunOptions& o) {
             std::fflush(stdout);
         }
 
+        // --- What is shown: the screens and the trials, on screen or on the
+        // virtual display (session_display.h). The session clock goes on from
+        // the last stored answer.
+        SessionDisplayOptions display_options;
+        display_options.person = person;
+        display_options.trace = o.trace;
+        display_options.font = font ? &*font : nullptr;
+        display_options.screen = screen;
+        SessionDisplay display(*presenter, renderer, protocol, display_scene, display_options, clock_s);
+        // On screen a signal ends the wait (or the stimulus) at once; headless a
+        // trial takes no time to show, and is finished and stored first.
+        if (presenter->on_screen()) presenter->set_interrupt([] { return g_stop_signal != 0; });
+        if (screen && !o.quiet) {
+            const RefreshEstimate& r = screen->refresh();
+            std::printf(
+                "screen: monitor %d \"%s\", %d×%d, %d bits per channel, mode %s; measured %.4f ms ± %.4f ms "
+                "(SD) over %d flips (%d rejected) = %.3f Hz\n  flips timed by %s\n  %s\n",
+                o.monitor, screen->monitor_name().c_str(), screen->width_px(), screen->height_px(),
+                screen->framebuffer_bits(),
+                screen->mode_hz() > 0 ? fmt::format("{} Hz", screen->mode_hz()).c_str() : "without a rate",
+                r.period_s * 1e3, r.sd_s * 1e3, r.valid, r.rejected, r.hz(), screen->timing_method().c_str(),
+                display.luminance_note().c_str());
+            std::fflush(stdout);
+        }
+
         const std::size_t runs = schedule.block_runs().size();
+        const std::optional<std::size_t> bound = trial_bound(protocol, schedule);
+        auto progress_text = [&](const p::ScheduledTrial& t, std::size_t row) {
+            return fmt::format("block {} of {}, trial {} of {}{}", t.run + 1, runs, row + 1, bound ? "at most " : "",
+                               bound ? fmt::format("{}", *bound) : std::string("?"));
+        };
         double snapshot_s = 0.0, store_s = 0.0;
         bool first_trial_here = true;
-        while (!schedule.finished() && g_stop_signal == 0) {
+        bool observer_quit = false;
+        std::size_t run_started = runs;   // the block run whose break, instructions and adaptation were shown
+        std::size_t row = logged.size();  // the next trial_index: every stored trial, counted or not
+        if (!display.text_screen(protocol.screens.instructions, resumed ? "Continuing the session." : "",
+                                 "instructions"))
+            observer_quit = g_stop_signal == 0;
+        while (!observer_quit && !schedule.finished() && g_stop_signal == 0) {
             const p::ScheduledTrial t = *schedule.next();
             const p::Condition& c = protocol.blocks[t.block].conditions[t.condition];
-            if (t.starts_run) clock_s += protocol.blocks[t.block].adaptation_s;
-            if (t.starts_run || first_trial_here) progress.block(protocol, t, runs);
+            const p::Block& block = protocol.blocks[t.block];
+            if (t.starts_run || first_trial_here) progress.block(protocol, t, runs, presenter->on_screen());
+            // Before a block run: the break, the block's instructions, the
+            // adaptation. Headless the simulated clock adapts only where a run
+            // starts (as an uninterrupted session would); on screen a resumed
+            // session adapts again, the observer having been away.
+            if ((t.starts_run || (first_trial_here && presenter->on_screen())) && run_started != t.run) {
+                run_started = t.run;  // once per run: a trial shown again after a pause does not start it again
+                bool go_on = true;
+                if (t.starts_run && t.run > 0)
+                    go_on = display.text_screen(protocol.screens.between, progress_text(t, row), "break");
+                go_on = go_on && display.text_screen(block.instructions, "", "block instructions");
+                go_on = go_on && display.adapt(c, block.adaptation_s);
+                if (!go_on) {
+                    observer_quit = g_stop_signal == 0;
+                    break;
+                }
+                previous_ended_trial = true;
+            }
             first_trial_here = false;
             if (!snapshotted.count(c.name)) {
                 const auto started = std::chrono::steady_clock::now();
@@ -1225,61 +1414,100 @@ int run_session(const RunOptions& o) {
                 snapshotted.insert(c.name);
                 snapshot_s += seconds_since(started);
             }
-            p::Answer answer;
-            try {
-                answer = observer.answer(t, &renderer);
-            } catch (const p::ProtocolError& e) {
-                // The script ran out or does not fit: what is stored stays, and the session can go on.
-                throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()},
-                                 fmt::format("{} Session {} stays open: continue it with --resume {}.", e.message(),
-                                             session.value, session.value));
+            std::optional<p::Answer> answer;
+            if (!person) {
+                try {
+                    answer = observer.answer(t, &renderer);
+                } catch (const p::ProtocolError& e) {
+                    // The script ran out or does not fit: what is stored stays, and the session can go on.
+                    throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()},
+                                     fmt::format("{} Session {} stays open: continue it with --resume {}.", e.message(),
+                                                 session.value, session.value));
+                }
+            }
+            TrialHooks hooks;
+            if (o.inject_stall_at_trial && static_cast<std::size_t>(*o.inject_stall_at_trial) == row)
+                hooks.stall_frames = o.inject_stall_frames;
+            if (o.capture_trial && static_cast<std::size_t>(*o.capture_trial) == row) {
+                hooks.before_frame_onset = [&, r = row](std::size_t f) {
+                    capture_frame(o, screen, renderer, t, r, f, false);
+                };
+                hooks.after_frame_onset = [&, r = row](std::size_t f) {
+                    capture_frame(o, screen, renderer, t, r, f, true);
+                };
+            }
+            const TrialShown shown = display.present(t, c, previous_ended_trial, answer, hooks);
+            if (shown.end == TrialEnd::interrupted) break;
+            if (shown.end == TrialEnd::paused) {
+                // Nothing of the interrupted trial is stored: it is shown again
+                // (after a fixation) unless the observer ends the session here.
+                if (display.confirm_quit(progress_text(t, row))) {
+                    observer_quit = g_stop_signal == 0;
+                    break;
+                }
+                previous_ended_trial = true;
+                continue;
+            }
+            // A trial the procedure does not see: a timeout, or (repeat_missed)
+            // a stimulus that missed a refresh. Stored, then shown again.
+            const bool repeat_missed = shown.end == TrialEnd::answered && shown.missed_deadline &&
+                                       protocol.timing.repeat_missed && t.task != p::Task::Adjust;
+            const bool counted = shown.end == TrialEnd::answered && !repeat_missed;
+            if (counted) {
+                try {
+                    schedule.record(*shown.response);
+                } catch (const p::ProcedureError& e) {
+                    throw InputError(SourceLocation{o.script.empty() ? o.protocol : o.script, 0, 0, ""},
+                                     fmt::format("trial {} ({}) cannot take the answer \"{}\": {}", t.step + 1,
+                                                 t.condition_id, response_word(*shown.response), e.message()));
+                }
             }
             std::vector<double> frame_times;
             for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
                 const s::Scene sc = renderer.scene(t.stimulus.frames[f].overrides);
                 frame_times.push_back(brightest_moment_s(sc, judged_lights(t.stimulus, f), interval_s));
             }
-            try {
-                schedule.record(answer.response);
-            } catch (const p::ProcedureError& e) {
-                throw InputError(SourceLocation{o.script.empty() ? o.protocol : o.script, 0, 0, ""},
-                                 fmt::format("trial {} ({}) cannot take the answer \"{}\": {}", t.step + 1,
-                                             t.condition_id, response_word(answer.response), e.message()));
-            }
             st::TrialRecord tr;
-            tr.trial_index = static_cast<std::int64_t>(t.step);
+            tr.trial_index = static_cast<std::int64_t>(row);
             tr.block = static_cast<int>(t.block);
             tr.condition_id = t.condition_id;
             tr.procedure_id = t.procedure_id;
             tr.level = t.proposal.level;
             tr.test_on_left = t.proposal.test_on_left;
-            tr.stimulus_json = stimulus_json(protocol, c, t, frame_times);
-            tr.response = std::string(response_word(answer.response));
+            tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json);
+            tr.response = counted ? std::string(response_word(*shown.response))
+                                  : std::string(shown.end == TrialEnd::timeout ? "timeout" : "missed");
             if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;
-            // Onset to answer: the presentation, then the observer's time after it.
-            tr.response_time_s = presentation_s(protocol, c) + std::max(0.0, answer.response_time_s);
-            tr.onset_time_s = clock_s;
-            tr.dropped_frames = 0;  // headless: no display, no frame to drop
-            tr.missed_deadline = false;
-            tr.procedure_state_json = state_json(schedule, observer, answer.response_time_s);
+            tr.response_time_s = std::max(0.0, shown.response_time_s);  // onset to answer
+            tr.onset_time_s = shown.onset_s;
+            tr.dropped_frames = shown.dropped_frames;
+            tr.missed_deadline = shown.missed_deadline;
+            tr.procedure_state_json =
+                state_json(schedule, observer, shown.answer_after_offset_s, shown.response, shown.input, t.step);
             const auto storing = std::chrono::steady_clock::now();
             store.record_trial(session, tr);  // durable before the next stimulus
             store_s += seconds_since(storing);
-            const bool ends_trial = t.task != p::Task::Adjust || answer.response == p::Response::Confirm;
-            clock_s = tr.onset_time_s + tr.response_time_s + (ends_trial ? protocol.timing.inter_trial_s : 0.0);
-            progress.trial(protocol, t, t.step + 1);
+            ++row;
+            previous_ended_trial = !counted || t.task != p::Task::Adjust || *shown.response == p::Response::Confirm;
+            progress.trial(protocol, t, row);
         }
         progress.end_line();
         const int stop = g_stop_signal;
         const bool completed = schedule.finished();
         store.finish_session(session, completed ? st::SessionStatus::completed : st::SessionStatus::quit);
+        if (completed && stop == 0) display.text_screen(protocol.screens.end, "", "end");
         signals.restore();
 
         const std::size_t total = schedule.history().size();
         if (!o.quiet) {
             std::printf("%s after %zu trials (%zu in this run, %s)\n",
-                        completed ? "completed" : fmt::format("stopped by signal {}", stop).c_str(), total,
-                        progress.done_here(), clock_text(progress.seconds()).c_str());
+                        completed       ? "completed"
+                        : observer_quit ? "ended by the observer"
+                                        : fmt::format("stopped by signal {}", stop).c_str(),
+                        total, progress.done_here(), clock_text(progress.seconds()).c_str());
+            if (row != total)
+                std::printf("  %zu trials stored in all: %zu shown again (missed refreshes or timeouts)\n", row,
+                            row - total);
             std::printf(
                 "  %zu frames rendered for %zu shown (%.1f s, snapshots included); snapshots %.1f s; "
                 "study file %.1f s\n",
@@ -1296,6 +1524,7 @@ int run_session(const RunOptions& o) {
                         completed ? "completed" : "quit",
                         completed ? "" : fmt::format("; continue with --resume {}", session.value).c_str());
         }
+        if (observer_quit && !completed) return 6;
         return completed ? 0 : 128 + stop;
     } catch (const st::StoreError& e) {
         throw st::StoreError(

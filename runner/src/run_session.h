@@ -17,12 +17,14 @@
 #include <glm/vec2.hpp>
 #include <list>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
+#include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/image_io.h"
@@ -71,6 +73,27 @@ public:
     stimuli::ImageRGBA32F hdr(const protocols::Frame& frame, const std::vector<std::string>& lights,
                               double& degrees_per_pixel);
 
+    // --- On screen (session_display.cpp) ---------------------------------
+    /// The frame's code values for the screen: rendered at the moment of its
+    /// interval when `lights` are brightest (as the observer's views), kept in a
+    /// small LRU (a block's background is shown every trial).
+    std::shared_ptr<const stimuli::EncodedImage> codes(const protocols::Frame& frame,
+                                                       const std::vector<std::string>& lights);
+    /// A light of the frame's scene has a rhythm: the frame changes within its interval.
+    bool animated(const protocols::Frame& frame);
+    /// Renders the frame at time_s (s after its onset) through the display
+    /// pipeline, leaving its codes on the GPU for present(): an animated frame
+    /// is sampled at each flip's predicted time.
+    void encode(const protocols::Frame& frame, double time_s);
+    /// Draws the codes encode() made into the bound framebuffer, lower-left corner at (x, y).
+    void present(int x, int y) const;
+    /// The names of the scene's lights (the template with the display).
+    std::vector<std::string> light_names(const std::vector<std::string>& overrides) const;
+
+    /// Encode every frame for this display model instead of the scene's (the
+    /// display's measured calibration: calibration_policy.h). Set before the first frame.
+    void use_display_model(stimuli::DisplayModel model) { display_model_ = std::move(model); }
+
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
     /// Wall-clock seconds spent rendering and reading frames back.
@@ -80,9 +103,17 @@ private:
     std::shared_ptr<const FrameViews> render(const protocols::Frame& frame, const std::vector<std::string>& lights,
                                              stimuli::ImageRGBA32F* hdr, double* degrees_per_pixel);
     void remember(const std::string& key, std::shared_ptr<const FrameViews> views);
+    /// Renders a scene through the display pipeline: the code values the screen gets.
+    stimuli::EncodedImage render_codes(const stimuli::Scene& scene, double time_s);
+    /// render_codes without reading the codes back (they stay on the GPU).
+    void encode_scene(const stimuli::Scene& scene, double time_s);
+    /// The codes of `frame` with the named `lights` off, at time_s (a small LRU).
+    const stimuli::EncodedImage& background_codes(const protocols::Frame& frame, const std::vector<std::string>& lights,
+                                                  double time_s);
 
     std::string scene_text_;
     std::filesystem::path scene_file_;
+    std::optional<stimuli::DisplayModel> display_model_;  ///< use_display_model()
     double window_radius_deg_;
     double interval_s_;
     std::size_t capacity_;
@@ -91,10 +122,28 @@ private:
     // LRU: most recent at the front.
     std::list<std::pair<std::string, std::shared_ptr<const FrameViews>>> lru_;
     std::unordered_map<std::string, decltype(lru_)::iterator> index_;
+    std::list<std::pair<std::string, stimuli::EncodedImage>> background_lru_;
+    std::list<std::pair<std::string, std::shared_ptr<const stimuli::EncodedImage>>> codes_lru_;
+    std::pair<std::string, std::shared_ptr<const stimuli::Scene>> last_scene_;  ///< encode()'s parsed scene
     std::size_t rendered_ = 0;
     std::size_t requested_ = 0;
     double render_s_ = 0.0;
 };
+
+/// What the observer is shown in trial t: each view's window of its rendered
+/// frame (rendered or from the cache). `frames` keeps the frames alive while
+/// the returned Shown points into them.
+protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer& renderer,
+                           std::vector<std::shared_ptr<const FrameViews>>& frames);
+
+/// The model observer's true value for condition c: the level its procedure
+/// should converge on (2AFC and adjust: where the level stimulus is chosen with
+/// the procedure's target probability, 0.5 = the PSE; yes-no: the detection
+/// threshold at the target P(yes)), found on the frames the renderer makes.
+/// Returns "" and sets value, or says why there is none (e.g. the display
+/// clips the level stimulus so its brightness never crosses the other's).
+std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol,
+                       const protocols::Condition& c, const protocols::ModelObserverParams& params, double& value);
 
 /// Runs `atonlab run` (RunOptions in commands.h). Returns the exit status: 0
 /// when the session completed, 128 + N when signal N stopped it between trials.

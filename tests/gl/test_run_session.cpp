@@ -237,8 +237,8 @@ TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
         schedule.record(t.response == "left" ? protocols::Response::Left : protocols::Response::Right);
     }
     EXPECT_TRUE(schedule.finished());
-    // The first block adapts 30 s (simulated) before its first trial.
-    EXPECT_DOUBLE_EQ(trials.front().onset_time_s, 30.0);
+    // The first block adapts 30 s (simulated), then the 0.8 s fixation: refresh 1848 at 60 Hz.
+    EXPECT_DOUBLE_EQ(trials.front().onset_time_s, 30.8);
     // Both answers occur: the staircases reverse.
     EXPECT_NE(std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.response == "left"; }), 0);
     EXPECT_NE(std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.response == "right"; }), 0);

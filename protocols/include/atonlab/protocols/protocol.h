@@ -154,6 +154,12 @@ struct Display {
     int height_px = 0;
     double width_m = 0.0;             ///< visible width of the picture, metres
     double viewing_distance_m = 0.0;  ///< eye to screen, metres
+    /// The lab's name for the display (`atonlab calibrate --display NAME`): the
+    /// session uses its latest measured calibration from the study file. Empty:
+    /// the scene's nominal display model (docs/calibration.md).
+    std::string name;
+    /// `atonlab run` warns when the calibration is older than this, days (> 0).
+    std::optional<double> max_calibration_age_days;
 };
 
 struct Timing {
@@ -161,12 +167,27 @@ struct Timing {
     double inter_stimulus_s = 0.5;             ///< blank between the two intervals, s
     double inter_trial_s = 1.0;                ///< answer to the next stimulus, s
     std::optional<double> response_timeout_s;  ///< none: wait for the answer
+    /// A 2AFC or yes-no trial whose stimulus missed a refresh (a frame shown
+    /// late) is stored as missed, not shown to the procedure, and shown again.
+    bool repeat_missed = false;
+    /// The refresh rate the protocol's durations are meant for, Hz: the
+    /// headless clock's rate (60 when absent); on screen the measured rate
+    /// must agree with it.
+    std::optional<double> refresh_hz;
+    /// The continue key may end a block's adaptation period early.
+    bool adaptation_skippable = false;
 };
 
 struct Screens {
     std::string instructions;  ///< before the first block
     std::string between;       ///< between runs of blocks (the file's `break`)
     std::string end;           ///< after the last block
+    double text_cd_m2 = 10.0;  ///< the luminance of text on these screens, cd/m² (through the display model)
+    /// The luminance of what is shown during adaptation and trials (the
+    /// countdown, the prompt, the fixation mark), cd/m².
+    double cue_cd_m2 = 1.0;
+    double text_size_deg = 0.5;  ///< the height of a line of text, degrees of visual angle
+    bool fixation = true;        ///< a fixation mark at the screen's centre before each stimulus
 };
 
 /// What a key or a gamepad button does.
