@@ -20,6 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct WindowSums {
     double window_lux = 0.0;     ///< Σ L Ω inside the window
+    double background_lux = 0.0; ///< Σ L_off Ω inside the window (0 without a background image)
     std::size_t window_px = 0;   ///< pixels inside
     double annulus_cd_m2 = 0.0;  ///< Σ L over the annulus r < d <= 2r
     std::size_t annulus_px = 0;
@@ -32,6 +33,9 @@ WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_de
             fmt::format("a displayed image needs width, height > 0, deg_per_px > 0 and "
                         "width*height values; got {}x{}, {} deg/px, {} values",
                         image.width, image.height, image.deg_per_px, image.luminance_cd_m2.size()));
+    if (image.has_background() && image.background_cd_m2.size() != image.luminance_cd_m2.size())
+        throw std::invalid_argument(fmt::format("a displayed image's background needs {} values, not {}",
+                                                image.luminance_cd_m2.size(), image.background_cd_m2.size()));
     if (!(radius_deg > 0.0) || !std::isfinite(radius_deg))
         throw std::invalid_argument(fmt::format("the window radius must be > 0 degrees, not {}", radius_deg));
     const double r = radius_deg / image.deg_per_px;  // pixels
@@ -50,6 +54,11 @@ WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_de
             const double l = image.at(x, y);
             if (d2 <= r * r) {
                 s.window_lux += l * omega;
+                if (image.has_background())
+                    s.background_lux +=
+                        image.background_cd_m2[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
+                                               static_cast<std::size_t>(x)] *
+                        omega;
                 ++s.window_px;
             } else if (annulus && d2 <= outer * outer) {
                 s.annulus_cd_m2 += l;
@@ -143,11 +152,20 @@ double window_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_px,
     return sums(image, centre_px, radius_deg, false).window_lux;
 }
 
+double window_light_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg) {
+    const WindowSums s = sums(image, centre_px, radius_deg, false);
+    return std::max(0.0, s.window_lux - s.background_lux);
+}
+
 double brightness(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg, double exponent) {
-    return std::pow(window_illuminance_lux(image, centre_px, radius_deg), exponent);
+    return std::pow(window_light_lux(image, centre_px, radius_deg), exponent);
 }
 
 double increment_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg) {
+    if (image.has_background()) {
+        const WindowSums s = sums(image, centre_px, radius_deg, false);
+        return s.window_lux - s.background_lux;
+    }
     const WindowSums s = sums(image, centre_px, radius_deg, true);
     const double background = s.annulus_px > 0 ? s.annulus_cd_m2 / static_cast<double>(s.annulus_px) : 0.0;
     return s.window_lux - background * static_cast<double>(s.window_px) * image.pixel_sr();
@@ -161,8 +179,7 @@ ModelObserver::ModelObserver(ModelObserverParams params, std::uint64_t seed) : p
 }
 
 double ModelObserver::log10_brightness(const View& v) const {
-    return params_.exponent *
-           log10_or_minus_inf(window_illuminance_lux(*v.image, v.light_px, params_.window_radius_deg));
+    return params_.exponent * log10_or_minus_inf(window_light_lux(*v.image, v.light_px, params_.window_radius_deg));
 }
 
 double ModelObserver::gaussian() {
@@ -251,8 +268,7 @@ double model_p_yes(const ModelObserverParams& params, const View& view) {
 double model_p_first(const ModelObserverParams& params, const View& first, const View& second) {
     validate(params);
     auto log_b = [&](const View& v) {
-        return params.exponent *
-               log10_or_minus_inf(window_illuminance_lux(*v.image, v.light_px, params.window_radius_deg));
+        return params.exponent * log10_or_minus_inf(window_light_lux(*v.image, v.light_px, params.window_radius_deg));
     };
     const double delta = log_difference(log_b(first), log_b(second));
     const double sigma = params.noise_sd_log10;

@@ -182,12 +182,14 @@ DisplayedImage toy_render(const ToyScene& t) {
                     peak * std::exp(-(rx * rx + ry * ry) / (2.0 * sigma_px * sigma_px));
             }
     }
+    const auto tonemap = [&](double v) {
+        return t.tonemap == "perceptual" ? t.adaptation_cd_m2 * std::pow(v / t.adaptation_cd_m2, 0.85) : v;
+    };
     img.luminance_cd_m2.resize(l.size());
-    for (std::size_t i = 0; i < l.size(); ++i) {
-        double v = l[i];
-        if (t.tonemap == "perceptual") v = t.adaptation_cd_m2 * std::pow(v / t.adaptation_cd_m2, 0.85);
-        img.luminance_cd_m2[i] = static_cast<float>(v);
-    }
+    for (std::size_t i = 0; i < l.size(); ++i) img.luminance_cd_m2[i] = static_cast<float>(tonemap(l[i]));
+    // What the screen shows with the lights off, as the runner gives the model
+    // observer (observer.h DisplayedImage::background_cd_m2).
+    img.background_cd_m2.assign(l.size(), static_cast<float>(tonemap(t.background_cd_m2)));
     return img;
 }
 
@@ -261,15 +263,19 @@ TEST(ProtocolExamples, ParseWithTheDocumentedShape) {
     EXPECT_EQ(c.level_scale, LevelScale::Log10);
     EXPECT_EQ(c.choice, ChoiceMapping::ChoseReference);
     // set: the block's, then the condition's.
-    ASSERT_EQ(c.set.size(), 3u);
+    ASSERT_EQ(c.set.size(), 4u);
     EXPECT_EQ(c.set[0].text(), "eye.adaptation_cd_m2=0.001");
-    EXPECT_EQ(c.set[2].text(), "tonemap.operator=\"perceptual\"");
+    EXPECT_EQ(c.set[2].text(), "light.test.intensity_cd=0.002");
+    EXPECT_EQ(c.set[3].text(), "tonemap.operator=\"perceptual\"");
     ASSERT_EQ(c.procedure.kind, ProcedureKind::Staircase);
-    EXPECT_EQ(c.procedure.track_starts, (std::vector<double>{2.9, 1.9}));
+    // The block's inline procedure table merges key by key into [defaults.procedure].
+    EXPECT_EQ(c.procedure.track_starts, (std::vector<double>{-2.2, -3.2}));
     const auto& sp = std::get<StaircaseParams>(c.procedure.params);
     EXPECT_EQ(sp.step_sizes, (std::vector<double>{0.2, 0.1, 0.05}));
     EXPECT_EQ(sp.step_type, StepType::Lin);
     EXPECT_EQ(sp.max_trials, 24);
+    EXPECT_EQ(sp.min_level, -3.7);
+    EXPECT_EQ(sp.max_level, -1.7);
     EXPECT_EQ(p.responses.keys_of(Action::Left), (std::vector<std::string>{"left", "1"}));
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "2"), Action::Right);
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "escape"), Action::Quit);
@@ -485,7 +491,7 @@ TEST(ProtocolSchedule, MakeProcedureBuildsTheSameTracksAsTheSchedule) {
     EXPECT_EQ(proc->kind(), "interleaved");  // two tracks
     const auto track = make_track(c, 1, derive_seed(11, 1));
     EXPECT_EQ(track->kind(), "2afc");
-    EXPECT_EQ(track->next()->level, 1.9);
+    EXPECT_EQ(track->next()->level, -3.2);
     EXPECT_TRUE(track->next()->test_on_left.has_value());
     EXPECT_THROW((void)make_track(c, 2, 0), std::out_of_range);
 }
@@ -757,8 +763,20 @@ double truth(const ToyCondition& tc, const ModelObserverParams& params) {
     if (tc.condition.task == Task::YesNo)
         return true_threshold(image_at(Role::Test), tc.pixel(Role::Test),
                               std::get<QuestParams>(tc.condition.procedure.params).p_threshold, -3.0, 3.0, params);
+    // Search 3 log10 units either side of where the procedure starts (the
+    // examples centre it on each block's test intensity).
+    double centre = 0.0;
+    const ProcedureSpec& spec = tc.condition.procedure;
+    if (!spec.track_starts.empty()) {
+        centre = 0.5 * (*std::min_element(spec.track_starts.begin(), spec.track_starts.end()) +
+                        *std::max_element(spec.track_starts.begin(), spec.track_starts.end()));
+    } else if (const auto* a = std::get_if<AdjustmentParams>(&spec.params)) {
+        centre = 0.5 * (a->start_min + a->start_max);
+    } else if (const auto* cs = std::get_if<ConstantStimuliParams>(&spec.params)) {
+        centre = 0.5 * (cs->levels.front() + cs->levels.back());
+    }
     return true_pse(image_at(Role::Reference), tc.pixel(Role::Reference), tc.image(0.0, Role::Test),
-                    tc.pixel(Role::Test), 0.0, 4.5, params);
+                    tc.pixel(Role::Test), centre - 3.0, centre + 3.0, params);
 }
 
 /// The standard error of the PSE that N binary trials at the constant-stimuli

@@ -34,8 +34,15 @@ struct DisplayedImage {
     int height = 0;
     double deg_per_px = 0.0;
     std::vector<float> luminance_cd_m2;  ///< width * height values, cd/m², >= 0
+    /// What the same pixels show with the judged light off (cd/m²): empty, or
+    /// width * height values. When given, a light's brightness and increment
+    /// are what it adds to this, pixel by pixel; when empty, the light's
+    /// brightness is the whole window's and its increment is over the annulus
+    /// mean (see window_light_lux, increment_illuminance_lux).
+    std::vector<float> background_cd_m2;
 
     float at(int x, int y) const { return luminance_cd_m2[static_cast<std::size_t>(y) * width + x]; }
+    bool has_background() const noexcept { return !background_cd_m2.empty(); }
     /// Solid angle of one pixel, sr.
     double pixel_sr() const;
 };
@@ -44,15 +51,24 @@ struct DisplayedImage {
 /// the illuminance (lux) that window of the image puts at the eye.
 double window_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg);
 
-/// Brightness of a light: window_illuminance_lux^exponent, a power law
+/// The illuminance (lux) the light adds within radius_deg of centre_px:
+/// Σ (L − L_off) · Ω over the window, L_off the background image (what the
+/// screen shows there with the light off), or 0 when the image has none (then
+/// equal to window_illuminance_lux). Clamped at 0 (a light cannot take light
+/// away; dithering can make the sum a hair negative).
+double window_light_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg);
+
+/// Brightness of a light: window_light_lux^exponent, a power law
 /// (Stevens 1961, "To honor Fechner and repeal his law", Science 133:80-86,
 /// Table 1: exponent 0.33 for a 5° target in the dark-adapted eye, 0.5 for a
 /// point source). Arbitrary units; only ratios matter.
 double brightness(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg, double exponent);
 
-/// The light's increment over its surround: Σ (L − L_bg) · Ω over the window,
-/// L_bg the mean luminance of the annulus radius_deg … 2·radius_deg (lux; may
-/// be negative). What yes/no detection is decided on.
+/// The light's increment over its surround: Σ (L − L_bg) · Ω over the window
+/// (lux; may be negative). L_bg is the background image pixel by pixel when the
+/// image has one (exact: a glare halo reaching the annulus is not mistaken for
+/// surround), else the mean luminance of the annulus radius_deg … 2·radius_deg.
+/// What yes/no detection is decided on.
 double increment_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg);
 
 /// One light the observer judges: an image and the light's position in it (pixels).
