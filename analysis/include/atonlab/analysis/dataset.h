@@ -1,0 +1,195 @@
+#pragma once
+// The trials `atonlab analyze` works on (docs/analysis.md "Input"): read from
+// one or more study files (store/, opened read-only, so a running session is
+// never disturbed and nothing stored can be lost) or from a long-format CSV
+// of trials, merged into one Dataset. Observers are keyed by their code (the
+// same code in two study files is one observer); sessions are kept apart by
+// "FILE#ID", so two files that both hold a session 1 never mix.
+//
+// Every trial carries the binary answer the psychometric function counts
+// (`outcome`), the guess rate and target probability its procedure implies,
+// and the stimulus parameters the report groups by (adaptation luminance,
+// tone mapper, glare of test and reference, test intensity), read from the
+// stored stimulus JSON. For adaptive tracks the study reader also replays the
+// logged answers through the protocol's own procedure (protocols/), which
+// gives the staircase reversals and QUEST's posterior after every trial.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace atonlab::analysis {
+
+/// Bad input for an analysis (a CSV without a required column, a value that is
+/// not a number, a study file given twice): one sentence that names the file
+/// and, where there is one, the line and the column. what() is
+/// "FILE:LINE: column 'COLUMN': MESSAGE" with the parts that are known.
+class InputError : public std::runtime_error {
+public:
+    InputError(std::string file, int line, std::string column, const std::string& message);
+
+    const std::string& file() const noexcept { return file_; }
+    int line() const noexcept { return line_; }  ///< 1-based; 0 when unknown
+    const std::string& column() const noexcept { return column_; }
+    const std::string& message() const noexcept { return message_; }
+
+private:
+    std::string file_;
+    int line_;
+    std::string column_;
+    std::string message_;
+};
+
+/// What the observer was asked (docs/protocol-file.md, `task`).
+enum class Task : std::uint8_t { TwoAfc, YesNo, Adjust };
+/// "2afc", "yes-no", "adjust".
+std::string_view to_string(Task t) noexcept;
+std::optional<Task> parse_task(std::string_view text) noexcept;
+
+/// One trial: one row of the study's `trials` table, or of a CSV.
+struct Trial {
+    // --- where it came from ---------------------------------------------------
+    std::string source;       ///< the study file or CSV as named on the command line
+    std::string session;      ///< unique over all inputs: "FILE#ID" for a study file's session
+    std::string observer;     ///< the observer's code
+    std::int64_t trial_index = 0;  ///< 0-based within the session
+    int block = 0;                 ///< 0-based block of the protocol
+    std::string condition;         ///< the protocol's condition name
+    std::string track;        ///< the procedure instance ("CONDITION/rREP/tTRACK"); empty when unknown
+    /// "staircase", "weighted-staircase", "quest", "constant-stimuli",
+    /// "adjustment"; empty when unknown (the trials then get a psychometric fit only).
+    std::string procedure;
+
+    // --- what was shown and answered --------------------------------------------
+    Task task = Task::TwoAfc;
+    double level = 0.0;                  ///< the procedure's level, its own units
+    std::string level_key;               ///< the scene key the level sets, e.g. "light.reference.intensity_cd"
+    std::string level_scale = "log10";   ///< "log10" (scene value = 10^level) or "linear"
+    std::string level_on = "reference";  ///< "test" or "reference": the stimulus the level sets
+    std::string response;                ///< the answer's word: left, right, yes, no, coarse_up, ..., confirm
+    /// The binary answer a psychometric function counts: 2AFC, the observer chose
+    /// the stimulus the level is on ("chose the reference" when level_on is the
+    /// reference); yes-no, "yes". Absent for adjustment actions and timeouts.
+    std::optional<bool> outcome;
+    std::optional<bool> test_on_left;     ///< 2AFC: the test was the left / first stimulus
+    std::optional<double> response_value;  ///< adjustment: the scene value shown
+    double response_time_s = 0.0;
+    double onset_time_s = 0.0;
+    int dropped_frames = 0;
+    bool missed_deadline = false;
+
+    // --- the stimulus, from the stored overrides (absent where not stated) ------
+    std::optional<double> adaptation_cd_m2;   ///< eye.adaptation_cd_m2, cd/m²
+    std::string tone_operator;                ///< tonemap.operator
+    std::string glare_test;                   ///< eye.glare in the test's frame
+    std::string glare_reference;              ///< eye.glare in the reference's frame
+    std::optional<double> test_intensity_cd;  ///< the test light's intensity_cd, cd
+
+    // --- what the procedure implies -----------------------------------------------
+    double guess_rate = 0.0;  ///< gamma of the psychometric function for `outcome`
+    double target_p = 0.5;    ///< P(outcome) the procedure converges on (0.5: a PSE)
+    /// Staircases: this trial's level was a reversal (protocols/staircase.h).
+    std::optional<bool> reversal;
+    /// QUEST: the posterior after this trial, log10 units: mean (QuestMean), SD
+    /// (QuestSd) and the 2.5% and 97.5% quantiles (QuestQuantile).
+    std::optional<double> quest_mean, quest_sd, quest_lower, quest_upper;
+
+    /// An adjustment trial that confirms a match (its level is the match).
+    bool is_match() const noexcept { return task == Task::Adjust && (response == "confirm" || response == "match"); }
+};
+
+/// A session of a study file (or of a CSV's session column).
+struct SessionInfo {
+    std::string key;     ///< as Trial::session
+    std::string source;  ///< the file
+    std::int64_t id = 0; ///< the session's id in its study file (0 for a CSV)
+    std::string observer;
+    std::string protocol_name;
+    std::string protocol_sha256;
+    std::string software_version;
+    std::uint64_t seed = 0;
+    std::string started_at, ended_at;
+    std::string status;  ///< running, quit, completed, crashed ("" for a CSV)
+    std::int64_t trial_count = 0;
+    std::optional<std::int64_t> calibration_id;
+    /// Every condition the session's protocol defines, in file order (so a
+    /// condition without trials is still reported); empty for a CSV.
+    std::vector<std::string> protocol_conditions;
+};
+
+/// One photometer reading behind a calibration (the store's calibration_readings).
+struct CalibrationPoint {
+    std::string patch;    ///< "black", "grey-128", ...
+    std::string channel;  ///< "red", "green", "blue", "grey" or "other"
+    double drive = 0.0;   ///< drive level of the lit channel(s), [0, 1]
+    double luminance_cd_m2 = 0.0;
+};
+
+/// A display calibration a session used (the store's `calibrations` row).
+struct CalibrationInfo {
+    std::string source;  ///< the study file
+    std::int64_t id = 0;
+    std::string display_name;
+    int width_px = 0, height_px = 0;
+    double width_m = 0.0, height_m = 0.0, viewing_distance_m = 0.0;
+    std::string fit_json;     ///< the model's parameters (docs/analysis.md "Display calibration")
+    std::string how;          ///< the row's `source`: "measured", "imported FILE", ...
+    std::string measured_at;
+    std::vector<CalibrationPoint> readings;  ///< in measuring order; empty for a nominal model
+};
+
+/// A stored stimulus snapshot (an EXR) of one condition in one session.
+struct SnapshotRef {
+    std::string source;       ///< the study file
+    std::int64_t session_id = 0;
+    std::string session;      ///< as Trial::session
+    std::string condition;
+    /// The file to open to read it: the study file, or the migrated temporary
+    /// copy of a study file with an older schema (kept while the Dataset lives).
+    std::string read_from;
+};
+
+/// Everything read, from every input.
+struct Dataset {
+    std::vector<std::string> sources;      ///< the inputs, in the order given
+    std::vector<Trial> trials;             ///< in input order, then session, then trial_index
+    std::vector<SessionInfo> sessions;
+    std::vector<CalibrationInfo> calibrations;
+    std::vector<SnapshotRef> snapshots;    ///< one per (session, condition) that has one
+    std::vector<std::string> notes;        ///< what the reader could not do (a protocol it could not replay, ...)
+    /// Owns temporary files the dataset refers to (migrated copies of older
+    /// study files, see SnapshotRef::read_from); removed with the last copy.
+    std::vector<std::shared_ptr<void>> temporaries;
+};
+
+/// Reads a study file read-only (Store::open_read_only: readable while a
+/// session runs). Throws store::StoreError for a file the store refuses (not
+/// SQLite, not a study, a newer schema, ...), InputError for nothing else.
+Dataset read_study(const std::filesystem::path& study_file);
+
+/// The CSV's required columns ("observer", "condition", "level", "response").
+const std::vector<std::string>& required_csv_columns();
+/// Every column read_trials_csv understands, in the order write_trials_csv writes them.
+const std::vector<std::string>& trials_csv_columns();
+
+/// Reads a long-format CSV of trials (RFC 4180 quoting, a header row; columns
+/// in docs/analysis.md "CSV input"). Throws InputError naming the file, line
+/// and column for a missing required column, an unknown column, a bad value,
+/// or a file without trials.
+Dataset read_trials_csv(const std::filesystem::path& csv_file);
+
+/// Writes `data.trials` as the tidy trials.csv: a header of trials_csv_columns()
+/// and one row per trial. Numbers in their shortest round-trip form, so that
+/// read_trials_csv gives back the same values. Throws std::runtime_error when
+/// the file cannot be written.
+void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data);
+
+/// Appends `more` to `into`. A session key already present (the same study
+/// file given twice) is an InputError.
+void merge(Dataset& into, Dataset&& more);
+
+}  // namespace atonlab::analysis

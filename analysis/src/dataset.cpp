@@ -1,0 +1,392 @@
+// The Dataset's CSV side: the long-format input, the tidy trials.csv output,
+// and merging inputs. The study-file reader is study_reader.cpp.
+#include "atonlab/analysis/dataset.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "csv.h"
+
+namespace atonlab::analysis {
+
+namespace {
+
+std::string input_error_text(const std::string& file, int line, const std::string& column, const std::string& msg) {
+    std::string out = file;
+    if (line > 0) out += fmt::format(":{}", line);
+    if (!column.empty()) out += fmt::format(": column '{}'", column);
+    return out + ": " + msg;
+}
+
+}  // namespace
+
+InputError::InputError(std::string file, int line, std::string column, const std::string& message)
+    : std::runtime_error(input_error_text(file, line, column, message)),
+      file_(std::move(file)),
+      line_(line),
+      column_(std::move(column)),
+      message_(message) {}
+
+std::string_view to_string(Task t) noexcept {
+    switch (t) {
+        case Task::TwoAfc:
+            return "2afc";
+        case Task::YesNo:
+            return "yes-no";
+        case Task::Adjust:
+            return "adjust";
+    }
+    return "2afc";
+}
+
+std::optional<Task> parse_task(std::string_view text) noexcept {
+    if (text == "2afc") return Task::TwoAfc;
+    if (text == "yes-no") return Task::YesNo;
+    if (text == "adjust") return Task::Adjust;
+    return std::nullopt;
+}
+
+const std::vector<std::string>& required_csv_columns() {
+    static const std::vector<std::string> cols{"observer", "condition", "level", "response"};
+    return cols;
+}
+
+const std::vector<std::string>& trials_csv_columns() {
+    static const std::vector<std::string> cols{
+        "session",         "observer",       "trial_index",     "block",          "condition",
+        "track",           "procedure",      "task",            "level",          "level_key",      "level_scale",
+        "level_on",        "response",       "outcome",         "test_on_left",   "response_value",
+        "response_time_s", "onset_time_s",   "dropped_frames",  "missed_deadline", "adaptation_cd_m2",
+        "tone_operator",   "glare_test",     "glare_reference", "test_intensity_cd", "guess_rate",
+        "target_p",        "reversal",       "quest_mean",      "quest_sd",       "quest_lower",
+        "quest_upper",     "source"};
+    return cols;
+}
+
+// ---------------------------------------------------------------------------
+// Reading the CSV
+
+namespace {
+
+class RowReader {
+public:
+    RowReader(const std::string& file, int line, const std::map<std::string, std::size_t>& index,
+              const std::vector<std::string>& fields)
+        : file_(file), line_(line), index_(index), fields_(fields) {}
+
+    /// The field's text, or nullopt when the column is absent or the field empty.
+    std::optional<std::string> text(const std::string& column) const {
+        const auto it = index_.find(column);
+        if (it == index_.end()) return std::nullopt;
+        std::string v = trim(fields_[it->second]);
+        if (v.empty()) return std::nullopt;
+        return v;
+    }
+    std::string required(const std::string& column) const {
+        auto v = text(column);
+        if (!v) fail(column, "is empty; every row needs a value here");
+        return *v;
+    }
+    std::optional<double> number(const std::string& column) const {
+        const auto v = text(column);
+        if (!v) return std::nullopt;
+        double x = 0.0;
+        const char* begin = v->data();
+        const char* end = begin + v->size();
+        if (*begin == '+') ++begin;
+        const auto [ptr, ec] = std::from_chars(begin, end, x);
+        if (ec != std::errc() || ptr != end || !std::isfinite(x))
+            fail(column, fmt::format("'{}' is not a finite number", *v));
+        return x;
+    }
+    std::optional<std::int64_t> integer(const std::string& column, std::int64_t min) const {
+        const auto v = text(column);
+        if (!v) return std::nullopt;
+        std::int64_t x = 0;
+        const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), x);
+        if (ec != std::errc() || ptr != v->data() + v->size())
+            fail(column, fmt::format("'{}' is not an integer", *v));
+        if (x < min) fail(column, fmt::format("{} is below the smallest allowed value, {}", x, min));
+        return x;
+    }
+    std::optional<bool> boolean(const std::string& column) const {
+        const auto v = text(column);
+        if (!v) return std::nullopt;
+        const auto b = parse_bool(*v);
+        if (!b) fail(column, fmt::format("'{}' is not a yes/no value (1, 0, true, false, yes, no)", *v));
+        return b;
+    }
+    [[noreturn]] void fail(const std::string& column, const std::string& message) const {
+        throw InputError(file_, line_, column, message);
+    }
+
+    static std::optional<bool> parse_bool(std::string_view v) {
+        if (v == "1" || v == "true" || v == "TRUE" || v == "True" || v == "yes") return true;
+        if (v == "0" || v == "false" || v == "FALSE" || v == "False" || v == "no") return false;
+        return std::nullopt;
+    }
+    static std::string trim(std::string_view s) {
+        while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+        while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+        return std::string(s);
+    }
+
+private:
+    const std::string& file_;
+    int line_;
+    const std::map<std::string, std::size_t>& index_;
+    const std::vector<std::string>& fields_;
+};
+
+const std::set<std::string, std::less<>> kAdjustWords{"coarse_up", "coarse_down", "fine_up", "fine_down", "confirm",
+                                                      "match"};
+
+Trial trial_from_row(const RowReader& row, const std::string& file) {
+    Trial t;
+    t.source = file;
+    t.observer = row.required("observer");
+    t.condition = row.required("condition");
+    if (const auto task = row.text("task")) {
+        const auto parsed = parse_task(*task);
+        if (!parsed) row.fail("task", fmt::format("'{}' is not a task (2afc, yes-no, adjust)", *task));
+        t.task = *parsed;
+    }
+    const auto level = row.number("level");
+    if (!level) row.fail("level", "is empty; every row needs a value here");
+    t.level = *level;
+    if (const auto s = row.text("level_key")) t.level_key = *s;
+    if (const auto s = row.text("level_scale")) {
+        if (*s != "log10" && *s != "linear") row.fail("level_scale", fmt::format("'{}' is not log10 or linear", *s));
+        t.level_scale = *s;
+    }
+    t.level_on = t.task == Task::YesNo ? "test" : "reference";
+    if (const auto s = row.text("level_on")) {
+        if (*s != "test" && *s != "reference") row.fail("level_on", fmt::format("'{}' is not test or reference", *s));
+        t.level_on = *s;
+    }
+    t.test_on_left = row.boolean("test_on_left");
+    t.response = row.required("response");
+    // The outcome: an explicit `outcome` column wins; else the response, as a
+    // yes/no value or (2AFC) a side with test_on_left.
+    if (const auto o = row.boolean("outcome")) {
+        t.outcome = o;
+    } else if (t.task == Task::Adjust) {
+        if (!kAdjustWords.count(t.response))
+            row.fail("response", fmt::format("'{}' is not an adjustment action (confirm or match for a match; "
+                                             "coarse_up, coarse_down, fine_up, fine_down)",
+                                             t.response));
+    } else if (const auto b = RowReader::parse_bool(t.response)) {
+        t.outcome = b;
+    } else if (t.task == Task::TwoAfc && (t.response == "left" || t.response == "right")) {
+        if (!t.test_on_left)
+            row.fail("test_on_left", "is needed to score the answer 'left' or 'right' (where was the test?)");
+        const bool chose_test = (t.response == "left") == *t.test_on_left;
+        t.outcome = t.level_on == "test" ? chose_test : !chose_test;
+    } else if (t.response != "timeout") {
+        row.fail("response", fmt::format("'{}' is not an answer: give 1/0, yes/no or true/false (the outcome the "
+                                         "psychometric function counts), left/right with test_on_left, or timeout",
+                                         t.response));
+    }
+    if (const auto s = row.text("session")) t.session = *s;
+    if (const auto v = row.integer("trial_index", 0)) t.trial_index = *v;
+    if (const auto v = row.integer("block", 0)) t.block = static_cast<int>(*v);
+    if (const auto s = row.text("track")) t.track = *s;
+    if (const auto s = row.text("procedure")) {
+        static const std::set<std::string, std::less<>> kinds{"staircase", "weighted-staircase", "quest",
+                                                              "constant-stimuli", "adjustment"};
+        if (!kinds.count(*s))
+            row.fail("procedure", fmt::format("'{}' is not a procedure (staircase, weighted-staircase, quest, "
+                                              "constant-stimuli, adjustment)",
+                                              *s));
+        t.procedure = *s;
+    }
+    t.response_value = row.number("response_value");
+    if (const auto v = row.number("response_time_s")) t.response_time_s = *v;
+    if (const auto v = row.number("onset_time_s")) t.onset_time_s = *v;
+    if (const auto v = row.integer("dropped_frames", 0)) t.dropped_frames = static_cast<int>(*v);
+    if (const auto v = row.boolean("missed_deadline")) t.missed_deadline = *v;
+    t.adaptation_cd_m2 = row.number("adaptation_cd_m2");
+    if (t.adaptation_cd_m2 && *t.adaptation_cd_m2 <= 0.0)
+        row.fail("adaptation_cd_m2", "must be a luminance > 0 cd/m2");
+    if (const auto s = row.text("tone_operator")) t.tone_operator = *s;
+    if (const auto s = row.text("glare_test")) t.glare_test = *s;
+    if (const auto s = row.text("glare_reference")) t.glare_reference = *s;
+    t.test_intensity_cd = row.number("test_intensity_cd");
+    if (t.test_intensity_cd && *t.test_intensity_cd <= 0.0)
+        row.fail("test_intensity_cd", "must be an intensity > 0 cd");
+    if (const auto v = row.number("guess_rate")) {
+        if (*v < 0.0 || *v >= 1.0) row.fail("guess_rate", fmt::format("{} is outside [0, 1)", *v));
+        t.guess_rate = *v;
+    }
+    if (const auto v = row.number("target_p")) {
+        if (*v <= t.guess_rate || *v >= 1.0)
+            row.fail("target_p", fmt::format("{} is outside (guess_rate, 1) = ({}, 1)", *v, t.guess_rate));
+        t.target_p = *v;
+    }
+    t.reversal = row.boolean("reversal");
+    t.quest_mean = row.number("quest_mean");
+    t.quest_sd = row.number("quest_sd");
+    t.quest_lower = row.number("quest_lower");
+    t.quest_upper = row.number("quest_upper");
+    return t;
+}
+
+}  // namespace
+
+Dataset read_trials_csv(const std::filesystem::path& csv_file) {
+    const std::string file = csv_file.string();
+    std::error_code ec;
+    if (std::filesystem::is_directory(csv_file, ec)) throw InputError(file, 0, "", "is a directory, not a CSV file");
+    std::ifstream in(csv_file, std::ios::binary);
+    if (!in) throw InputError(file, 0, "", "cannot be opened for reading (does it exist?)");
+    int line = 0;
+    std::string error;
+    auto header = detail::read_csv_record(in, line, error);
+    if (!header) throw InputError(file, 1, "", error.empty() ? "is empty: it needs a header row" : error);
+    std::map<std::string, std::size_t> index;
+    for (std::size_t i = 0; i < header->fields.size(); ++i) {
+        std::string name = RowReader::trim(header->fields[i]);
+        if (i == 0 && name.rfind("\xEF\xBB\xBF", 0) == 0) name.erase(0, 3);  // a UTF-8 byte-order mark
+        if (name.empty()) throw InputError(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
+        if (!index.emplace(name, i).second)
+            throw InputError(file, 1, name, "appears twice in the header");
+    }
+    for (const std::string& col : required_csv_columns()) {
+        if (!index.count(col)) {
+            std::string have;
+            for (const std::string& f : header->fields) have += (have.empty() ? "" : ", ") + f;
+            throw InputError(file, 1, col,
+                             fmt::format("the header has no column '{}', which is required (required: observer, "
+                                         "condition, level, response; the header has: {})",
+                                         col, have));
+        }
+    }
+    Dataset d;
+    d.sources.push_back(file);
+    std::vector<std::string> unknown;
+    const auto& known = trials_csv_columns();
+    for (const auto& [name, i] : index)
+        if (std::find(known.begin(), known.end(), name) == known.end()) unknown.push_back(name);
+    if (!unknown.empty()) {
+        std::string list;
+        for (const std::string& u : unknown) list += (list.empty() ? "" : ", ") + u;
+        d.notes.push_back(fmt::format("{}: columns not used by the analysis were ignored: {}", file, list));
+    }
+    std::map<std::string, std::int64_t> next_index;  // per session, when trial_index is not given
+    while (true) {
+        auto rec = detail::read_csv_record(in, line, error);
+        if (!rec) {
+            if (!error.empty()) throw InputError(file, line, "", error);
+            break;
+        }
+        if (rec->fields.size() == 1 && RowReader::trim(rec->fields[0]).empty()) continue;  // a blank line
+        if (rec->fields.size() != header->fields.size())
+            throw InputError(file, rec->line, "",
+                             fmt::format("the row has {} fields where the header has {}", rec->fields.size(),
+                                         header->fields.size()));
+        const RowReader row(file, rec->line, index, rec->fields);
+        Trial t = trial_from_row(row, file);
+        if (t.session.empty()) t.session = fmt::format("{}:{}", file, t.observer);
+        if (!index.count("trial_index")) t.trial_index = next_index[t.session]++;
+        d.trials.push_back(std::move(t));
+    }
+    if (d.trials.empty()) throw InputError(file, 0, "", "has a header but no trials");
+    // One SessionInfo per session key, in order of appearance.
+    std::map<std::string, std::size_t> session_at;
+    for (const Trial& t : d.trials) {
+        auto [it, fresh] = session_at.emplace(t.session, d.sessions.size());
+        if (fresh) {
+            SessionInfo s;
+            s.key = t.session;
+            s.source = file;
+            s.observer = t.observer;
+            d.sessions.push_back(std::move(s));
+        } else if (d.sessions[it->second].observer != t.observer) {
+            throw InputError(file, 0, "session",
+                             fmt::format("session '{}' has trials of two observers, '{}' and '{}'", t.session,
+                                         d.sessions[it->second].observer, t.observer));
+        }
+        ++d.sessions[it->second].trial_count;
+    }
+    return d;
+}
+
+// ---------------------------------------------------------------------------
+// Writing trials.csv
+
+void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data) {
+    std::ofstream out(csv_file, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot be written", csv_file.string()));
+    const auto& cols = trials_csv_columns();
+    for (std::size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << cols[i];
+    out << '\n';
+    auto num = [](const std::optional<double>& v) { return v ? detail::number_text(*v) : std::string(); };
+    auto flag = [](const std::optional<bool>& v) { return v ? std::string(*v ? "1" : "0") : std::string(); };
+    using detail::csv_field;
+    for (const Trial& t : data.trials) {
+        const std::vector<std::string> f{csv_field(t.session),
+                                         csv_field(t.observer),
+                                         std::to_string(t.trial_index),
+                                         std::to_string(t.block),
+                                         csv_field(t.condition),
+                                         csv_field(t.track),
+                                         csv_field(t.procedure),
+                                         std::string(to_string(t.task)),
+                                         detail::number_text(t.level),
+                                         csv_field(t.level_key),
+                                         csv_field(t.level_scale),
+                                         csv_field(t.level_on),
+                                         csv_field(t.response),
+                                         flag(t.outcome),
+                                         flag(t.test_on_left),
+                                         num(t.response_value),
+                                         detail::number_text(t.response_time_s),
+                                         detail::number_text(t.onset_time_s),
+                                         std::to_string(t.dropped_frames),
+                                         t.missed_deadline ? "1" : "0",
+                                         num(t.adaptation_cd_m2),
+                                         csv_field(t.tone_operator),
+                                         csv_field(t.glare_test),
+                                         csv_field(t.glare_reference),
+                                         num(t.test_intensity_cd),
+                                         detail::number_text(t.guess_rate),
+                                         detail::number_text(t.target_p),
+                                         flag(t.reversal),
+                                         num(t.quest_mean),
+                                         num(t.quest_sd),
+                                         num(t.quest_lower),
+                                         num(t.quest_upper),
+                                         csv_field(t.source)};
+        for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
+        out << '\n';
+    }
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("{}: writing failed (disk full?)", csv_file.string()));
+}
+
+// ---------------------------------------------------------------------------
+
+void merge(Dataset& into, Dataset&& more) {
+    std::set<std::string, std::less<>> keys;
+    for (const SessionInfo& s : into.sessions) keys.insert(s.key);
+    for (const SessionInfo& s : more.sessions)
+        if (keys.count(s.key))
+            throw InputError(s.source, 0, "",
+                             fmt::format("session '{}' is given twice (the same input named twice?)", s.key));
+    auto append = [](auto& a, auto& b) { a.insert(a.end(), std::make_move_iterator(b.begin()), std::make_move_iterator(b.end())); };
+    append(into.sources, more.sources);
+    append(into.trials, more.trials);
+    append(into.sessions, more.sessions);
+    append(into.calibrations, more.calibrations);
+    append(into.snapshots, more.snapshots);
+    append(into.notes, more.notes);
+    append(into.temporaries, more.temporaries);
+}
+
+}  // namespace atonlab::analysis

@@ -1,0 +1,172 @@
+#include "procedure_replay.h"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <memory>
+#include <type_traits>
+#include <variant>
+
+#include "atonlab/protocols/forced_choice.h"
+#include "atonlab/protocols/procedure.h"
+#include "atonlab/protocols/protocol_file.h"
+#include "atonlab/protocols/quest.h"
+#include "atonlab/protocols/staircase.h"
+#include "atonlab/protocols/weighted_staircase.h"
+
+namespace atonlab::analysis::detail {
+
+namespace p = atonlab::protocols;
+
+namespace {
+
+/// P(procedure Yes) the procedure converges on, as the runner's summary
+/// computes its true value (runner/src/run_session.cpp, target_p_yes).
+std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
+    return std::visit(
+        [](const auto& params) -> std::optional<double> {
+            using T = std::decay_t<decltype(params)>;
+            if constexpr (std::is_same_v<T, p::WeightedStaircaseParams>) {
+                return params.target;  // Kaernbach 1991
+            } else if constexpr (std::is_same_v<T, p::StaircaseParams>) {
+                if (params.up_step_ratio != 1.0) return std::nullopt;
+                // Levitt 1971: 1-up/n-down converges on p^n = 0.5, n-up/1-down on (1 - p)^n = 0.5.
+                if (params.n_up == 1) return std::pow(0.5, 1.0 / static_cast<double>(params.n_down));
+                if (params.n_down == 1) return 1.0 - std::pow(0.5, 1.0 / static_cast<double>(params.n_up));
+                return std::nullopt;
+            } else if constexpr (std::is_same_v<T, p::QuestParams>) {
+                return params.p_threshold;
+            } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
+                return params.criterion;
+            } else {
+                return 0.5;  // adjustment: a match
+            }
+        },
+        spec.params);
+}
+
+ConditionDesign condition_design(const p::Condition& c) {
+    ConditionDesign d;
+    d.condition = &c;
+    d.procedure = std::string(p::to_string(c.procedure.kind));
+    // The outcome is "chose the level stimulus" (2AFC) or "yes" (yes-no); the
+    // procedure's Yes is the protocol's `choice`. They agree when the choice
+    // names the stimulus the level is on.
+    const bool yes_is_outcome = c.task != p::Task::TwoAfc ||
+                                ((c.choice == p::ChoiceMapping::ChoseReference) == (c.level_on == p::Role::Reference));
+    const std::optional<double> p_yes = target_p_yes(c.procedure);
+    if (p_yes) {
+        d.target_p = yes_is_outcome ? *p_yes : 1.0 - *p_yes;
+    } else if (const auto* s = std::get_if<p::StaircaseParams>(&c.procedure.params)) {
+        d.note = fmt::format(
+            "condition \"{}\": a {}-up/{}-down staircase with up_step_ratio {} has no simple target probability; "
+            "its thresholds are given at P = 0.5",
+            c.name, s->n_up, s->n_down, s->up_step_ratio);
+    }
+    // Guess rate of the outcome: QUEST states its own; a 2AFC scored as "chose
+    // the test" with the level on the test and a target above 0.5 is a
+    // detection or discrimination (correct / incorrect, gamma = 0.5); every
+    // comparison whose target is 0.5 (a PSE) runs from 0 to 1.
+    if (const auto* q = std::get_if<p::QuestParams>(&c.procedure.params); q && yes_is_outcome) {
+        d.guess_rate = q->gamma;
+    } else if (c.task == p::Task::TwoAfc && c.level_on == p::Role::Test &&
+               c.choice == p::ChoiceMapping::ChoseTest && d.target_p > 0.5 + 1e-9) {
+        d.guess_rate = 0.5;
+    }
+    return d;
+}
+
+p::Response side_of(std::string_view word) {
+    return word == "left" ? p::Response::Left : p::Response::Right;
+}
+
+}  // namespace
+
+ProtocolDesign design_of(std::string_view protocol_text, std::string_view protocol_name) {
+    ProtocolDesign out;
+    try {
+        out.protocol = p::parse_protocol(protocol_text, protocol_name.empty() ? "protocol.toml" : protocol_name);
+    } catch (const std::exception& e) {
+        out.error = e.what();
+        return out;
+    }
+    for (const p::Block& b : out.protocol->blocks) {
+        for (const p::Condition& c : b.conditions) {
+            out.conditions.emplace(c.name, condition_design(c));
+            out.order.push_back(c.name);
+        }
+    }
+    return out;
+}
+
+std::optional<std::size_t> track_number(std::string_view procedure_id) {
+    const auto slash = procedure_id.rfind("/t");
+    if (slash == std::string_view::npos) return std::nullopt;
+    const std::string_view digits = procedure_id.substr(slash + 2);
+    std::size_t t = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), t);
+    if (ec != std::errc() || end != digits.data() + digits.size() || digits.empty()) return std::nullopt;
+    return t;
+}
+
+std::string replay_track(const ConditionDesign& design, std::size_t track, const std::vector<Trial*>& trials) {
+    const p::Condition& c = *design.condition;
+    const p::ProcedureKind kind = c.procedure.kind;
+    if (kind != p::ProcedureKind::Staircase && kind != p::ProcedureKind::WeightedStaircase &&
+        kind != p::ProcedureKind::Quest)
+        return {};
+    if (track >= c.procedure.tracks()) return fmt::format("the protocol's condition has no track {}", track);
+    // The inner procedure alone (a yes-no copy of the condition is not wrapped
+    // in a ForcedChoice); the 2AFC answers are mapped as ForcedChoice maps them.
+    p::Condition inner_condition = c;
+    inner_condition.task = p::Task::YesNo;
+    std::unique_ptr<p::Procedure> proc;
+    try {
+        proc = p::make_track(inner_condition, track, 0);
+    } catch (const std::exception& e) {
+        return fmt::format("its procedure could not be built: {}", e.what());
+    }
+    const auto* quest = dynamic_cast<const p::Quest*>(proc.get());
+    const auto* stair = dynamic_cast<const p::Staircase*>(proc.get());  // WeightedStaircase is one too
+    for (std::size_t i = 0; i < trials.size(); ++i) {
+        Trial& t = *trials[i];
+        const std::optional<p::Proposal> next = proc->next();
+        if (!next) return fmt::format("the procedure finished before trial {} of the session", t.trial_index);
+        if (std::abs(next->level - t.level) > 1e-9 * std::max(1.0, std::abs(t.level)))
+            return fmt::format("trial {} of the session was logged at level {} where the protocol's procedure "
+                               "proposes {}",
+                               t.trial_index, t.level, next->level);
+        p::Response r{};
+        if (c.task == p::Task::TwoAfc) {
+            if ((t.response != "left" && t.response != "right") || !t.test_on_left)
+                return fmt::format("trial {} has no side answer (response \"{}\")", t.trial_index, t.response);
+            r = p::ForcedChoice::inner_response(side_of(t.response), *t.test_on_left, c.choice);
+        } else if (t.response == "yes" || t.response == "no") {
+            r = t.response == "yes" ? p::Response::Yes : p::Response::No;
+        } else {
+            return fmt::format("trial {} has no yes/no answer (response \"{}\")", t.trial_index, t.response);
+        }
+        try {
+            proc->record(r);
+        } catch (const std::exception& e) {
+            return fmt::format("trial {} could not be replayed: {}", t.trial_index, e.what());
+        }
+        if (quest) {
+            // QuestDemo's final estimate (mean +- sd) and the 95% credible
+            // interval by QuestQuantile (thresholds.h summarize_quest reads them back).
+            t.quest_mean = quest->mean();
+            t.quest_sd = quest->sd();
+            t.quest_lower = quest->quantile(0.025);
+            t.quest_upper = quest->quantile(0.975);
+        }
+    }
+    if (stair) {
+        for (Trial* t : trials) t->reversal = false;
+        for (const std::size_t r : stair->reversal_trials())
+            if (r < trials.size()) trials[r]->reversal = true;
+    }
+    return {};
+}
+
+}  // namespace atonlab::analysis::detail

@@ -1,0 +1,370 @@
+// report.html (report.h): one self-contained page. Styles are inline, the
+// figures are embedded as base64 PNG (with a relative link to each SVG next
+// to the report), and nothing is loaded from anywhere else: the page reads
+// the same offline, from a USB stick or an e-mail attachment.
+#include <fmt/format.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "atonlab/analysis/report.h"
+#include "csv.h"
+
+namespace atonlab::analysis {
+
+namespace {
+
+std::string esc(std::string_view s) {
+    std::string o;
+    for (const char ch : s) {
+        switch (ch) {
+            case '&':
+                o += "&amp;";
+                break;
+            case '<':
+                o += "&lt;";
+                break;
+            case '>':
+                o += "&gt;";
+                break;
+            case '"':
+                o += "&quot;";
+                break;
+            case '\'':
+                o += "&#39;";
+                break;
+            default:
+                o += ch;
+        }
+    }
+    return o;
+}
+
+std::string f3(const std::optional<double>& v) {
+    return v ? fmt::format("{:.3f}", *v) : std::string("&ndash;");
+}
+
+std::string g3(const std::optional<double>& v) {
+    return v ? fmt::format("{:.3g}", *v) : std::string("&ndash;");
+}
+
+std::string ci_text(const std::optional<Interval>& ci) {
+    return ci ? fmt::format("[{:.3f}, {:.3f}]", ci->lower, ci->upper) : std::string("&ndash;");
+}
+
+std::string yes_no(bool reliable, const std::string& reason) {
+    if (reliable) return "<span class=\"ok\">yes</span>";
+    return "<span class=\"bad\">no</span>" + (reason.empty() ? std::string() : ": " + esc(reason));
+}
+
+std::string read_file(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::string figure_html(const std::filesystem::path& out_dir, const Figure& f) {
+    const std::string png = read_file(out_dir / f.png);
+    if (png.empty()) return {};
+    std::string h = "<figure>\n";
+    h += fmt::format("<img alt=\"{}\" src=\"data:image/png;base64,{}\">\n", esc(f.title), base64(png));
+    h += fmt::format("<figcaption><b>{}.</b> {}", esc(f.title), esc(f.caption));
+    h += fmt::format(" <span class=\"files\">Files: <a href=\"{0}\">{0}</a>", esc(f.png.generic_string()));
+    if (!f.svg.empty()) h += fmt::format(", <a href=\"{0}\">{0}</a>", esc(f.svg.generic_string()));
+    h += ".</span></figcaption>\n</figure>\n";
+    return h;
+}
+
+const char* kStyle = R"(body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 2em auto; max-width: 72em; color: #222; line-height: 1.4; }
+h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
+table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: left; vertical-align: top; }
+th { background: #f2f2f2; }
+td.num { text-align: right; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
+.ok { color: #1a7f37; font-weight: bold; } .bad { color: #b3261e; font-weight: bold; }
+.warn { background: #fff4e5; border-left: 4px solid #f0a020; padding: 0.5em 1em; }
+figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #444; max-width: 60em; } .files { color: #777; }
+code { background: #f4f4f4; padding: 0 0.2em; })";
+
+}  // namespace
+
+std::string base64(const std::string& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    std::size_t i = 0;
+    for (; i + 2 < bytes.size(); i += 3) {
+        const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) |
+                           (static_cast<unsigned char>(bytes[i + 1]) << 8) | static_cast<unsigned char>(bytes[i + 2]);
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += table[(v >> 6) & 63];
+        out += table[v & 63];
+    }
+    if (i + 1 == bytes.size()) {
+        const unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += "==";
+    } else if (i + 2 == bytes.size()) {
+        const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8);
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += table[(v >> 6) & 63];
+        out += '=';
+    }
+    return out;
+}
+
+void write_report_html(const std::filesystem::path& file, const ReportContext& ctx) {
+    const StudyResults& r = *ctx.results;
+    const Dataset& d = *ctx.data;
+    const std::filesystem::path out_dir = file.parent_path();
+    std::map<std::string, std::vector<const Figure*>> by_condition;
+    std::map<std::string, const Figure*> by_kind;
+    if (ctx.plots) {
+        for (const Figure& f : ctx.plots->figures) {
+            if (!f.condition.empty()) by_condition[f.condition].push_back(&f);
+            else if (!by_kind.count(f.kind)) by_kind[f.kind] = &f;
+        }
+    }
+    std::string h;
+    h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+    h += "<title>atonlab analysis</title>\n<style>\n" + std::string(kStyle) + "\n</style>\n</head>\n<body>\n";
+    h += "<h1>atonlab analysis</h1>\n";
+    h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version), esc(ctx.command_line));
+    h += "<p>Inputs:</p>\n<ul>\n";
+    for (const std::string& s : d.sources) h += "<li><code>" + esc(s) + "</code></li>\n";
+    h += "</ul>\n";
+    h += fmt::format(
+        "<p>{} trials of {} observer(s) in {} session(s). Psychometric functions: {} family, binomial maximum "
+        "likelihood, guess rate fixed by the task, lapse rate free in [0, 0.06]; {:.0f}% intervals from {} parametric "
+        "bootstrap resamples (seed {}). Levels are in each condition's procedure units.</p>\n",
+        d.trials.size(), r.observers.size(), d.sessions.size(), to_string(r.options.family), 100.0 * r.options.ci_level,
+        r.options.bootstrap, r.options.seed);
+
+    std::vector<std::string> warnings = r.warnings;
+    if (ctx.plots) warnings.insert(warnings.end(), ctx.plots->problems.begin(), ctx.plots->problems.end());
+    warnings.insert(warnings.end(), ctx.problems.begin(), ctx.problems.end());
+    if (!warnings.empty()) {
+        h += "<div class=\"warn\"><p><b>Notes and warnings</b></p>\n<ul>\n";
+        for (const std::string& w : warnings) h += "<li>" + esc(w) + "</li>\n";
+        h += "</ul></div>\n";
+    }
+
+    // --- summary table
+    h += "<h2>Summary</h2>\n";
+    h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
+         "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
+         "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
+    h += "<table>\n<tr><th>condition</th><th>task / procedure</th><th>adaptation (cd/m²)</th><th>tone mapper</th>"
+         "<th>glare test / reference</th><th>test (cd)</th><th>observer</th><th>trials</th><th>estimate</th>"
+         "<th>interval</th><th>unit</th><th>enhancement [interval]</th><th>reliable</th></tr>\n";
+    for (const ConditionInfo& c : r.conditions) {
+        const GroupResult* g = r.main_group(c.condition);
+        if (!g) continue;
+        const HeadlineEstimate& e = g->headline;
+        std::string enh = "&ndash;";
+        if (g->match_ratio && g->match_ratio->value)
+            enh = f3(g->match_ratio->value) + " " + ci_text(g->match_ratio->ci);
+        h += fmt::format(
+            "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
+            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            esc(file_slug(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))), esc(c.procedure),
+            g3(c.adaptation_cd_m2), esc(c.tone_operator), esc(c.glare_test), esc(c.glare_reference),
+            g3(c.test_intensity_cd), esc(g->observer), g->n_scored, f3(e.value), ci_text(e.ci), esc(c.level_unit()),
+            enh, yes_no(e.reliable, e.reason));
+    }
+    h += "</table>\n";
+    for (const char* kind : {"pse", "enhancement"})
+        if (by_kind.count(kind)) h += figure_html(out_dir, *by_kind[kind]);
+
+    // --- per condition
+    for (const ConditionInfo& c : r.conditions) {
+        h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(file_slug(c.condition)), esc(c.condition));
+        h += fmt::format(
+            "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
+            "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "
+            "(guess rate {}, target P {}). {} trials.</p>\n",
+            esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure),
+            esc(c.level_key), esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
+            esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
+            esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
+            esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
+            c.task == Task::YesNo ? "yes" : c.task == Task::Adjust ? "the confirmed match"
+                                    : c.level_on == "test"         ? "chose the test"
+                                                                   : "chose the reference",
+            c.guess_rate, c.target_p, c.n_trials);
+        h += "<table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</th><th>how</th>"
+             "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
+             "<th>reliable</th></tr>\n";
+        for (const GroupResult& g : r.groups) {
+            if (g.condition != c.condition) continue;
+            std::string slope = "&ndash;", width = "&ndash;", lapse = "&ndash;", gof = "&ndash;";
+            if (g.fit && g.fit->estimate) {
+                const PsychometricEstimate& e = *g.fit->estimate;
+                slope = fmt::format("{:.3g}", e.slope);
+                width = fmt::format("{:.3g}", e.width);
+                lapse = fmt::format("{:.3f}", e.params.lambda);
+                gof = fmt::format("{:.2f}", e.deviance);
+                if (g.bootstrap) {
+                    if (g.bootstrap->slope)
+                        slope += fmt::format(" [{:.3g}, {:.3g}]", g.bootstrap->slope->lower, g.bootstrap->slope->upper);
+                    const GoodnessOfFit& gf = g.bootstrap->goodness_of_fit;
+                    gof = fmt::format("{:.2f} ({}), {}", gf.deviance, gf.dof, g3(gf.p_value));
+                }
+            }
+            h += fmt::format(
+                "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>"
+                "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                "<td>{}</td></tr>\n",
+                esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method), slope,
+                width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason));
+        }
+        h += "</table>\n";
+        // The procedures' own estimates.
+        std::string tracks;
+        for (const GroupResult& g : r.groups) {
+            if (g.condition != c.condition || (g.observer == kPooled)) continue;
+            for (const TrackResult& t : g.tracks) {
+                if (t.reversals) {
+                    const ReversalSummary& s = *t.reversals;
+                    tracks += fmt::format(
+                        "<tr><td>{}</td><td>{}</td><td>staircase</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                        "<td>mean of the last {} of {} reversals, sd {}</td><td>{}</td><td>{}</td></tr>\n",
+                        esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(s.mean), s.n_used,
+                        s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason));
+                }
+                if (t.quest) {
+                    const QuestSummary& q = *t.quest;
+                    tracks += fmt::format(
+                        "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                        "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+                        esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(q.mean), g3(q.sd),
+                        ci_text(q.interval), yes_no(q.reliable, q.reason));
+                }
+            }
+            if (g.matches) {
+                const AdjustmentSummary& m = *g.matches;
+                tracks += fmt::format(
+                    "<tr><td>{}</td><td>all matches</td><td>adjustment</td><td class=\"num\">{}</td>"
+                    "<td class=\"num\">{}</td><td>mean match; median {} {}, sd {}</td><td class=\"num\">{}</td>"
+                    "<td>{}</td></tr>\n",
+                    esc(g.observer), m.n, f3(m.mean_log10_ratio), f3(m.median_log10_ratio), ci_text(m.median_ci),
+                    g3(m.sd_log10_ratio), ci_text(m.mean_ci), yes_no(m.reliable, m.reason));
+            }
+        }
+        if (!tracks.empty()) {
+            h += "<p>The procedures' own estimates:</p>\n<table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
+                 "<th>trials</th><th>estimate</th><th>how</th><th>interval</th><th>reliable</th></tr>\n" +
+                 tracks + "</table>\n";
+        }
+        if (const auto it = by_condition.find(c.condition); it != by_condition.end())
+            for (const Figure* f : it->second) h += figure_html(out_dir, *f);
+        for (const SnapshotImage& s : ctx.snapshots) {
+            if (s.condition != c.condition) continue;
+            Figure f;
+            f.title = "Stimulus: " + c.condition;
+            f.caption = s.caption;
+            f.png = s.png;
+            h += figure_html(out_dir, f);
+        }
+    }
+
+    // --- paired comparisons
+    if (!r.paired.empty()) {
+        h += "<h2>Paired comparisons across observers</h2>\n";
+        h += "<p>Conditions that differ in one stimulus parameter, compared within observers: the mean of each "
+             "observer's difference A &minus; B of the headline estimates, its bootstrap interval over observers, "
+             "and Student's paired t test.</p>\n";
+        h += "<table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean A &minus; B</th>"
+             "<th>interval</th><th>t (dof)</th><th>p</th><th>reliable</th></tr>\n";
+        for (const PairedResult& p : r.paired) {
+            const PairedComparison& c = p.comparison;
+            h += fmt::format(
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                "<td class=\"num\">{}</td><td class=\"num\">{} ({})</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+                esc(p.condition_a), esc(p.condition_b), esc(p.factor), c.n, f3(c.mean_difference), ci_text(c.ci),
+                g3(c.t), c.dof, g3(c.p_value), yes_no(c.reliable, c.reason));
+        }
+        h += "</table>\n";
+    }
+
+    // --- sessions and timing
+    h += "<h2>Sessions and frame timing</h2>\n<table>\n<tr><th>session</th><th>observer</th><th>protocol</th>"
+         "<th>status</th><th>started</th><th>trials</th><th>dropped frames</th><th>trials with drops</th>"
+         "<th>missed deadlines</th></tr>\n";
+    for (const SessionInfo& s : d.sessions) {
+        const SessionTiming* t = nullptr;
+        for (const SessionTiming& x : r.timing)
+            if (x.session == s.key) t = &x;
+        h += fmt::format(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+            esc(s.key), esc(s.observer), esc(s.protocol_name), esc(s.status), esc(s.started_at),
+            t ? t->n_trials : 0, t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0);
+    }
+    h += "</table>\n";
+    if (by_kind.count("timing")) h += figure_html(out_dir, *by_kind["timing"]);
+
+    // --- calibration
+    h += "<h2>Display calibration</h2>\n";
+    if (d.calibrations.empty()) {
+        h += "<p>No calibration is recorded for these sessions (a CSV input has none).</p>\n";
+    } else {
+        h += "<table>\n<tr><th>display</th><th>file</th><th>measured</th><th>how</th><th>geometry</th>"
+             "<th>readings</th><th>model (fit_json)</th></tr>\n";
+        for (const CalibrationInfo& c : d.calibrations) {
+            h += fmt::format(
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} × {} px, {:.3f} × {:.3f} m at {:.3f} m</td>"
+                "<td class=\"num\">{}</td><td><code>{}</code></td></tr>\n",
+                esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px,
+                c.width_m, c.height_m, c.viewing_distance_m, c.readings.size(), esc(c.fit_json));
+        }
+        h += "</table>\n";
+        if (ctx.plots)
+            for (const Figure& f : ctx.plots->figures)
+                if (f.kind == "calibration") h += figure_html(out_dir, f);
+    }
+
+    // --- methods and files
+    h += "<h2>Methods</h2>\n<ul>\n"
+         "<li>Each condition's trials are grouped per observer (sessions pooled), and over observers when there "
+         "are several. 2AFC trials count whether the observer chose the stimulus the level is on; yes-no trials "
+         "count yes.</li>\n"
+         "<li>Psychometric function &Psi;(x) = &gamma; + (1 &minus; &gamma; &minus; &lambda;) F(x) fitted by binomial "
+         "maximum likelihood (Wichmann &amp; Hill 2001; the Palamedes conventions). &gamma; is fixed: 0 for "
+         "comparisons and yes-no, 0.5 for a 2AFC scored correct / incorrect, QUEST's own &gamma; for QUEST. The "
+         "threshold is where F = (P &minus; &gamma;) / (1 &minus; &gamma;), P the procedure's target (0.5: the "
+         "PSE).</li>\n"
+         "<li>Intervals: percentile intervals of a parametric bootstrap (Wichmann &amp; Hill 2001b); goodness of "
+         "fit: the deviance against its bootstrap distribution.</li>\n"
+         "<li>Staircases: the mean of each track's last reversals (Levitt 1971). QUEST: the posterior mean and "
+         "the 2.5% and 97.5% posterior quantiles (Watson &amp; Pelli 1983; Psychtoolbox QuestMean, "
+         "QuestQuantile), from the logged answers replayed through the protocol's procedure.</li>\n"
+         "<li>Adjustment: the mean of the confirmed matches with a bootstrap interval over matches. Brightness "
+         "enhancement: log10(PSE or match / test intensity), both in cd.</li>\n"
+         "<li>Observed proportions carry Clopper-Pearson intervals.</li>\n"
+         "</ul>\n";
+    h += "<p>Files next to this report: <a href=\"trials.csv\">trials.csv</a> (one row per trial), "
+         "<a href=\"fits.csv\">fits.csv</a> (one row per estimate), <a href=\"summary.json\">summary.json</a> (every "
+         "number here), and <code>figures/</code>. Their columns are described in docs/analysis.md.</p>\n";
+    h += "</body>\n</html>\n";
+
+    const std::filesystem::path tmp = file.string() + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << h;
+        out.flush();
+        if (!out) throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, file, ec);
+    if (ec) throw std::runtime_error(fmt::format("{}: cannot be written: {}", file.string(), ec.message()));
+}
+
+}  // namespace atonlab::analysis

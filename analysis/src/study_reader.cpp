@@ -1,0 +1,275 @@
+// read_study(): a study file's sessions, trials, calibrations and snapshot
+// list, through the store's read-only connection (docs/store.md), with the
+// stimulus parameters taken from each trial's stimulus_json and the
+// procedures' per-trial state replayed from the stored protocol text.
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "atonlab/analysis/dataset.h"
+#include "atonlab/store/json.h"
+#include "atonlab/store/store.h"
+#include "gnuplot.h"
+#include "procedure_replay.h"
+
+namespace atonlab::analysis {
+
+namespace {
+
+/// A TOML value as the protocol wrote it in an override: a number, or a quoted
+/// string (the protocol loader accepts nothing else for the keys read here).
+std::optional<double> toml_number(std::string_view v) {
+    double x = 0.0;
+    const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+    if (ec != std::errc() || ptr != v.data() + v.size() || !std::isfinite(x)) return std::nullopt;
+    return x;
+}
+
+std::string toml_string(std::string_view v) {
+    if (v.size() >= 2 && (v.front() == '"' || v.front() == '\'') && v.back() == v.front())
+        return std::string(v.substr(1, v.size() - 2));
+    return std::string(v);
+}
+
+struct Frame {
+    std::string role;  ///< "test", "reference", "both"
+    std::vector<std::pair<std::string, std::string>> overrides;  ///< (key, TOML value), in order
+
+    /// The last value written to `key` (later overrides win).
+    std::optional<std::string> value(std::string_view key) const {
+        std::optional<std::string> v;
+        for (const auto& [k, val] : overrides)
+            if (k == key) v = val;
+        return v;
+    }
+};
+
+/// Fills the trial's task, level scale and stimulus parameters from its
+/// stimulus JSON (docs/running.md "What each trial stores"), read with the
+/// store's JsonReader (SQLite's JSON functions: no second JSON library).
+void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& problems) {
+    std::optional<store::JsonReader> jr;
+    try {
+        jr.emplace(json, fmt::format("the stimulus_json of trial {}", t.trial_index));
+    } catch (const store::StoreError& e) {
+        problems.push_back(e.what());
+        return;
+    }
+    const store::JsonReader& j = *jr;
+    if (const auto task = parse_task(j.string("$.task").value_or(""))) t.task = *task;
+    t.level_key = j.string("$.level_key").value_or("");
+    t.level_scale = j.string("$.level_scale").value_or("log10");
+    t.level_on = j.string("$.level_on").value_or(t.task == Task::YesNo ? "test" : "reference");
+    std::vector<Frame> frames;
+    const std::size_t n_frames = j.array_length("$.frames");
+    for (std::size_t f = 0; f < n_frames; ++f) {
+        Frame frame;
+        frame.role = j.string(fmt::format("$.frames[{}].role", f)).value_or("both");
+        const std::size_t n_overrides = j.array_length(fmt::format("$.frames[{}].overrides", f));
+        for (std::size_t k = 0; k < n_overrides; ++k) {
+            const std::string text = j.string(fmt::format("$.frames[{}].overrides[{}]", f, k)).value_or("");
+            const auto eq = text.find('=');
+            if (eq == std::string::npos) continue;
+            frame.overrides.emplace_back(text.substr(0, eq), text.substr(eq + 1));
+        }
+        frames.push_back(std::move(frame));
+    }
+    std::string test_light;
+    const std::size_t n_views = j.array_length("$.views");
+    for (std::size_t v = 0; v < n_views; ++v)
+        if (j.string(fmt::format("$.views[{}].role", v)).value_or("") == "test")
+            test_light = j.string(fmt::format("$.views[{}].light", v)).value_or("");
+    const Frame* test = nullptr;
+    const Frame* reference = nullptr;
+    for (const Frame& f : frames) {
+        if (!test && (f.role == "test" || f.role == "both")) test = &f;
+        if (!reference && (f.role == "reference" || f.role == "both")) reference = &f;
+    }
+    if (!test && !frames.empty()) test = &frames.front();
+    if (test) {
+        if (const auto v = test->value("eye.adaptation_cd_m2")) t.adaptation_cd_m2 = toml_number(*v);
+        if (const auto v = test->value("tonemap.operator")) t.tone_operator = toml_string(*v);
+        if (const auto v = test->value("eye.glare")) t.glare_test = toml_string(*v);
+        if (!test_light.empty()) {
+            if (const auto v = test->value("light." + test_light + ".intensity_cd")) {
+                const auto cd = toml_number(*v);
+                if (cd && *cd > 0.0) t.test_intensity_cd = cd;
+            }
+        }
+    }
+    if (reference) {
+        if (const auto v = reference->value("eye.glare")) t.glare_reference = toml_string(*v);
+    }
+}
+
+/// The binary outcome of a trial (Trial::outcome).
+std::optional<bool> outcome_of(const Trial& t) {
+    if (t.task == Task::TwoAfc) {
+        if ((t.response != "left" && t.response != "right") || !t.test_on_left) return std::nullopt;
+        const bool chose_test = (t.response == "left") == *t.test_on_left;
+        return t.level_on == "test" ? chose_test : !chose_test;
+    }
+    if (t.task == Task::YesNo) {
+        if (t.response == "yes") return true;
+        if (t.response == "no") return false;
+    }
+    return std::nullopt;
+}
+
+/// The procedure kind named in the schedule state line (a fallback when the
+/// protocol text cannot be read): "[i: 2afc mapping=... [staircase trials=...".
+std::string kind_from_state(const std::string& state_json) {
+    for (const char* kind : {"weighted-staircase", "staircase", "quest", "constant-stimuli", "adjustment"}) {
+        if (state_json.find(fmt::format("[{} ", kind)) != std::string::npos ||
+            state_json.find(fmt::format(": {} ", kind)) != std::string::npos)
+            return kind;
+    }
+    return {};
+}
+
+}  // namespace
+
+namespace {
+
+Dataset read_store(const store::Store& db, const std::string& file);
+
+}  // namespace
+
+Dataset read_study(const std::filesystem::path& study_file) {
+    const std::string file = study_file.string();
+    try {
+        return read_store(store::Store::open_read_only(study_file), file);
+    } catch (const store::StoreError& e) {
+        if (e.kind() != store::StoreErrc::older_schema) throw;
+    }
+    // A file of an older schema can only be migrated by a writer, and the input
+    // is never written to: migrate a private copy (the file and its WAL) instead.
+    auto tmp = std::make_shared<detail::TempFolder>("atonlab-analyze-");
+    const std::filesystem::path copy = tmp->path() / "study.db";
+    std::filesystem::copy_file(study_file, copy);
+    std::error_code ec;
+    if (std::filesystem::exists(file + "-wal", ec)) std::filesystem::copy_file(file + "-wal", copy.string() + "-wal");
+    { store::Store migrate = store::Store::open_existing(copy); }
+    Dataset d = read_store(store::Store::open_read_only(copy), file);
+    for (SnapshotRef& r : d.snapshots) r.read_from = copy.string();
+    d.temporaries.push_back(tmp);
+    d.notes.push_back(fmt::format("{} was written with an older schema; it was read through a migrated temporary "
+                                  "copy and is unchanged",
+                                  file));
+    return d;
+}
+
+namespace {
+
+Dataset read_store(const store::Store& db, const std::string& file) {
+    Dataset d;
+    d.sources.push_back(file);
+    std::set<std::int64_t> calibrations;
+    for (const store::SessionRecord& s : db.sessions()) {
+        SessionInfo info;
+        info.key = fmt::format("{}#{}", file, s.id.value);
+        info.source = file;
+        info.id = s.id.value;
+        info.observer = s.observer_code;
+        info.protocol_name = s.protocol_name;
+        info.protocol_sha256 = s.protocol_sha256;
+        info.software_version = s.software_version;
+        info.seed = s.seed;
+        info.started_at = s.started_at;
+        info.ended_at = s.ended_at.value_or("");
+        info.status = store::to_string(s.status);
+        info.trial_count = s.trial_count;
+        if (s.calibration) {
+            info.calibration_id = s.calibration->value;
+            calibrations.insert(s.calibration->value);
+        }
+        const detail::ProtocolDesign design = detail::design_of(db.protocol_text(s.id), s.protocol_name);
+        if (!design.protocol)
+            d.notes.push_back(fmt::format("{} session {}: its protocol text could not be read ({}); the procedures "
+                                          "are taken from the trials' state, guess rates 0 and targets 0.5",
+                                          file, s.id.value, design.error));
+        info.protocol_conditions = design.order;
+        for (const auto& [name, cd] : design.conditions)
+            if (!cd.note.empty()) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, cd.note));
+
+        const std::size_t first = d.trials.size();
+        std::vector<std::string> problems;
+        for (const store::TrialRecord& r : db.trials(s.id)) {
+            Trial t;
+            t.source = file;
+            t.session = info.key;
+            t.observer = s.observer_code;
+            t.trial_index = r.trial_index;
+            t.block = r.block;
+            t.condition = r.condition_id;
+            t.track = r.procedure_id;
+            t.level = r.level;
+            t.response = r.response;
+            t.test_on_left = r.test_on_left;
+            t.response_value = r.response_value;
+            t.response_time_s = r.response_time_s;
+            t.onset_time_s = r.onset_time_s;
+            t.dropped_frames = r.dropped_frames;
+            t.missed_deadline = r.missed_deadline;
+            read_stimulus(t, r.stimulus_json, problems);
+            t.outcome = outcome_of(t);
+            if (const auto it = design.conditions.find(t.condition); it != design.conditions.end()) {
+                t.procedure = it->second.procedure;
+                t.guess_rate = it->second.guess_rate;
+                t.target_p = it->second.target_p;
+            } else {
+                t.procedure = kind_from_state(r.procedure_state_json);
+            }
+            d.trials.push_back(std::move(t));
+        }
+        for (const std::string& p : problems) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, p));
+
+        // Replay each adaptive track through the protocol's procedure.
+        std::map<std::string, std::vector<Trial*>> tracks;
+        std::set<std::string> conditions_seen;
+        for (std::size_t i = first; i < d.trials.size(); ++i) {
+            tracks[d.trials[i].track].push_back(&d.trials[i]);
+            conditions_seen.insert(d.trials[i].condition);
+        }
+        for (auto& [id, trials] : tracks) {
+            const auto it = design.conditions.find(trials.front()->condition);
+            if (it == design.conditions.end()) continue;
+            const auto track = detail::track_number(id);
+            if (!track) continue;
+            const std::string why = detail::replay_track(it->second, *track, trials);
+            if (!why.empty())
+                d.notes.push_back(fmt::format("{} session {}: track {} could not be replayed ({}); its reversals "
+                                              "or QUEST posterior are not reported",
+                                              file, s.id.value, id, why));
+        }
+        for (const std::string& c : conditions_seen) d.snapshots.push_back({file, s.id.value, info.key, c, file});
+        d.sessions.push_back(std::move(info));
+    }
+    for (const std::int64_t id : calibrations) {
+        const store::Calibration c = db.calibration(store::CalibrationId{id});
+        CalibrationInfo ci;
+        ci.source = file;
+        ci.id = id;
+        ci.display_name = c.display_name;
+        ci.width_px = c.width_px;
+        ci.height_px = c.height_px;
+        ci.width_m = c.width_m;
+        ci.height_m = c.height_m;
+        ci.viewing_distance_m = c.viewing_distance_m;
+        ci.fit_json = c.fit_json;
+        ci.how = c.source;
+        ci.measured_at = c.measured_at;
+        for (const store::CalibrationReading& r : db.calibration_readings(store::CalibrationId{id}))
+            ci.readings.push_back({r.patch, r.channel, r.level, r.luminance_cd_m2});
+        d.calibrations.push_back(std::move(ci));
+    }
+    return d;
+}
+
+}  // namespace
+
+}  // namespace atonlab::analysis

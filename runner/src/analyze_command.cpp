@@ -1,0 +1,342 @@
+// `atonlab analyze STUDY.db... [--csv FILE]... --out DIR [--bootstrap N] [--seed N] [--family F] [--quiet]`
+// Offline analysis of response logs (docs/analysis.md): reads study files
+// read-only (and/or CSVs of trials), fits and summarises every condition
+// (analysis/), draws the figures with gnuplot and writes report.html,
+// summary.json, fits.csv, trials.csv and figures/ into DIR.
+//
+// The one part that needs the stimuli library lives here, not in analysis/:
+// the stored stimulus snapshots (scene-referred EXR, cd/m²) are made into
+// PNGs for the report with the CPU references of the tone mapper and the
+// sRGB curve.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "atonlab/analysis/dataset.h"
+#include "atonlab/analysis/plots.h"
+#include "atonlab/analysis/report.h"
+#include "atonlab/analysis/study_analysis.h"
+#include "atonlab/stimuli/colour.h"
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/store/error.h"
+#include "atonlab/store/store.h"
+#include "commands.h"
+
+namespace atonlab::runner {
+
+namespace an = atonlab::analysis;
+namespace fs = std::filesystem;
+
+void add_analyze_command(CLI::App& app, AnalyzeOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "analyze", "Analyse study files (or CSVs of trials): fits, report.html, summary.json, CSVs and figures");
+    cmd->add_option("studies", o.studies, "Study files (SQLite; opened read-only; see docs/store.md)");
+    cmd->add_option("--csv", o.csv, "A long-format CSV of trials (docs/analysis.md); may be given several times");
+    cmd->add_option("--out", o.out, "Output folder (created if absent)")->required();
+    cmd->add_option("--bootstrap", o.bootstrap, "Parametric bootstrap resamples per fit (0: no intervals)")
+        ->check(CLI::Range(0, 1000000));
+    cmd->add_option("--seed", o.seed, "Seed of the bootstrap's random streams");
+    cmd->add_option("--family", o.family, "Psychometric function: normal, logistic, weibull, gumbel")
+        ->check(CLI::IsMember({"normal", "logistic", "weibull", "gumbel"}));
+    cmd->add_option("--last-reversals", o.last_reversals, "Staircases: average the last N reversals")
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--threads", o.threads, "Bootstrap threads (default: the machine's cores; results do not depend on it)")
+        ->check(CLI::Range(1, 256));
+    cmd->add_option("--gnuplot", o.gnuplot, "The gnuplot program that draws the figures");
+    cmd->add_flag("--quiet", o.quiet, "Print nothing but errors");
+}
+
+namespace {
+
+/// One updating line on a terminal, a line per finished group otherwise.
+class BootstrapProgress {
+public:
+    explicit BootstrapProgress(bool quiet) : quiet_(quiet), tty_(isatty(2) != 0) {}
+    ~BootstrapProgress() { end(); }
+    BootstrapProgress(const BootstrapProgress&) = delete;
+    BootstrapProgress& operator=(const BootstrapProgress&) = delete;
+
+    void operator()(const std::string& group, int done, int total) {
+        if (quiet_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (tty_) {
+            if (done != total && group == group_ && now - last_ < std::chrono::milliseconds(100)) return;
+            std::fprintf(stderr, "\r\033[Kbootstrap: %s %d/%d", group.c_str(), done, total);
+            std::fflush(stderr);
+            open_ = true;
+        } else if (done == total) {
+            std::fprintf(stderr, "bootstrap: %s: %d resamples\n", group.c_str(), total);
+        }
+        group_ = group;
+        last_ = now;
+    }
+    void end() {
+        if (open_) std::fprintf(stderr, "\r\033[K");
+        open_ = false;
+    }
+
+private:
+    bool quiet_;
+    bool tty_;
+    bool open_ = false;
+    std::string group_;
+    std::chrono::steady_clock::time_point last_{};
+};
+
+/// The frames of a snapshot EXR: "rows A-B: frame F (role); ..." (run_session.cpp).
+std::vector<std::pair<int, int>> frame_rows(const std::string& note, int height) {
+    std::vector<std::pair<int, int>> out;
+    std::size_t at = 0;
+    while ((at = note.find("rows ", at)) != std::string::npos) {
+        int a = 0, b = 0;
+        if (std::sscanf(note.c_str() + at, "rows %d-%d", &a, &b) == 2 && a >= 0 && b >= a && b < height)
+            out.emplace_back(a, b);
+        at += 5;
+    }
+    if (out.empty()) out.emplace_back(0, height - 1);
+    return out;
+}
+
+/// The condition's snapshot as a PNG: each frame tone-mapped (the condition's
+/// operator at its adaptation luminance, CPU reference) and sRGB-encoded,
+/// cropped to a square of `crop_deg` around its brightest pixel, side by side.
+std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c, const fs::path& png,
+                         std::string& caption) {
+    if (snap.format != "exr") return fmt::format("its format is \"{}\", not exr", snap.format);
+    const fs::path exr = fs::temp_directory_path() / fmt::format("atonlab-analyze-{}-snapshot.exr", getpid());
+    {
+        std::ofstream out(exr, std::ios::binary);
+        out.write(reinterpret_cast<const char*>(snap.data.data()), static_cast<std::streamsize>(snap.data.size()));
+        if (!out) return "it could not be written to a temporary file";
+    }
+    stimuli::ExrImage img;
+    try {
+        img = stimuli::read_exr(exr);
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        fs::remove(exr, ec);
+        return e.what();
+    }
+    std::error_code ec;
+    fs::remove(exr, ec);
+    const stimuli::ImageRGBA32F& hdr = img.image;
+    if (hdr.width <= 0 || hdr.height <= 0) return "the image is empty";
+    stimuli::ToneMapSettings tm;
+    if (const auto op = stimuli::tone_operator_from_name(c.tone_operator)) tm.tone_operator = *op;
+    const double adaptation = c.adaptation_cd_m2.value_or(img.meta.adaptation_cd_m2.value_or(1.0));
+    const double crop_deg = 6.0;
+    const int half = img.meta.degrees_per_pixel > 0.0
+                         ? std::max(8, static_cast<int>(std::lround(0.5 * crop_deg / img.meta.degrees_per_pixel)))
+                         : 128;
+    const auto frames = frame_rows(img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "", hdr.height);
+    struct Tile {
+        int x0, y0, w, h;
+    };
+    std::vector<Tile> tiles;
+    for (const auto& [r0, r1] : frames) {
+        int bx = hdr.width / 2, by = (r0 + r1) / 2;
+        double best = -1.0;
+        for (int y = r0; y <= r1; ++y) {
+            for (int x = 0; x < hdr.width; ++x) {
+                const float* p = hdr.pixel(x, y);
+                const double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                if (lum > best) {
+                    best = lum;
+                    bx = x;
+                    by = y;
+                }
+            }
+        }
+        const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
+        const int x0 = std::clamp(bx - w / 2, 0, hdr.width - w);
+        const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
+        tiles.push_back({x0, y0, w, h});
+    }
+    const int gap = 8;
+    int width = 0, height = 0;
+    for (const Tile& t : tiles) {
+        width += t.w + (width ? gap : 0);
+        height = std::max(height, t.h);
+    }
+    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
+    int left = 0;
+    for (const Tile& t : tiles) {
+        for (int y = 0; y < t.h; ++y) {
+            for (int x = 0; x < t.w; ++x) {
+                const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
+                const glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                float* q = &rgb[(static_cast<std::size_t>(y) * width + left + x) * 3];
+                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(d[k], 0.0, 1.0)));
+            }
+        }
+        left += t.w + gap;
+    }
+    try {
+        stimuli::write_png_rgb8(png, width, height, rgb);
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    caption = fmt::format(
+        "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames left to right in "
+        "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
+        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).",
+        c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
+        stimuli::tone_operator_name(tm.tone_operator), adaptation);
+    return {};
+}
+
+/// Snapshot PNGs for every condition that has one (the first session's).
+std::vector<an::SnapshotImage> make_snapshots(const an::Dataset& data, const an::StudyResults& results,
+                                              const fs::path& out_dir, std::vector<std::string>& problems) {
+    std::vector<an::SnapshotImage> out;
+    std::set<std::string> done;
+    std::map<std::string, std::unique_ptr<store::Store>> open;
+    for (const an::SnapshotRef& ref : data.snapshots) {
+        if (done.count(ref.condition)) continue;
+        const an::ConditionInfo* c = results.condition(ref.condition);
+        if (!c) continue;
+        try {
+            const std::string& file = ref.read_from.empty() ? ref.source : ref.read_from;
+            auto& db = open[file];
+            if (!db) db = std::make_unique<store::Store>(store::Store::open_read_only(file));
+            const auto snap = db->get_snapshot(store::SessionId{ref.session_id}, ref.condition);
+            if (!snap) continue;
+            done.insert(ref.condition);
+            fs::create_directories(out_dir / "figures");
+            const fs::path rel = fs::path("figures") / ("snapshot-" + an::file_slug(ref.condition) + ".png");
+            std::string caption;
+            const std::string why = snapshot_png(*snap, *c, out_dir / rel, caption);
+            if (!why.empty()) {
+                problems.push_back(fmt::format("the snapshot of condition \"{}\" (session {}) could not be shown: {}",
+                                               ref.condition, ref.session, why));
+                continue;
+            }
+            out.push_back({ref.condition, ref.session, rel, caption});
+        } catch (const store::StoreError& e) {
+            problems.push_back(fmt::format("the snapshot of condition \"{}\" could not be read: {}", ref.condition,
+                                           e.what()));
+        }
+    }
+    return out;
+}
+
+std::string command_line_text(const AnalyzeOptions& o) {
+    std::string s = "atonlab analyze";
+    for (const std::string& f : o.studies) s += " " + f;
+    for (const std::string& f : o.csv) s += " --csv " + f;
+    s += " --out " + o.out;
+    if (o.bootstrap) s += fmt::format(" --bootstrap {}", *o.bootstrap);
+    if (o.seed) s += fmt::format(" --seed {}", *o.seed);
+    if (!o.family.empty()) s += " --family " + o.family;
+    return s;
+}
+
+/// A study-file error that is the input's fault (exit status 2) rather than
+/// the file system's (4).
+bool is_bad_input(store::StoreErrc k) {
+    using store::StoreErrc;
+    return k == StoreErrc::cannot_open || k == StoreErrc::not_a_database || k == StoreErrc::not_a_study ||
+           k == StoreErrc::newer_schema || k == StoreErrc::not_found || k == StoreErrc::invalid_argument;
+}
+
+}  // namespace
+
+int run_analyze(const AnalyzeOptions& o) {
+    if (o.studies.empty() && o.csv.empty())
+        throw InputError("atonlab analyze needs at least one study file or --csv FILE to read.");
+    an::AnalysisOptions ao;
+    if (o.bootstrap) ao.bootstrap = *o.bootstrap;
+    if (o.seed) ao.seed = *o.seed;
+    if (!o.family.empty()) ao.family = *an::parse_family(o.family);
+    ao.last_reversals = o.last_reversals;
+    ao.n_threads = o.threads ? *o.threads : std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+
+    // --- read every input: nothing is written before all of them are read.
+    an::Dataset data;
+    try {
+        for (const std::string& f : o.studies) an::merge(data, an::read_study(f));
+        for (const std::string& f : o.csv) an::merge(data, an::read_trials_csv(f));
+    } catch (const store::StoreError& e) {
+        std::fprintf(stderr, "atonlab: %s\n", e.what());
+        return is_bad_input(e.kind()) ? 2 : 4;
+    } catch (const an::InputError& e) {
+        std::fprintf(stderr, "atonlab: %s\n", e.what());
+        return 2;
+    }
+    if (data.trials.empty() && data.sessions.empty()) {
+        std::fprintf(stderr, "atonlab: the input holds no sessions and no trials: nothing to analyse.\n");
+        return 2;
+    }
+
+    const fs::path out_dir = o.out;
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec || !fs::is_directory(out_dir)) {
+        std::fprintf(stderr, "atonlab: %s: the output folder cannot be created (%s).\n", o.out.c_str(),
+                     ec ? ec.message().c_str() : "a file of that name exists");
+        return 2;
+    }
+
+    const auto started = std::chrono::steady_clock::now();
+    BootstrapProgress progress(o.quiet);
+    ao.progress = [&progress](const std::string& g, int done, int total) { progress(g, done, total); };
+    const an::StudyResults results = an::analyze_study(data, ao);
+    progress.end();
+    const double analysis_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+    an::PlotOptions po;
+    po.gnuplot = o.gnuplot;
+    const an::PlotResult plots = an::make_figures(out_dir, data, results, po);
+    an::ReportContext ctx;
+    ctx.data = &data;
+    ctx.results = &results;
+    ctx.plots = &plots;
+    ctx.snapshots = make_snapshots(data, results, out_dir, ctx.problems);
+    ctx.software_version = ATONLAB_VERSION;
+    ctx.command_line = command_line_text(o);
+    an::write_report(out_dir, ctx);
+    const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+    if (!o.quiet) {
+        std::printf("analysed %zu trials of %zu observer(s) in %zu session(s): %zu conditions (%.1f s fits and "
+                    "bootstrap, %.1f s in all)\n",
+                    data.trials.size(), results.observers.size(), data.sessions.size(), results.conditions.size(),
+                    analysis_s, total_s);
+        for (const an::ConditionInfo& c : results.conditions) {
+            const an::GroupResult* g = results.main_group(c.condition);
+            if (!g) continue;
+            const an::HeadlineEstimate& h = g->headline;
+            std::string line = fmt::format("  {:<24} ", c.condition);
+            if (h.value) {
+                line += fmt::format("{:.3f}", *h.value);
+                if (h.ci) line += fmt::format(" [{:.3f}, {:.3f}]", h.ci->lower, h.ci->upper);
+                line += fmt::format(" {} ({})", c.level_unit(), h.method);
+            } else {
+                line += "no estimate";
+            }
+            if (!h.reliable && !h.reason.empty()) line += "; unreliable: " + h.reason;
+            std::printf("%s\n", line.c_str());
+        }
+        const std::size_t notes = results.warnings.size() + plots.problems.size() + ctx.problems.size();
+        if (notes) std::printf("%zu note(s) and warning(s): see the report\n", notes);
+        std::printf("report: %s\n", (out_dir / "report.html").string().c_str());
+    }
+    for (const std::string& p : plots.problems) std::fprintf(stderr, "atonlab: warning: %s\n", p.c_str());
+    // The report is complete but a figure is missing: a distinct status, so a
+    // script notices (docs/analysis.md "Exit status").
+    return plots.problems.empty() ? 0 : 5;
+}
+
+}  // namespace atonlab::runner

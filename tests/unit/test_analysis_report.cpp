@@ -1,0 +1,306 @@
+// `atonlab analyze`'s outputs (analysis/include/atonlab/analysis/report.h,
+// plots.h, study_analysis.h): degenerate data is flagged with a reason and
+// never becomes NaN; summary.json is valid JSON; report.html is well formed,
+// self-contained and lists only figures that exist; a missing gnuplot still
+// gives a report; a simulated observer's known PSE is recovered.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <fstream>
+#include <set>
+
+#include "../store/store_test_support.h"
+#include "analysis_test_data.h"
+#include "atonlab/analysis/dataset.h"
+#include "atonlab/analysis/plots.h"
+#include "atonlab/analysis/report.h"
+#include "atonlab/analysis/study_analysis.h"
+#include "atonlab/store/json.h"
+
+namespace atonlab::analysis {
+namespace {
+
+namespace fs = std::filesystem;
+using store::test_support::file_bytes;
+using store::test_support::TempDir;
+namespace td = test_data;
+
+Trial trial(const std::string& condition, double level, std::optional<bool> outcome, const std::string& obs = "P") {
+    Trial t;
+    t.source = "synthetic";
+    t.session = "synthetic#" + obs;
+    t.observer = obs;
+    t.condition = condition;
+    t.level = level;
+    t.outcome = outcome;
+    t.response = outcome ? (*outcome ? "yes" : "no") : "timeout";
+    t.task = Task::YesNo;
+    t.level_on = "test";
+    t.level_key = "light.flash.intensity_cd";
+    return t;
+}
+
+/// A dataset with one degenerate condition each, plus a condition of the
+/// protocol that has no trials at all.
+Dataset degenerate() {
+    Dataset d;
+    d.sources = {"synthetic"};
+    SessionInfo s;
+    s.key = "synthetic#P";
+    s.source = "synthetic";
+    s.observer = "P";
+    s.protocol_conditions = {"all-yes", "all-no", "one-level", "one-trial", "no-trials", "no-answers"};
+    d.sessions.push_back(s);
+    for (double l : {1.0, 2.0, 3.0})
+        for (int i = 0; i < 5; ++i) d.trials.push_back(trial("all-yes", l, true));
+    for (double l : {1.0, 2.0, 3.0})
+        for (int i = 0; i < 5; ++i) d.trials.push_back(trial("all-no", l, false));
+    for (int i = 0; i < 10; ++i) d.trials.push_back(trial("one-level", 2.0, i % 2 == 0));
+    d.trials.push_back(trial("one-trial", 2.0, true));
+    for (int i = 0; i < 3; ++i) d.trials.push_back(trial("no-answers", 2.0, std::nullopt));
+    for (std::size_t i = 0; i < d.trials.size(); ++i) d.trials[i].trial_index = static_cast<std::int64_t>(i);
+    return d;
+}
+
+/// The first word that spells a non-finite number ("nan", "inf", "infinity", any case), or "".
+std::string non_finite_word(const std::string& text) {
+    std::string word;
+    for (std::size_t i = 0; i <= text.size(); ++i) {
+        const bool letter = i < text.size() && std::isalpha(static_cast<unsigned char>(text[i]));
+        if (letter) {
+            word += static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
+            continue;
+        }
+        if (word == "nan" || word == "inf" || word == "infinity") return word;
+        word.clear();
+    }
+    return {};
+}
+
+TEST(AnalysisReport, DegenerateConditionsAreFlaggedWithReasonsNeverNaN) {
+    const Dataset d = degenerate();
+    AnalysisOptions o;
+    o.bootstrap = 50;
+    const StudyResults r = analyze_study(d, o);
+    ASSERT_EQ(r.conditions.size(), 6u);
+    for (const std::string name : {"all-yes", "all-no", "one-level", "one-trial", "no-trials", "no-answers"}) {
+        const GroupResult* g = r.main_group(name);
+        ASSERT_NE(g, nullptr) << name;
+        EXPECT_FALSE(g->headline.reliable) << name;
+        EXPECT_FALSE(g->headline.reason.empty()) << name;
+        if (g->headline.value) {
+            EXPECT_TRUE(std::isfinite(*g->headline.value)) << name;
+        }
+    }
+    EXPECT_EQ(r.main_group("no-trials")->n_trials, 0);
+
+    TempDir dir;
+    PlotResult plots;  // no figures: this test is about the numbers
+    ReportContext ctx;
+    ctx.data = &d;
+    ctx.results = &r;
+    ctx.plots = &plots;
+    ctx.software_version = "test";
+    write_report(dir.path(), ctx);
+    const std::string json = file_bytes(dir / "summary.json");
+    const std::string csv = file_bytes(dir / "fits.csv");
+    const std::string html = file_bytes(dir / "report.html");
+    for (const std::string* text : {&json, &csv, &html}) EXPECT_EQ(non_finite_word(*text), "");
+    // Valid JSON (SQLite's json_valid through the store's reader), nulls with reasons.
+    const store::JsonReader j(json, "summary.json");
+    const std::size_t n = j.array_length("$.conditions");
+    ASSERT_EQ(n, 6u);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::string at = fmt::format("$.conditions[{}].groups[0].headline", i);
+        const auto reason = j.string(at + ".reason");
+        ASSERT_TRUE(reason.has_value());
+        EXPECT_FALSE(reason->empty()) << at;
+        EXPECT_EQ(j.boolean(at + ".reliable"), std::optional<bool>(false)) << at;
+        const std::string cond = *j.string(fmt::format("$.conditions[{}].condition", i));
+        if (cond == "no-trials" || cond == "one-trial" || cond == "no-answers") {
+            EXPECT_FALSE(j.number(at + ".value").has_value()) << cond << ": value should be null";
+        }
+        EXPECT_NE(html.find(fmt::format(">{}<", cond)), std::string::npos) << cond;
+    }
+    // fits.csv carries the reasons: every headline row has reliable = 0 and a non-empty reason.
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line);
+    int headlines = 0;
+    while (std::getline(lines, line)) {
+        if (line.find(",headline,") == std::string::npos) continue;
+        ++headlines;
+        EXPECT_NE(line.find(",0,"), std::string::npos) << line;
+    }
+    EXPECT_EQ(headlines, 6);
+}
+
+/// The tags of an HTML document balance (void elements aside), and nothing is
+/// loaded from elsewhere.
+void expect_well_formed_and_self_contained(const std::string& html) {
+    static const std::set<std::string> kVoid{"meta", "img", "br", "hr", "link", "input"};
+    std::vector<std::string> stack;
+    // A plain scan (std::regex recurses per character and overflows on the base64 images).
+    for (std::size_t at = html.find('<'); at != std::string::npos; at = html.find('<', at + 1)) {
+        if (html.compare(at, 2, "<!") == 0) continue;  // the doctype
+        const std::size_t end = html.find('>', at);
+        ASSERT_NE(end, std::string::npos) << "a tag that never ends at " << at;
+        const bool closing = html[at + 1] == '/';
+        std::size_t b = at + (closing ? 2 : 1), e = b;
+        while (e < end && std::isalnum(static_cast<unsigned char>(html[e]))) ++e;
+        const std::string name = html.substr(b, e - b);
+        ASSERT_FALSE(name.empty()) << "a '<' that starts no tag at " << at << ": " << html.substr(at, 40);
+        if (kVoid.count(name) || html[end - 1] == '/') continue;
+        if (closing) {
+            ASSERT_FALSE(stack.empty()) << "</" << name << "> closes nothing";
+            ASSERT_EQ(stack.back(), name) << "</" << name << "> closes <" << stack.back() << ">";
+            stack.pop_back();
+        } else {
+            stack.push_back(name);
+        }
+    }
+    EXPECT_TRUE(stack.empty()) << "unclosed <" << (stack.empty() ? "" : stack.back()) << ">";
+    // Every row of a table has as many cells as its header row.
+    for (std::size_t t = html.find("<table>"); t != std::string::npos; t = html.find("<table>", t + 1)) {
+        const std::string table = html.substr(t, html.find("</table>", t) - t);
+        int header = -1;
+        for (std::size_t r = table.find("<tr>"); r != std::string::npos; r = table.find("<tr>", r + 1)) {
+            const std::string row = table.substr(r, table.find("</tr>", r) - r);
+            int cells = 0;
+            for (std::size_t c = row.find("<t"); c != std::string::npos; c = row.find("<t", c + 1))
+                cells += row.compare(c, 3, "<td") == 0 || row.compare(c, 3, "<th") == 0 ? 1 : 0;
+            if (header < 0) header = cells;
+            EXPECT_EQ(cells, header) << row.substr(0, 200);
+        }
+    }
+    EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+    for (const char* bad : {"src=\"http", "href=\"http", "src=\"//", "href=\"//", "<script", "<link", "@import",
+                            "url("})
+        EXPECT_EQ(html.find(bad), std::string::npos) << bad;
+}
+
+bool have_gnuplot() {
+    return std::system("gnuplot --version > /dev/null 2>&1") == 0;
+}
+
+TEST(AnalysisReport, RecoversAKnownPseAndWritesAWellFormedSelfContainedReport) {
+    TempDir dir;
+    // 2 conditions x 7 levels x 20 repetitions of a simulated observer with PSE 10^1.95 cd.
+    const double mu = 1.95, sigma = 0.12;
+    td::run_simulated(dir / "s.db", td::constant_stimuli_protocol(20), td::sim("A", mu, sigma));
+    // A second observer's staircases (another condition): the report's track tables and figures.
+    td::run_simulated(dir / "s.db", td::staircase_protocol(), td::sim("B", 2.0, 0.1, 5));
+    const Dataset d = read_study(dir / "s.db");
+    AnalysisOptions o;
+    o.bootstrap = 200;
+    const StudyResults r = analyze_study(d, o);
+    for (const std::string name : {"night-empirical", "night-perceptual"}) {
+        const GroupResult* g = r.main_group(name);
+        ASSERT_NE(g, nullptr);
+        ASSERT_TRUE(g->headline.value && g->headline.ci) << g->headline.reason;
+        EXPECT_TRUE(g->headline.reliable) << g->headline.reason;
+        // 140 trials around the PSE: the estimate lies within 0.05 log10 of it, the CI holds it.
+        EXPECT_NEAR(*g->headline.value, mu, 0.05);
+        EXPECT_TRUE(g->headline.ci->contains(mu)) << g->headline.ci->lower << " .. " << g->headline.ci->upper;
+        // Brightness enhancement: PSE - log10(100 cd).
+        ASSERT_TRUE(g->match_ratio && g->match_ratio->value);
+        EXPECT_DOUBLE_EQ(*g->match_ratio->value, *g->headline.value - 2.0);
+    }
+
+    if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (Debian package gnuplot-nox)";
+    const fs::path out = dir / "out";
+    fs::create_directories(out);
+    const PlotResult plots = make_figures(out, d, r);
+    EXPECT_TRUE(plots.problems.empty()) << plots.problems.front();
+    std::set<std::string> kinds;
+    for (const Figure& f : plots.figures) kinds.insert(f.kind);
+    EXPECT_TRUE(kinds.count("psychometric") && kinds.count("pse") && kinds.count("enhancement") &&
+                kinds.count("timing") && kinds.count("tracks"));
+    ReportContext ctx;
+    ctx.data = &d;
+    ctx.results = &r;
+    ctx.plots = &plots;
+    ctx.software_version = "test";
+    write_report(out, ctx);
+    const std::string html = file_bytes(out / "report.html");
+    expect_well_formed_and_self_contained(html);
+    // Every figure summary.json lists exists, is non-empty, and is embedded in the report.
+    const store::JsonReader j(file_bytes(out / "summary.json"), "summary.json");
+    const std::size_t n = j.array_length("$.figures");
+    EXPECT_EQ(n, plots.figures.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        for (const char* key : {"png", "svg"}) {
+            const auto rel = j.string(fmt::format("$.figures[{}].{}", i, key));
+            ASSERT_TRUE(rel.has_value());
+            std::error_code ec;
+            EXPECT_GT(fs::file_size(out / *rel, ec), 0u) << *rel;
+            EXPECT_FALSE(ec) << *rel;
+        }
+        const std::string png = file_bytes(out / *j.string(fmt::format("$.figures[{}].png", i)));
+        EXPECT_EQ(png.substr(1, 3), "PNG");
+        EXPECT_NE(html.find(base64(png).substr(0, 200)), std::string::npos) << "figure " << i << " not embedded";
+    }
+}
+
+TEST(AnalysisReport, WithoutGnuplotTheReportSaysSoAndIsStillWritten) {
+    TempDir dir;
+    const Dataset d = degenerate();
+    AnalysisOptions o;
+    o.bootstrap = 0;
+    const StudyResults r = analyze_study(d, o);
+    PlotOptions po;
+    po.gnuplot = (dir / "no-such-gnuplot").string();
+    const PlotResult plots = make_figures(dir.path(), d, r, po);
+    EXPECT_TRUE(plots.gnuplot_missing);
+    EXPECT_TRUE(plots.figures.empty());
+    ASSERT_EQ(plots.problems.size(), 1u);
+    EXPECT_NE(plots.problems[0].find("gnuplot-nox"), std::string::npos) << plots.problems[0];
+    ReportContext ctx;
+    ctx.data = &d;
+    ctx.results = &r;
+    ctx.plots = &plots;
+    write_report(dir.path(), ctx);
+    const std::string html = file_bytes(dir / "report.html");
+    EXPECT_NE(html.find("gnuplot could not be started"), std::string::npos);
+    expect_well_formed_and_self_contained(html);
+}
+
+TEST(AnalysisReport, Base64MatchesRfc4648Vectors) {
+    // RFC 4648 §10 test vectors.
+    EXPECT_EQ(base64(""), "");
+    EXPECT_EQ(base64("f"), "Zg==");
+    EXPECT_EQ(base64("fo"), "Zm8=");
+    EXPECT_EQ(base64("foo"), "Zm9v");
+    EXPECT_EQ(base64("foob"), "Zm9vYg==");
+    EXPECT_EQ(base64("fooba"), "Zm9vYmE=");
+    EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+}
+
+TEST(AnalysisReport, NominalDisplayModelCurveIsTheSrgbCurve) {
+    // The runner's nominal model: three sRGB channels sharing black 0.1 and white 100 cd/m2 by Rec.709 weights.
+    const std::string fit = R"({"model":"nominal","peak_cd_m2":100,"black_cd_m2":0.1,"bits":8,"dither":true,"channels":[)"
+                            R"({"transfer":"srgb","black_cd_m2":0.021264,"white_cd_m2":21.264},)"
+                            R"({"transfer":"srgb","black_cd_m2":0.071517,"white_cd_m2":71.517},)"
+                            R"({"transfer":"srgb","black_cd_m2":0.007219,"white_cd_m2":7.219}]})";
+    // IEC 61966-2-1: V = 0.5 decodes to ((0.5 + 0.055) / 1.055)^2.4 = 0.21404.
+    const double expect = 0.1 + (100.0 - 0.1) * std::pow(0.555 / 1.055, 2.4);
+    EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 0.5), expect, 1e-9);
+    EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 0.0), 0.1, 1e-12);
+    EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 1.0), 100.0, 1e-9);
+    EXPECT_FALSE(model_grey_luminance_cd_m2(R"({"channels":[{"transfer":"lut"}]})", 0.5).has_value());
+    // A measured GOG model (docs/calibration.md "fit_json"): L = sum over channels of a + (b + k V)^gamma.
+    const std::string gog = R"({"model":"gog","display":{"peak_cd_m2":100,"black_cd_m2":0.1,"channels":[)"
+                            R"({"channel":"red","transfer":"gog","a":0.03,"b":0.02,"k":2.9,"gamma":2.2},)"
+                            R"({"channel":"green","transfer":"gog","a":0.05,"b":-0.01,"k":5.0,"gamma":2.4},)"
+                            R"({"channel":"blue","transfer":"gog","a":0.02,"b":0.0,"k":1.5,"gamma":2.0}]}})";
+    const double v = 0.6;
+    const double gog_expect = 0.03 + std::pow(0.02 + 2.9 * v, 2.2) + 0.05 + std::pow(-0.01 + 5.0 * v, 2.4) + 0.02 +
+                              std::pow(1.5 * v, 2.0);
+    EXPECT_NEAR(*model_grey_luminance_cd_m2(gog, v), gog_expect, 1e-12 * gog_expect);
+    // Where b + k V <= 0 the channel emits its offset a alone.
+    EXPECT_NEAR(*model_grey_luminance_cd_m2(gog, 0.0), 0.03 + std::pow(0.02, 2.2) + 0.05 + 0.02, 1e-12);
+    EXPECT_FALSE(model_grey_luminance_cd_m2("not json", 0.5).has_value());
+}
+
+}  // namespace
+}  // namespace atonlab::analysis
