@@ -58,14 +58,39 @@ const std::vector<std::string>& required_csv_columns() {
 }
 
 const std::vector<std::string>& trials_csv_columns() {
-    static const std::vector<std::string> cols{
-        "session",         "observer",       "trial_index",     "block",          "condition",
-        "track",           "procedure",      "task",            "level",          "level_key",      "level_scale",
-        "level_on",        "response",       "outcome",         "test_on_left",   "response_value",
-        "response_time_s", "onset_time_s",   "dropped_frames",  "missed_deadline", "adaptation_cd_m2",
-        "tone_operator",   "glare_test",     "glare_reference", "test_intensity_cd", "guess_rate",
-        "target_p",        "reversal",       "quest_mean",      "quest_sd",       "quest_lower",
-        "quest_upper",     "source"};
+    static const std::vector<std::string> cols{"session",
+                                               "observer",
+                                               "trial_index",
+                                               "block",
+                                               "condition",
+                                               "track",
+                                               "procedure",
+                                               "task",
+                                               "level",
+                                               "level_key",
+                                               "level_scale",
+                                               "level_on",
+                                               "response",
+                                               "outcome",
+                                               "test_on_left",
+                                               "response_value",
+                                               "response_time_s",
+                                               "onset_time_s",
+                                               "dropped_frames",
+                                               "missed_deadline",
+                                               "adaptation_cd_m2",
+                                               "tone_operator",
+                                               "glare_test",
+                                               "glare_reference",
+                                               "test_intensity_cd",
+                                               "guess_rate",
+                                               "target_p",
+                                               "reversal",
+                                               "quest_mean",
+                                               "quest_sd",
+                                               "quest_lower",
+                                               "quest_upper",
+                                               "source"};
     return cols;
 }
 
@@ -110,8 +135,7 @@ public:
         if (!v) return std::nullopt;
         std::int64_t x = 0;
         const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), x);
-        if (ec != std::errc() || ptr != v->data() + v->size())
-            fail(column, fmt::format("'{}' is not an integer", *v));
+        if (ec != std::errc() || ptr != v->data() + v->size()) fail(column, fmt::format("'{}' is not an integer", *v));
         if (x < min) fail(column, fmt::format("{} is below the smallest allowed value, {}", x, min));
         return x;
     }
@@ -144,8 +168,8 @@ private:
     const std::vector<std::string>& fields_;
 };
 
-const std::set<std::string, std::less<>> kAdjustWords{"coarse_up", "coarse_down", "fine_up", "fine_down", "confirm",
-                                                      "match"};
+const std::set<std::string, std::less<>> kAdjustWords{"coarse_up", "coarse_down", "fine_up",
+                                                      "fine_down", "confirm",     "match"};
 
 Trial trial_from_row(const RowReader& row, const std::string& file) {
     Trial t;
@@ -212,8 +236,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     if (const auto v = row.integer("dropped_frames", 0)) t.dropped_frames = static_cast<int>(*v);
     if (const auto v = row.boolean("missed_deadline")) t.missed_deadline = *v;
     t.adaptation_cd_m2 = row.number("adaptation_cd_m2");
-    if (t.adaptation_cd_m2 && *t.adaptation_cd_m2 <= 0.0)
-        row.fail("adaptation_cd_m2", "must be a luminance > 0 cd/m2");
+    if (t.adaptation_cd_m2 && *t.adaptation_cd_m2 <= 0.0) row.fail("adaptation_cd_m2", "must be a luminance > 0 cd/m2");
     if (const auto s = row.text("tone_operator")) t.tone_operator = *s;
     if (const auto s = row.text("glare_test")) t.glare_test = *s;
     if (const auto s = row.text("glare_reference")) t.glare_reference = *s;
@@ -254,8 +277,7 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
         std::string name = RowReader::trim(header->fields[i]);
         if (i == 0 && name.rfind("\xEF\xBB\xBF", 0) == 0) name.erase(0, 3);  // a UTF-8 byte-order mark
         if (name.empty()) throw InputError(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
-        if (!index.emplace(name, i).second)
-            throw InputError(file, 1, name, "appears twice in the header");
+        if (!index.emplace(name, i).second) throw InputError(file, 1, name, "appears twice in the header");
     }
     for (const std::string& col : required_csv_columns()) {
         if (!index.count(col)) {
@@ -379,7 +401,9 @@ void merge(Dataset& into, Dataset&& more) {
         if (keys.count(s.key))
             throw InputError(s.source, 0, "",
                              fmt::format("session '{}' is given twice (the same input named twice?)", s.key));
-    auto append = [](auto& a, auto& b) { a.insert(a.end(), std::make_move_iterator(b.begin()), std::make_move_iterator(b.end())); };
+    auto append = [](auto& a, auto& b) {
+        a.insert(a.end(), std::make_move_iterator(b.begin()), std::make_move_iterator(b.end()));
+    };
     append(into.sources, more.sources);
     append(into.trials, more.trials);
     append(into.sessions, more.sessions);

@@ -79,14 +79,15 @@ public:
         const detail::GnuplotRun run = detail::run_gnuplot(o_.gnuplot, script, tmp_.path());
         if (run.not_found) {
             result_.gnuplot_missing = true;
-            result_.problems.push_back(fmt::format(
-                "gnuplot could not be started ('{}': {}), so the report has no figures; install the Debian "
-                "package gnuplot-nox (scripts/setup.sh does)",
-                o_.gnuplot, run.errors));
+            result_.problems.push_back(
+                fmt::format("gnuplot could not be started ('{}': {}), so the report has no figures; install the Debian "
+                            "package gnuplot-nox (scripts/setup.sh does)",
+                            o_.gnuplot, run.errors));
             return false;
         }
         std::error_code ec;
-        const bool written = fs::file_size(out_dir_ / png, ec) > 0 && !ec && fs::file_size(out_dir_ / svg, ec) > 0 && !ec;
+        const bool written =
+            fs::file_size(out_dir_ / png, ec) > 0 && !ec && fs::file_size(out_dir_ / svg, ec) > 0 && !ec;
         if (run.exit_status != 0 || !written) {
             std::string first = run.errors;
             if (const auto nl = first.find_last_not_of("\n "); nl != std::string::npos) first.erase(nl + 1);
@@ -120,8 +121,9 @@ std::string level_label(const ConditionInfo& c) {
 }
 
 std::string estimate_name(const ConditionInfo& c) {
-    return std::abs(c.target_p - 0.5) < 1e-12 && c.guess_rate == 0.0 ? "PSE"
-                                                                      : fmt::format("threshold (P = {:.3g})", c.target_p);
+    return std::abs(c.target_p - 0.5) < 1e-12 && c.guess_rate == 0.0
+               ? "PSE"
+               : fmt::format("threshold (P = {:.3g})", c.target_p);
 }
 
 // --- psychometric curves ------------------------------------------------------
@@ -187,7 +189,8 @@ void psychometric_figure(Drawer& d, const StudyResults& r, const ConditionInfo& 
         const double y = psi(main->family, e.threshold, e.params);
         if (main->bootstrap && main->bootstrap->threshold) {
             const Interval& ci = *main->bootstrap->threshold;
-            const std::string t = d.data(slug + "-threshold.tsv", {{num(e.threshold), num(y), num(ci.lower), num(ci.upper)}});
+            const std::string t =
+                d.data(slug + "-threshold.tsv", {{num(e.threshold), num(y), num(ci.lower), num(ci.upper)}});
             plot += fmt::format(", \\\n     {} using 1:2:3:4 with xerrorbars pt 5 ps 1.3 lc rgb '#000000' title {}", t,
                                 gp_quote(fmt::format("{} and {:.0f}% CI", estimate_name(c), 100.0 * level)));
         } else {
@@ -198,9 +201,10 @@ void psychometric_figure(Drawer& d, const StudyResults& r, const ConditionInfo& 
     }
     std::string body = "reset\nset datafile separator '\\t'\nset key below\nset grid\n";
     body += fmt::format("set title {}\n", gp_quote(fmt::format("{}: {} against the level ({}, {} trials)", c.condition,
-                                                                outcome_label(c), main->observer, main->n_scored)));
-    body += fmt::format("set xlabel {}\nset ylabel {}\nset yrange [-0.03:1.03]\nset offsets graph 0.04, graph 0.04, 0, 0\n",
-                        gp_quote(level_label(c)), gp_quote(outcome_label(c)));
+                                                               outcome_label(c), main->observer, main->n_scored)));
+    body +=
+        fmt::format("set xlabel {}\nset ylabel {}\nset yrange [-0.03:1.03]\nset offsets graph 0.04, graph 0.04, 0, 0\n",
+                    gp_quote(level_label(c)), gp_quote(outcome_label(c)));
     body += plot + "\n";
     Figure f;
     f.id = "psychometric-" + slug;
@@ -226,12 +230,12 @@ void tracks_figure(Drawer& d, const StudyResults& r, const ConditionInfo& c, con
     for (const TrackResult& t : main->tracks) {
         std::vector<std::vector<std::string>> rows;
         for (std::size_t i = 0; i < t.levels.size(); ++i)
-            rows.push_back({std::to_string(i + 1), num(t.levels[i]),
-                            i < t.reversal.size() && t.reversal[i] ? "1" : "0"});
+            rows.push_back(
+                {std::to_string(i + 1), num(t.levels[i]), i < t.reversal.size() && t.reversal[i] ? "1" : "0"});
         const std::string f = d.data(fmt::format("{}-track-{}.tsv", slug, k), rows);
         const std::string name = r.observers.size() > 1 ? t.observer + " " + t.track : t.track;
-        plot += fmt::format("{}{} using 1:2 with linespoints pt 7 ps 0.6 lc rgb '{}' title {}", k ? ", \\\n     " : "", f,
-                            kColours[k % kNColours], gp_quote(name));
+        plot += fmt::format("{}{} using 1:2 with linespoints pt 7 ps 0.6 lc rgb '{}' title {}", k ? ", \\\n     " : "",
+                            f, kColours[k % kNColours], gp_quote(name));
         if (!t.reversal.empty()) {
             plot += fmt::format(", \\\n     {} using 1:($3 > 0 ? $2 : 1/0) with points pt 6 ps 1.8 lc rgb '{}' notitle",
                                 f, kColours[k % kNColours]);
@@ -240,8 +244,9 @@ void tracks_figure(Drawer& d, const StudyResults& r, const ConditionInfo& c, con
         ++k;
     }
     if (main->headline.value) {
-        plot += fmt::format(", \\\n     {} with lines dt 2 lw 1.5 lc rgb '#000000' title {}", num(*main->headline.value),
-                            gp_quote(fmt::format("{} ({})", estimate_name(c), main->observer)));
+        plot +=
+            fmt::format(", \\\n     {} with lines dt 2 lw 1.5 lc rgb '#000000' title {}", num(*main->headline.value),
+                        gp_quote(fmt::format("{} ({})", estimate_name(c), main->observer)));
     }
     std::string body = "reset\nset datafile separator '\\t'\nset key outside right top\nset grid\n";
     body += fmt::format("set title {}\nset xlabel 'trial of the track'\nset ylabel {}\n",
@@ -288,15 +293,20 @@ void pse_figure(Drawer& d, const StudyResults& r) {
     }
     if (main_rows.empty()) return;
     const std::string m = d.data("pse-main.tsv", main_rows);
-    std::string plot = fmt::format("plot {0} using 1:2:3:4:xtic(5) with yerrorbars pt 7 ps 1.4 lc rgb '#000000' title {1}",
-                                   m, gp_quote(r.observers.size() > 1 ? "pooled" : r.observers.empty() ? "" : r.observers[0]));
+    std::string plot =
+        fmt::format("plot {0} using 1:2:3:4:xtic(5) with yerrorbars pt 7 ps 1.4 lc rgb '#000000' title {1}", m,
+                    gp_quote(r.observers.size() > 1 ? "pooled"
+                             : r.observers.empty()  ? ""
+                                                    : r.observers[0]));
     if (!obs_rows.empty()) {
         const std::string o = d.data("pse-observers.tsv", obs_rows);
-        plot += fmt::format(", \\\n     {} using 1:2:3:4 with yerrorbars pt 6 ps 0.9 lc rgb '#1f77b4' title 'each observer'", o);
+        plot += fmt::format(
+            ", \\\n     {} using 1:2:3:4 with yerrorbars pt 6 ps 0.9 lc rgb '#1f77b4' title 'each observer'", o);
     }
     if (!unreliable.empty())
-        plot += fmt::format(", \\\n     {} using 1:2 with points pt 6 ps 3 lw 1.5 lc rgb '#b3261e' title 'unreliable (see the report)'",
-                            d.data("pse-unreliable.tsv", unreliable));
+        plot += fmt::format(
+            ", \\\n     {} using 1:2 with points pt 6 ps 3 lw 1.5 lc rgb '#b3261e' title 'unreliable (see the report)'",
+            d.data("pse-unreliable.tsv", unreliable));
     std::string body = "reset\nset datafile separator '\\t'\nset key top left box opaque\nset grid ytics\n";
     body += fmt::format("set xrange [0.4:{}]\nset xtics rotate by -30 nomirror\nset bmargin 9\n", x + 0.6);
     body += fmt::format("set title 'PSE or threshold per condition, {:.0f}% intervals'\nset ylabel {}\n",
@@ -307,9 +317,10 @@ void pse_figure(Drawer& d, const StudyResults& r) {
     f.id = "pse";
     f.kind = "pse";
     f.title = "PSE or threshold per condition";
-    f.caption = "Each condition's headline estimate (the psychometric fit's PSE or threshold, QUEST's or the "
-                "staircases' own estimate where no fit exists, the mean match for adjustment) with its interval" +
-                std::string(r.observers.size() > 1 ? "; open circles: each observer, filled: pooled." : ".");
+    f.caption =
+        "Each condition's headline estimate (the psychometric fit's PSE or threshold, QUEST's or the "
+        "staircases' own estimate where no fit exists, the mean match for adjustment) with its interval" +
+        std::string(r.observers.size() > 1 ? "; open circles: each observer, filled: pooled." : ".");
     d.draw(std::move(f), body);
 }
 
@@ -355,12 +366,15 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
         ++k;
     }
     if (!unreliable.empty())
-        plot += fmt::format(", \\\n     {} using 1:2 with points pt 6 ps 3 lw 1.5 lc rgb '#b3261e' title 'unreliable (see the report)'",
-                            d.data("enhancement-unreliable.tsv", unreliable));
+        plot += fmt::format(
+            ", \\\n     {} using 1:2 with points pt 6 ps 3 lw 1.5 lc rgb '#b3261e' title 'unreliable (see the report)'",
+            d.data("enhancement-unreliable.tsv", unreliable));
     plot += ", \\\n     0 with lines dt 2 lc rgb '#000000' title 'no enhancement'";
     std::string body = "reset\nset datafile separator '\\t'\nset key outside right top\nset grid\n";
     if (all_adaptation)
-        body += "set logscale x 10\nset format x '%g'\nset xlabel 'adaptation luminance (cd/m2)'\nset offsets graph 0.1, graph 0.1, graph 0.1, graph 0.1\n";
+        body +=
+            "set logscale x 10\nset format x '%g'\nset xlabel 'adaptation luminance (cd/m2)'\nset offsets graph 0.1, "
+            "graph 0.1, graph 0.1, graph 0.1\n";
     else
         body += "set xlabel 'condition (adaptation not stated)'\nset offsets 0.5, 0.5, graph 0.1, graph 0.1\n";
     body += "set ylabel 'log10(matched no-glare intensity / glare test intensity)'\n";
@@ -370,9 +384,10 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
     f.id = "enhancement";
     f.kind = "enhancement";
     f.title = "Brightness enhancement by glare";
-    f.caption = "log10 of the intensity of the light without glare that matches the light with glare, over the "
-                "glare light's own intensity (both put the same illuminance into the eye), per adaptation level and "
-                "tone mapper. Above 0: the glare rendering looks brighter than its energy-matched twin.";
+    f.caption =
+        "log10 of the intensity of the light without glare that matches the light with glare, over the "
+        "glare light's own intensity (both put the same illuminance into the eye), per adaptation level and "
+        "tone mapper. Above 0: the glare rendering looks brighter than its energy-matched twin.";
     d.draw(std::move(f), body);
 }
 
@@ -402,9 +417,10 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
         }
         const std::string id = fmt::format("calibration-{}", k);
         if (curve.empty() && points.empty()) {
-            problems.push_back(fmt::format("display calibration {} of {}: its model (fit_json) is not one the report "
-                                           "can draw and it has no grey readings; no figure",
-                                           c.id, c.source));
+            problems.push_back(
+                fmt::format("display calibration {} of {}: its model (fit_json) is not one the report "
+                            "can draw and it has no grey readings; no figure",
+                            c.id, c.source));
             continue;
         }
         std::string model;
@@ -418,8 +434,9 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
         std::string top = "plot ";
         bool first = true;
         if (!curve.empty()) {
-            top += fmt::format("{} using 1:2 with lines lw 2 lc rgb '#d62728' title {}", d.data(id + "-model.tsv", curve),
-                               gp_quote(nominal ? "nominal model (not measured)" : "fitted model"));
+            top +=
+                fmt::format("{} using 1:2 with lines lw 2 lc rgb '#d62728' title {}", d.data(id + "-model.tsv", curve),
+                            gp_quote(nominal ? "nominal model (not measured)" : "fitted model"));
             first = false;
         }
         if (!points.empty())
@@ -428,10 +445,12 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
         if (!residuals.empty()) {
             body += "set multiplot layout 2,1 title " + gp_quote(title) + "\n";
             body += "set size 1,0.68\nset origin 0,0.32\nset ylabel 'luminance (cd/m2)'\nset xlabel ''\n" + top + "\n";
-            body += "set size 1,0.32\nset origin 0,0\nset title ''\nset ylabel 'reading - model (cd/m2)'\n"
-                    "set xlabel 'drive level V (all channels)'\nunset key\n";
-            body += fmt::format("plot {} using 1:2 with impulses lw 2 lc rgb '#1f77b4', 0 with lines lc rgb '#000000'\n",
-                                d.data(id + "-residuals.tsv", residuals));
+            body +=
+                "set size 1,0.32\nset origin 0,0\nset title ''\nset ylabel 'reading - model (cd/m2)'\n"
+                "set xlabel 'drive level V (all channels)'\nunset key\n";
+            body +=
+                fmt::format("plot {} using 1:2 with impulses lw 2 lc rgb '#1f77b4', 0 with lines lc rgb '#000000'\n",
+                            d.data(id + "-residuals.tsv", residuals));
             body += "unset multiplot\n";
         } else {
             body += "set title " + gp_quote(title + (nominal ? " (nominal model: not measured)" : "")) + "\n";
@@ -441,15 +460,17 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
         f.id = id;
         f.kind = "calibration";
         f.title = fmt::format("Display calibration: {}", c.display_name);
-        f.caption = nominal ? fmt::format("The display model the sessions used, {}: a nominal model taken from the "
-                                          "scene's [display] table, not measured, so there are no readings or "
-                                          "residuals to show.",
-                                          c.how)
+        f.caption = nominal ? fmt::format(
+                                  "The display model the sessions used, {}: a nominal model taken from the "
+                                  "scene's [display] table, not measured, so there are no readings or "
+                                  "residuals to show.",
+                                  c.how)
                     : residuals.empty()
                         ? fmt::format("The display model ({}) and its grey readings.", c.how)
-                        : fmt::format("The fitted display model ({}) with its grey photometer readings (top) and the "
-                                      "residuals reading - model (bottom).",
-                                      c.how);
+                        : fmt::format(
+                              "The fitted display model ({}) with its grey photometer readings (top) and the "
+                              "residuals reading - model (bottom).",
+                              c.how);
         d.draw(std::move(f), body);
     }
 }
@@ -466,17 +487,18 @@ void timing_figure(Drawer& d, const Dataset& data, const StudyResults& r) {
     for (const SessionTiming& s : r.timing) {
         std::vector<std::vector<std::string>> rows;
         for (const Trial* t : per[s.session]) {
-            rows.push_back({std::to_string(t->trial_index), std::to_string(t->dropped_frames),
-                            t->missed_deadline ? "1" : "0"});
+            rows.push_back(
+                {std::to_string(t->trial_index), std::to_string(t->dropped_frames), t->missed_deadline ? "1" : "0"});
             max_drop = std::max(max_drop, t->dropped_frames);
         }
         const std::string f = d.data(fmt::format("timing-{}.tsv", k), rows);
         plot += fmt::format("{}{} using 1:2 with impulses lw 2 lc rgb '{}' title {}", k ? ", \\\n     " : "", f,
                             kColours[k % kNColours],
                             gp_quote(fmt::format("{} ({}): dropped frames", s.session, s.observer)));
-        plot += fmt::format(", \\\n     {} using 1:($3 > 0 ? $2 + 0.2 : 1/0) with points pt 2 ps 1.2 lc rgb '{}' "
-                            "title 'missed deadline'",
-                            f, kColours[k % kNColours]);
+        plot += fmt::format(
+            ", \\\n     {} using 1:($3 > 0 ? $2 + 0.2 : 1/0) with points pt 2 ps 1.2 lc rgb '{}' "
+            "title 'missed deadline'",
+            f, kColours[k % kNColours]);
         ++k;
     }
     std::string body = "reset\nset datafile separator '\\t'\nset key outside bottom center horizontal\nset grid\n";
@@ -488,15 +510,16 @@ void timing_figure(Drawer& d, const Dataset& data, const StudyResults& r) {
         total_missed += s.missed_deadlines;
     }
     body += fmt::format("set title {}\n", gp_quote(fmt::format("Frame timing: {} dropped frames, {} missed deadlines "
-                                                                "in {} session(s)",
-                                                                total_drops, total_missed, r.timing.size())));
+                                                               "in {} session(s)",
+                                                               total_drops, total_missed, r.timing.size())));
     body += plot + "\n";
     Figure f;
     f.id = "timing";
     f.kind = "timing";
     f.title = "Frame-timing quality per session";
-    f.caption = "Dropped frames per trial (impulses) and trials whose onset frame missed its deadline (crosses), "
-                "per session. Headless sessions (model or scripted observer) have no display and record none.";
+    f.caption =
+        "Dropped frames per trial (impulses) and trials whose onset frame missed its deadline (crosses), "
+        "per session. Headless sessions (model or scripted observer) have no display and record none.";
     d.draw(std::move(f), body);
 }
 
@@ -518,8 +541,8 @@ double pq_eotf_cd_m2(double n) {
 std::string file_slug(const std::string& name) {
     std::string out;
     for (const char ch : name) {
-        const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
-                        ch == '.' || ch == '-' || ch == '_';
+        const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '.' ||
+                        ch == '-' || ch == '_';
         out += ok ? ch : '_';
     }
     return out.empty() ? std::string("_") : out;

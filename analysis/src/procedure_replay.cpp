@@ -70,8 +70,8 @@ ConditionDesign condition_design(const p::Condition& c) {
     // comparison whose target is 0.5 (a PSE) runs from 0 to 1.
     if (const auto* q = std::get_if<p::QuestParams>(&c.procedure.params); q && yes_is_outcome) {
         d.guess_rate = q->gamma;
-    } else if (c.task == p::Task::TwoAfc && c.level_on == p::Role::Test &&
-               c.choice == p::ChoiceMapping::ChoseTest && d.target_p > 0.5 + 1e-9) {
+    } else if (c.task == p::Task::TwoAfc && c.level_on == p::Role::Test && c.choice == p::ChoiceMapping::ChoseTest &&
+               d.target_p > 0.5 + 1e-9) {
         d.guess_rate = 0.5;
     }
     return d;
@@ -134,9 +134,10 @@ std::string replay_track(const ConditionDesign& design, std::size_t track, const
         const std::optional<p::Proposal> next = proc->next();
         if (!next) return fmt::format("the procedure finished before trial {} of the session", t.trial_index);
         if (std::abs(next->level - t.level) > 1e-9 * std::max(1.0, std::abs(t.level)))
-            return fmt::format("trial {} of the session was logged at level {} where the protocol's procedure "
-                               "proposes {}",
-                               t.trial_index, t.level, next->level);
+            return fmt::format(
+                "trial {} of the session was logged at level {} where the protocol's procedure "
+                "proposes {}",
+                t.trial_index, t.level, next->level);
         p::Response r{};
         if (c.task == p::Task::TwoAfc) {
             if ((t.response != "left" && t.response != "right") || !t.test_on_left)

@@ -149,7 +149,8 @@ void write_atomically(const std::filesystem::path& file, const std::string& text
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         out << text;
         out.flush();
-        if (!out) throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
+        if (!out)
+            throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
     }
     std::error_code ec;
     std::filesystem::rename(tmp, file, ec);
@@ -163,13 +164,39 @@ std::string opt(const std::optional<double>& v) {
 }  // namespace
 
 const std::vector<std::string>& fits_csv_columns() {
-    static const std::vector<std::string> cols{
-        "condition",      "observer",     "analysis",       "track",           "task",           "procedure",
-        "level_unit",     "n_trials",     "n_levels",       "estimate",        "ci_lower",       "ci_upper",
-        "sd",             "family",       "alpha",          "beta",            "gamma",          "lambda",
-        "slope",          "slope_ci_lower", "slope_ci_upper", "width",         "width_ci_lower", "width_ci_upper",
-        "lambda_ci_lower", "lambda_ci_upper", "deviance",   "dof",             "gof_p",          "bootstrap_n",
-        "reliable",       "reason",       "method"};
+    static const std::vector<std::string> cols{"condition",
+                                               "observer",
+                                               "analysis",
+                                               "track",
+                                               "task",
+                                               "procedure",
+                                               "level_unit",
+                                               "n_trials",
+                                               "n_levels",
+                                               "estimate",
+                                               "ci_lower",
+                                               "ci_upper",
+                                               "sd",
+                                               "family",
+                                               "alpha",
+                                               "beta",
+                                               "gamma",
+                                               "lambda",
+                                               "slope",
+                                               "slope_ci_lower",
+                                               "slope_ci_upper",
+                                               "width",
+                                               "width_ci_lower",
+                                               "width_ci_upper",
+                                               "lambda_ci_lower",
+                                               "lambda_ci_upper",
+                                               "deviance",
+                                               "dof",
+                                               "gof_p",
+                                               "bootstrap_n",
+                                               "reliable",
+                                               "reason",
+                                               "method"};
     return cols;
 }
 
@@ -315,9 +342,9 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
                 {"n_levels", std::to_string(f.n_levels)},
                 {"family", std::string(to_string(g.family))},
                 {"reliable", yn(f.reliable && (!g.bootstrap || g.bootstrap->reliable))},
-                {"reason", csv_field(!f.reason.empty() ? f.reason
+                {"reason", csv_field(!f.reason.empty()                       ? f.reason
                                      : g.bootstrap && !g.bootstrap->reliable ? "bootstrap: " + g.bootstrap->reason
-                                                                              : std::string())},
+                                                                             : std::string())},
                 {"method", csv_field(fmt::format("maximum likelihood, threshold at F = {}",
                                                  g.threshold_proportion ? detail::number_text(*g.threshold_proportion)
                                                                         : std::string("0.5")))}};
@@ -358,7 +385,8 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
                      {"sd", opt(s.sd)},
                      {"reliable", yn(s.reliable)},
                      {"reason", csv_field(s.reason)},
-                     {"method", csv_field(fmt::format("mean of the last {} of {} reversals", s.n_used, s.n_reversals))}});
+                     {"method",
+                      csv_field(fmt::format("mean of the last {} of {} reversals", s.n_used, s.n_reversals))}});
             }
             if (t.quest) {
                 const QuestSummary& q = *t.quest;
@@ -371,7 +399,7 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
                      {"reliable", yn(q.reliable)},
                      {"reason", csv_field(q.reason)},
                      {"method", q.interval_is_normal_approximation ? "QUEST posterior mean, mean +- z sd"
-                                                                    : "QUEST posterior mean, 2.5%..97.5% quantiles"}});
+                                                                   : "QUEST posterior mean, 2.5%..97.5% quantiles"}});
             }
         }
         if (g.matches) {

@@ -77,7 +77,8 @@ std::string figure_html(const std::filesystem::path& out_dir, const Figure& f) {
     return h;
 }
 
-const char* kStyle = R"(body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 2em auto; max-width: 72em; color: #222; line-height: 1.4; }
+const char* kStyle =
+    R"(body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 2em auto; max-width: 72em; color: #222; line-height: 1.4; }
 h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
 table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
 th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: left; vertical-align: top; }
@@ -110,7 +111,8 @@ std::string base64(const std::string& bytes) {
         out += table[(v >> 12) & 63];
         out += "==";
     } else if (i + 2 == bytes.size()) {
-        const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8);
+        const unsigned v =
+            (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8);
         out += table[(v >> 18) & 63];
         out += table[(v >> 12) & 63];
         out += table[(v >> 6) & 63];
@@ -127,15 +129,18 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     std::map<std::string, const Figure*> by_kind;
     if (ctx.plots) {
         for (const Figure& f : ctx.plots->figures) {
-            if (!f.condition.empty()) by_condition[f.condition].push_back(&f);
-            else if (!by_kind.count(f.kind)) by_kind[f.kind] = &f;
+            if (!f.condition.empty())
+                by_condition[f.condition].push_back(&f);
+            else if (!by_kind.count(f.kind))
+                by_kind[f.kind] = &f;
         }
     }
     std::string h;
     h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += "<title>atonlab analysis</title>\n<style>\n" + std::string(kStyle) + "\n</style>\n</head>\n<body>\n";
     h += "<h1>atonlab analysis</h1>\n";
-    h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version), esc(ctx.command_line));
+    h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version),
+                     esc(ctx.command_line));
     h += "<p>Inputs:</p>\n<ul>\n";
     for (const std::string& s : d.sources) h += "<li><code>" + esc(s) + "</code></li>\n";
     h += "</ul>\n";
@@ -195,9 +200,10 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
             esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
             esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
-            c.task == Task::YesNo ? "yes" : c.task == Task::Adjust ? "the confirmed match"
-                                    : c.level_on == "test"         ? "chose the test"
-                                                                   : "chose the reference",
+            c.task == Task::YesNo    ? "yes"
+            : c.task == Task::Adjust ? "the confirmed match"
+            : c.level_on == "test"   ? "chose the test"
+                                     : "chose the reference",
             c.guess_rate, c.target_p, c.n_trials);
         h += "<table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</th><th>how</th>"
              "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
@@ -222,8 +228,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                 "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>"
                 "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                 "<td>{}</td></tr>\n",
-                esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method), slope,
-                width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason));
+                esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method),
+                slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason));
         }
         h += "</table>\n";
         // The procedures' own estimates.
@@ -305,8 +311,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         h += fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
-            esc(s.key), esc(s.observer), esc(s.protocol_name), esc(s.status), esc(s.started_at),
-            t ? t->n_trials : 0, t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0);
+            esc(s.key), esc(s.observer), esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0,
+            t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0);
     }
     h += "</table>\n";
     if (by_kind.count("timing")) h += figure_html(out_dir, *by_kind["timing"]);
@@ -322,8 +328,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             h += fmt::format(
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} × {} px, {:.3f} × {:.3f} m at {:.3f} m</td>"
                 "<td class=\"num\">{}</td><td><code>{}</code></td></tr>\n",
-                esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px,
-                c.width_m, c.height_m, c.viewing_distance_m, c.readings.size(), esc(c.fit_json));
+                esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px, c.width_m,
+                c.height_m, c.viewing_distance_m, c.readings.size(), esc(c.fit_json));
         }
         h += "</table>\n";
         if (ctx.plots)
@@ -360,7 +366,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         out << h;
         out.flush();
-        if (!out) throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
+        if (!out)
+            throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
     }
     std::error_code ec;
     std::filesystem::rename(tmp, file, ec);

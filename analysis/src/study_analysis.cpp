@@ -211,15 +211,17 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
     if (o.family == Family::Weibull && log_levels) {
         // psychometric.h: the Weibull of 10^x is the Gumbel of x with alpha = log10(alpha_W), same beta.
         g.family = Family::Gumbel;
-        g.family_note = "the Weibull of the intensity 10^level is fitted as the Gumbel (log-Weibull) of the log10 level";
+        g.family_note =
+            "the Weibull of the intensity 10^level is fitted as the Gumbel (log-Weibull) of the log10 level";
     }
     fo.family = g.family;
     fo.guess = RateConstraint::fixed_at(info.guess_rate);
     double prop = (info.target_p - info.guess_rate) / (1.0 - info.guess_rate);
     if (!(prop > 0.0 && prop < 1.0)) {
-        warnings.push_back(fmt::format("condition \"{}\": target P {} with guess rate {} gives no threshold on the "
-                                       "sigmoid; the threshold is given at F = 0.5",
-                                       info.condition, info.target_p, info.guess_rate));
+        warnings.push_back(
+            fmt::format("condition \"{}\": target P {} with guess rate {} gives no threshold on the "
+                        "sigmoid; the threshold is given at F = 0.5",
+                        info.condition, info.target_p, info.guess_rate));
         prop = 0.5;
     }
     fo.threshold_proportion = prop;
@@ -253,8 +255,9 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
             } else if (h.ci && !(h.ci->upper > h.ci->lower)) {
                 h.reliable = false;
                 if (h.reason.empty())
-                    h.reason = "the bootstrap interval has no width: every resample gave the same threshold, so the "
-                               "data do not constrain it (answers perfectly separated by level)";
+                    h.reason =
+                        "the bootstrap interval has no width: every resample gave the same threshold, so the "
+                        "data do not constrain it (answers perfectly separated by level)";
             }
         } else if (o.bootstrap > 0) {
             h.reliable = false;
@@ -278,7 +281,8 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
         } else if (g.reversal_mean) {
             h.value = g.reversal_mean;
             h.method = fmt::format("mean of the tracks' last {} reversals (no psychometric fit)", o.last_reversals);
-            h.reason = "the psychometric fit failed (" + why + "); the staircases' reversal mean is shown, without "
+            h.reason = "the psychometric fit failed (" + why +
+                       "); the staircases' reversal mean is shown, without "
                        "an interval";
         } else {
             h.reason = why;
@@ -286,8 +290,7 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
     }
 
     // log10(PSE / test intensity): brightness enhancement when the test has glare.
-    if (log_levels && info.level_on == "reference" && std::abs(info.target_p - 0.5) < 1e-12 &&
-        info.guess_rate == 0.0) {
+    if (log_levels && info.level_on == "reference" && std::abs(info.target_p - 0.5) < 1e-12 && info.guess_rate == 0.0) {
         MatchRatio mr;
         mr.method = "log10(PSE / test intensity)";
         if (!info.test_intensity_cd) {
@@ -296,9 +299,9 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
             mr.reason = h.reason;
         } else {
             const std::vector<double> none;
-            const Enhancement e = brightness_enhancement(
-                g.fit->estimate->threshold, g.bootstrap ? g.bootstrap->threshold_samples : none,
-                std::log10(*info.test_intensity_cd), o.ci_level);
+            const Enhancement e =
+                brightness_enhancement(g.fit->estimate->threshold, g.bootstrap ? g.bootstrap->threshold_samples : none,
+                                       std::log10(*info.test_intensity_cd), o.ci_level);
             mr.value = e.log10_enhancement;
             mr.ci = e.ci;
             mr.reliable = e.reliable && h.reliable;
@@ -311,8 +314,8 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
 
 /// The one stimulus parameter in which two conditions differ, or "" (none or several).
 std::string single_factor(const ConditionInfo& a, const ConditionInfo& b) {
-    if (a.task != b.task || a.level_key != b.level_key || a.level_scale != b.level_scale ||
-        a.level_on != b.level_on || a.target_p != b.target_p)
+    if (a.task != b.task || a.level_key != b.level_key || a.level_scale != b.level_scale || a.level_on != b.level_on ||
+        a.target_p != b.target_p)
         return {};
     std::vector<std::string> differ;
     if (a.adaptation_cd_m2 != b.adaptation_cd_m2) differ.push_back("adaptation luminance");
@@ -390,19 +393,21 @@ StudyResults analyze_study(const Dataset& data, const AnalysisOptions& options) 
         if (!info.mixed.empty()) {
             std::string list;
             for (const std::string& m : info.mixed) list += (list.empty() ? "" : ", ") + m;
-            out.warnings.push_back(fmt::format("condition \"{}\": its trials differ in {} (two protocols with one "
-                                               "condition name?); the first trial's values are shown",
-                                               name, list));
+            out.warnings.push_back(
+                fmt::format("condition \"{}\": its trials differ in {} (two protocols with one "
+                            "condition name?); the first trial's values are shown",
+                            name, list));
         }
         if (trials.empty()) {
-            out.groups.push_back(analyse_group(info, out.observers.size() == 1 ? out.observers[0] : kPooled, {},
-                                               options, out.warnings));
+            out.groups.push_back(
+                analyse_group(info, out.observers.size() == 1 ? out.observers[0] : kPooled, {}, options, out.warnings));
         } else {
             std::map<std::string, std::vector<const Trial*>> per_observer;
             for (const Trial* t : trials) per_observer[t->observer].push_back(t);
             for (const auto& [obs, ts] : per_observer)
                 out.groups.push_back(analyse_group(info, obs, ts, options, out.warnings));
-            if (out.observers.size() > 1) out.groups.push_back(analyse_group(info, kPooled, trials, options, out.warnings));
+            if (out.observers.size() > 1)
+                out.groups.push_back(analyse_group(info, kPooled, trials, options, out.warnings));
         }
         out.conditions.push_back(std::move(info));
     }

@@ -36,7 +36,7 @@ std::string toml_string(std::string_view v) {
 }
 
 struct Frame {
-    std::string role;  ///< "test", "reference", "both"
+    std::string role;                                            ///< "test", "reference", "both"
     std::vector<std::pair<std::string, std::string>> overrides;  ///< (key, TOML value), in order
 
     /// The last value written to `key` (later overrides win).
@@ -157,9 +157,10 @@ Dataset read_study(const std::filesystem::path& study_file) {
     Dataset d = read_store(store::Store::open_read_only(copy), file);
     for (SnapshotRef& r : d.snapshots) r.read_from = copy.string();
     d.temporaries.push_back(tmp);
-    d.notes.push_back(fmt::format("{} was written with an older schema; it was read through a migrated temporary "
-                                  "copy and is unchanged",
-                                  file));
+    d.notes.push_back(
+        fmt::format("{} was written with an older schema; it was read through a migrated temporary "
+                    "copy and is unchanged",
+                    file));
     return d;
 }
 
@@ -189,9 +190,10 @@ Dataset read_store(const store::Store& db, const std::string& file) {
         }
         const detail::ProtocolDesign design = detail::design_of(db.protocol_text(s.id), s.protocol_name);
         if (!design.protocol)
-            d.notes.push_back(fmt::format("{} session {}: its protocol text could not be read ({}); the procedures "
-                                          "are taken from the trials' state, guess rates 0 and targets 0.5",
-                                          file, s.id.value, design.error));
+            d.notes.push_back(
+                fmt::format("{} session {}: its protocol text could not be read ({}); the procedures "
+                            "are taken from the trials' state, guess rates 0 and targets 0.5",
+                            file, s.id.value, design.error));
         info.protocol_conditions = design.order;
         for (const auto& [name, cd] : design.conditions)
             if (!cd.note.empty()) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, cd.note));
@@ -242,9 +244,10 @@ Dataset read_store(const store::Store& db, const std::string& file) {
             if (!track) continue;
             const std::string why = detail::replay_track(it->second, *track, trials);
             if (!why.empty())
-                d.notes.push_back(fmt::format("{} session {}: track {} could not be replayed ({}); its reversals "
-                                              "or QUEST posterior are not reported",
-                                              file, s.id.value, id, why));
+                d.notes.push_back(
+                    fmt::format("{} session {}: track {} could not be replayed ({}); its reversals "
+                                "or QUEST posterior are not reported",
+                                file, s.id.value, id, why));
         }
         for (const std::string& c : conditions_seen) d.snapshots.push_back({file, s.id.value, info.key, c, file});
         d.sessions.push_back(std::move(info));

@@ -8,6 +8,7 @@
 // the stored stimulus snapshots (scene-referred EXR, cd/m²) are made into
 // PNGs for the report with the CPU references of the tone mapper and the
 // sRGB curve.
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -19,8 +20,6 @@
 #include <map>
 #include <set>
 #include <thread>
-
-#include <fmt/format.h>
 
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/plots.h"
@@ -52,7 +51,8 @@ void add_analyze_command(CLI::App& app, AnalyzeOptions& o) {
         ->check(CLI::IsMember({"normal", "logistic", "weibull", "gumbel"}));
     cmd->add_option("--last-reversals", o.last_reversals, "Staircases: average the last N reversals")
         ->check(CLI::Range(1, 1000));
-    cmd->add_option("--threads", o.threads, "Bootstrap threads (default: the machine's cores; results do not depend on it)")
+    cmd->add_option("--threads", o.threads,
+                    "Bootstrap threads (default: the machine's cores; results do not depend on it)")
         ->check(CLI::Range(1, 256));
     cmd->add_option("--gnuplot", o.gnuplot, "The gnuplot program that draws the figures");
     cmd->add_flag("--quiet", o.quiet, "Print nothing but errors");
@@ -225,8 +225,8 @@ std::vector<an::SnapshotImage> make_snapshots(const an::Dataset& data, const an:
             }
             out.push_back({ref.condition, ref.session, rel, caption});
         } catch (const store::StoreError& e) {
-            problems.push_back(fmt::format("the snapshot of condition \"{}\" could not be read: {}", ref.condition,
-                                           e.what()));
+            problems.push_back(
+                fmt::format("the snapshot of condition \"{}\" could not be read: {}", ref.condition, e.what()));
         }
     }
     return out;
@@ -310,10 +310,11 @@ int run_analyze(const AnalyzeOptions& o) {
     const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
     if (!o.quiet) {
-        std::printf("analysed %zu trials of %zu observer(s) in %zu session(s): %zu conditions (%.1f s fits and "
-                    "bootstrap, %.1f s in all)\n",
-                    data.trials.size(), results.observers.size(), data.sessions.size(), results.conditions.size(),
-                    analysis_s, total_s);
+        std::printf(
+            "analysed %zu trials of %zu observer(s) in %zu session(s): %zu conditions (%.1f s fits and "
+            "bootstrap, %.1f s in all)\n",
+            data.trials.size(), results.observers.size(), data.sessions.size(), results.conditions.size(), analysis_s,
+            total_s);
         for (const an::ConditionInfo& c : results.conditions) {
             const an::GroupResult* g = results.main_group(c.condition);
             if (!g) continue;

@@ -5,11 +5,11 @@
 // store records each trial with a stimulus JSON in the runner's format
 // (docs/running.md "What each trial stores"). The true PSE / threshold is a
 // parameter here, so the analysis can be checked against it.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
@@ -128,7 +128,8 @@ inline store::SessionId run_simulated(const std::filesystem::path& db, const std
         s.record_trial(session, tr);
         ++n;
     }
-    if (finish) s.finish_session(session, schedule.finished() ? store::SessionStatus::completed : store::SessionStatus::quit);
+    if (finish)
+        s.finish_session(session, schedule.finished() ? store::SessionStatus::completed : store::SessionStatus::quit);
     return session;
 }
 

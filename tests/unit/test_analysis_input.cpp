@@ -127,9 +127,9 @@ TEST(AnalysisCsv, StructuralErrors) {
     write(dir / "empty.csv", "");
     EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "empty.csv"); }).line(), 1);
     write(dir / "header-only.csv", "observer,condition,level,response\n");
-    EXPECT_NE(std::string(expect_input_error([&] { read_trials_csv(dir / "header-only.csv"); }).what())
-                  .find("no trials"),
-              std::string::npos);
+    EXPECT_NE(
+        std::string(expect_input_error([&] { read_trials_csv(dir / "header-only.csv"); }).what()).find("no trials"),
+        std::string::npos);
     write(dir / "short.csv", "observer,condition,level,response\nP,c,1\n");
     EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "short.csv"); }).line(), 2);
     write(dir / "quote.csv", "observer,condition,level,response\nP,\"c,1,1\n");
@@ -137,9 +137,9 @@ TEST(AnalysisCsv, StructuralErrors) {
               std::string::npos);
     write(dir / "dup.csv", "observer,condition,level,level,response\nP,c,1,1,1\n");
     EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "dup.csv"); }).column(), "level");
-    EXPECT_NE(std::string(expect_input_error([&] { read_trials_csv(dir / "missing.csv"); }).what())
-                  .find("cannot be opened"),
-              std::string::npos);
+    EXPECT_NE(
+        std::string(expect_input_error([&] { read_trials_csv(dir / "missing.csv"); }).what()).find("cannot be opened"),
+        std::string::npos);
 }
 
 // --- study files --------------------------------------------------------------------
@@ -237,8 +237,10 @@ TEST(AnalysisStudy, StaircaseReversalsAndQuestPosteriorsMatchTheProceduresOwn) {
         const p::Protocol protocol = p::parse_protocol(text, "sim.toml");
         std::vector<p::Response> answers;
         for (const Trial& t : d.trials) {
-            if (t.task == Task::TwoAfc) answers.push_back(t.response == "left" ? p::Response::Left : p::Response::Right);
-            else answers.push_back(t.response == "yes" ? p::Response::Yes : p::Response::No);
+            if (t.task == Task::TwoAfc)
+                answers.push_back(t.response == "left" ? p::Response::Left : p::Response::Right);
+            else
+                answers.push_back(t.response == "yes" ? p::Response::Yes : p::Response::No);
         }
         const p::Schedule replayed = p::Schedule::replay(protocol, 7, answers);
         AnalysisOptions o;

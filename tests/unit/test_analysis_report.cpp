@@ -174,8 +174,8 @@ void expect_well_formed_and_self_contained(const std::string& html) {
         }
     }
     EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
-    for (const char* bad : {"src=\"http", "href=\"http", "src=\"//", "href=\"//", "<script", "<link", "@import",
-                            "url("})
+    for (const char* bad :
+         {"src=\"http", "href=\"http", "src=\"//", "href=\"//", "<script", "<link", "@import", "url("})
         EXPECT_EQ(html.find(bad), std::string::npos) << bad;
 }
 
@@ -278,10 +278,11 @@ TEST(AnalysisReport, Base64MatchesRfc4648Vectors) {
 
 TEST(AnalysisReport, NominalDisplayModelCurveIsTheSrgbCurve) {
     // The runner's nominal model: three sRGB channels sharing black 0.1 and white 100 cd/m2 by Rec.709 weights.
-    const std::string fit = R"({"model":"nominal","peak_cd_m2":100,"black_cd_m2":0.1,"bits":8,"dither":true,"channels":[)"
-                            R"({"transfer":"srgb","black_cd_m2":0.021264,"white_cd_m2":21.264},)"
-                            R"({"transfer":"srgb","black_cd_m2":0.071517,"white_cd_m2":71.517},)"
-                            R"({"transfer":"srgb","black_cd_m2":0.007219,"white_cd_m2":7.219}]})";
+    const std::string fit =
+        R"({"model":"nominal","peak_cd_m2":100,"black_cd_m2":0.1,"bits":8,"dither":true,"channels":[)"
+        R"({"transfer":"srgb","black_cd_m2":0.021264,"white_cd_m2":21.264},)"
+        R"({"transfer":"srgb","black_cd_m2":0.071517,"white_cd_m2":71.517},)"
+        R"({"transfer":"srgb","black_cd_m2":0.007219,"white_cd_m2":7.219}]})";
     // IEC 61966-2-1: V = 0.5 decodes to ((0.5 + 0.055) / 1.055)^2.4 = 0.21404.
     const double expect = 0.1 + (100.0 - 0.1) * std::pow(0.555 / 1.055, 2.4);
     EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 0.5), expect, 1e-9);
@@ -294,8 +295,8 @@ TEST(AnalysisReport, NominalDisplayModelCurveIsTheSrgbCurve) {
                             R"({"channel":"green","transfer":"gog","a":0.05,"b":-0.01,"k":5.0,"gamma":2.4},)"
                             R"({"channel":"blue","transfer":"gog","a":0.02,"b":0.0,"k":1.5,"gamma":2.0}]}})";
     const double v = 0.6;
-    const double gog_expect = 0.03 + std::pow(0.02 + 2.9 * v, 2.2) + 0.05 + std::pow(-0.01 + 5.0 * v, 2.4) + 0.02 +
-                              std::pow(1.5 * v, 2.0);
+    const double gog_expect =
+        0.03 + std::pow(0.02 + 2.9 * v, 2.2) + 0.05 + std::pow(-0.01 + 5.0 * v, 2.4) + 0.02 + std::pow(1.5 * v, 2.0);
     EXPECT_NEAR(*model_grey_luminance_cd_m2(gog, v), gog_expect, 1e-12 * gog_expect);
     // Where b + k V <= 0 the channel emits its offset a alone.
     EXPECT_NEAR(*model_grey_luminance_cd_m2(gog, 0.0), 0.03 + std::pow(0.02, 2.2) + 0.05 + 0.02, 1e-12);

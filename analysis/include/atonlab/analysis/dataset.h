@@ -53,13 +53,13 @@ std::optional<Task> parse_task(std::string_view text) noexcept;
 /// One trial: one row of the study's `trials` table, or of a CSV.
 struct Trial {
     // --- where it came from ---------------------------------------------------
-    std::string source;       ///< the study file or CSV as named on the command line
-    std::string session;      ///< unique over all inputs: "FILE#ID" for a study file's session
-    std::string observer;     ///< the observer's code
+    std::string source;            ///< the study file or CSV as named on the command line
+    std::string session;           ///< unique over all inputs: "FILE#ID" for a study file's session
+    std::string observer;          ///< the observer's code
     std::int64_t trial_index = 0;  ///< 0-based within the session
     int block = 0;                 ///< 0-based block of the protocol
     std::string condition;         ///< the protocol's condition name
-    std::string track;        ///< the procedure instance ("CONDITION/rREP/tTRACK"); empty when unknown
+    std::string track;             ///< the procedure instance ("CONDITION/rREP/tTRACK"); empty when unknown
     /// "staircase", "weighted-staircase", "quest", "constant-stimuli",
     /// "adjustment"; empty when unknown (the trials then get a psychometric fit only).
     std::string procedure;
@@ -75,7 +75,7 @@ struct Trial {
     /// the stimulus the level is on ("chose the reference" when level_on is the
     /// reference); yes-no, "yes". Absent for adjustment actions and timeouts.
     std::optional<bool> outcome;
-    std::optional<bool> test_on_left;     ///< 2AFC: the test was the left / first stimulus
+    std::optional<bool> test_on_left;      ///< 2AFC: the test was the left / first stimulus
     std::optional<double> response_value;  ///< adjustment: the scene value shown
     double response_time_s = 0.0;
     double onset_time_s = 0.0;
@@ -104,9 +104,9 @@ struct Trial {
 
 /// A session of a study file (or of a CSV's session column).
 struct SessionInfo {
-    std::string key;     ///< as Trial::session
-    std::string source;  ///< the file
-    std::int64_t id = 0; ///< the session's id in its study file (0 for a CSV)
+    std::string key;      ///< as Trial::session
+    std::string source;   ///< the file
+    std::int64_t id = 0;  ///< the session's id in its study file (0 for a CSV)
     std::string observer;
     std::string protocol_name;
     std::string protocol_sha256;
@@ -136,17 +136,17 @@ struct CalibrationInfo {
     std::string display_name;
     int width_px = 0, height_px = 0;
     double width_m = 0.0, height_m = 0.0, viewing_distance_m = 0.0;
-    std::string fit_json;     ///< the model's parameters (docs/analysis.md "Display calibration")
-    std::string how;          ///< the row's `source`: "measured", "imported FILE", ...
+    std::string fit_json;  ///< the model's parameters (docs/analysis.md "Display calibration")
+    std::string how;       ///< the row's `source`: "measured", "imported FILE", ...
     std::string measured_at;
     std::vector<CalibrationPoint> readings;  ///< in measuring order; empty for a nominal model
 };
 
 /// A stored stimulus snapshot (an EXR) of one condition in one session.
 struct SnapshotRef {
-    std::string source;       ///< the study file
+    std::string source;  ///< the study file
     std::int64_t session_id = 0;
-    std::string session;      ///< as Trial::session
+    std::string session;  ///< as Trial::session
     std::string condition;
     /// The file to open to read it: the study file, or the migrated temporary
     /// copy of a study file with an older schema (kept while the Dataset lives).
@@ -155,12 +155,12 @@ struct SnapshotRef {
 
 /// Everything read, from every input.
 struct Dataset {
-    std::vector<std::string> sources;      ///< the inputs, in the order given
-    std::vector<Trial> trials;             ///< in input order, then session, then trial_index
+    std::vector<std::string> sources;  ///< the inputs, in the order given
+    std::vector<Trial> trials;         ///< in input order, then session, then trial_index
     std::vector<SessionInfo> sessions;
     std::vector<CalibrationInfo> calibrations;
-    std::vector<SnapshotRef> snapshots;    ///< one per (session, condition) that has one
-    std::vector<std::string> notes;        ///< what the reader could not do (a protocol it could not replay, ...)
+    std::vector<SnapshotRef> snapshots;  ///< one per (session, condition) that has one
+    std::vector<std::string> notes;      ///< what the reader could not do (a protocol it could not replay, ...)
     /// Owns temporary files the dataset refers to (migrated copies of older
     /// study files, see SnapshotRef::read_from); removed with the last copy.
     std::vector<std::shared_ptr<void>> temporaries;

@@ -20,8 +20,8 @@ namespace atonlab::analysis {
 
 /// One figure of the report. Paths are relative to the output folder.
 struct Figure {
-    std::string id;       ///< "psychometric-L0.001-empirical", "pse", ...
-    std::string kind;     ///< "psychometric", "tracks", "pse", "enhancement", "calibration", "timing", "snapshot"
+    std::string id;         ///< "psychometric-L0.001-empirical", "pse", ...
+    std::string kind;       ///< "psychometric", "tracks", "pse", "enhancement", "calibration", "timing", "snapshot"
     std::string condition;  ///< the condition it shows, if one
     std::string title;
     std::string caption;  ///< what it shows, one or two sentences

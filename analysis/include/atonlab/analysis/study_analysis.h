@@ -32,12 +32,12 @@ namespace atonlab::analysis {
 inline constexpr const char* kPooled = "(pooled)";
 
 struct AnalysisOptions {
-    int bootstrap = 999;                    ///< parametric bootstrap resamples per fit; 0: no intervals
-    std::uint64_t seed = kDefaultSeed;      ///< resample i draws from Rng(derive_seed(seed, i))
+    int bootstrap = 999;                ///< parametric bootstrap resamples per fit; 0: no intervals
+    std::uint64_t seed = kDefaultSeed;  ///< resample i draws from Rng(derive_seed(seed, i))
     Family family = Family::CumulativeNormal;
-    double ci_level = 0.95;                 ///< coverage of every interval reported
-    int last_reversals = 6;                 ///< staircases: reversals averaged (Levitt 1971: an even number)
-    int n_threads = 1;                      ///< bootstrap threads; results do not depend on it
+    double ci_level = 0.95;  ///< coverage of every interval reported
+    int last_reversals = 6;  ///< staircases: reversals averaged (Levitt 1971: an even number)
+    int n_threads = 1;       ///< bootstrap threads; results do not depend on it
     /// Called as each group's bootstrap advances (group label, done, total).
     std::function<void(const std::string& group, int done, int total)> progress;
 };
@@ -69,9 +69,9 @@ struct ConditionInfo {
 /// One adaptive track (a staircase or QUEST of one session).
 struct TrackResult {
     std::string session, observer, track, procedure;
-    std::vector<double> levels;            ///< per trial, in order
+    std::vector<double> levels;  ///< per trial, in order
     std::vector<std::optional<bool>> outcomes;
-    std::vector<bool> reversal;            ///< per trial; empty when unknown
+    std::vector<bool> reversal;                ///< per trial; empty when unknown
     std::optional<ReversalSummary> reversals;  ///< staircases
     std::optional<QuestSummary> quest;         ///< QUEST
 };
@@ -79,11 +79,11 @@ struct TrackResult {
 /// A headline number with its interval: what the PSE figure and paired
 /// comparisons use for a group.
 struct HeadlineEstimate {
-    std::optional<double> value;     ///< level units (ConditionInfo::level_unit)
+    std::optional<double> value;  ///< level units (ConditionInfo::level_unit)
     std::optional<Interval> ci;
-    std::string method;              ///< how it was obtained, one phrase
+    std::string method;  ///< how it was obtained, one phrase
     bool reliable = false;
-    std::string reason;              ///< why not reliable / absent
+    std::string reason;  ///< why not reliable / absent
 };
 
 /// log10(match / test): brightness enhancement when the test has glare.
@@ -99,18 +99,18 @@ struct MatchRatio {
 struct GroupResult {
     std::string condition;
     std::string observer;
-    int n_trials = 0;    ///< trials in the group (every row)
-    int n_scored = 0;    ///< with a binary outcome (2AFC, yes-no) or matches (adjustment)
+    int n_trials = 0;  ///< trials in the group (every row)
+    int n_scored = 0;  ///< with a binary outcome (2AFC, yes-no) or matches (adjustment)
     int n_sessions = 0;
     std::vector<LevelCounts> counts;  ///< outcome counts per level
     Family family = Family::CumulativeNormal;
-    std::string family_note;          ///< e.g. the Weibull fitted as its log-level twin, the Gumbel
+    std::string family_note;  ///< e.g. the Weibull fitted as its log-level twin, the Gumbel
     std::optional<PsychometricFit> fit;
     std::optional<PsychometricBootstrap> bootstrap;
     std::optional<double> threshold_proportion;  ///< F at the threshold: (target_p - gamma) / (1 - gamma)
     std::vector<TrackResult> tracks;
-    std::optional<double> reversal_mean;  ///< mean over tracks of their reversal means
-    std::optional<double> quest_mean;     ///< mean over tracks of QUEST's posterior means
+    std::optional<double> reversal_mean;       ///< mean over tracks of their reversal means
+    std::optional<double> quest_mean;          ///< mean over tracks of QUEST's posterior means
     std::optional<AdjustmentSummary> matches;  ///< adjustment: matched levels (mean, median, CIs)
     std::optional<MatchRatio> match_ratio;     ///< log10(match / test intensity)
     HeadlineEstimate headline;
@@ -128,19 +128,19 @@ struct PairedResult {
 struct SessionTiming {
     std::string session, observer;
     int n_trials = 0;
-    int dropped_frames = 0;     ///< sum over trials
+    int dropped_frames = 0;  ///< sum over trials
     int trials_with_drops = 0;
-    int missed_deadlines = 0;   ///< trials whose onset frame was late
+    int missed_deadlines = 0;  ///< trials whose onset frame was late
 };
 
 struct StudyResults {
-    AnalysisOptions options;  ///< as given (progress cleared)
-    std::vector<std::string> observers;      ///< sorted
-    std::vector<ConditionInfo> conditions;   ///< in the order first met (protocol order where known)
-    std::vector<GroupResult> groups;         ///< per condition: each observer, then kPooled when > 1 observer
+    AnalysisOptions options;                ///< as given (progress cleared)
+    std::vector<std::string> observers;     ///< sorted
+    std::vector<ConditionInfo> conditions;  ///< in the order first met (protocol order where known)
+    std::vector<GroupResult> groups;        ///< per condition: each observer, then kPooled when > 1 observer
     std::vector<PairedResult> paired;
     std::vector<SessionTiming> timing;
-    std::vector<std::string> warnings;       ///< the reader's notes and anything doubtful found here
+    std::vector<std::string> warnings;  ///< the reader's notes and anything doubtful found here
 
     const ConditionInfo* condition(const std::string& name) const;
     /// The group of a condition that the figures and the summary lead with:
