@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
+#include "../support/child_process.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/stimuli/image_io.h"
@@ -61,11 +62,7 @@ bool have_display() {
     return std::getenv("DISPLAY") != nullptr;
 }
 
-int status_code(int status) {
-    if (WIFEXITED(status)) return WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-    return -1;
-}
+using test::status_code;
 
 /// A child process, stdout and stderr to files.
 struct Child {

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
+#include "../support/child_process.h"
 #include "atonlab/stimuli/display_model.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
@@ -59,22 +60,8 @@ Result atonlab(const std::vector<std::string>& args, const fs::path& dir) {
     const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
     std::vector<std::string> argv{ATONLAB_BINARY};
     argv.insert(argv.end(), args.begin(), args.end());
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int i = open("/dev/null", O_RDONLY);
-        const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (i < 0 || o < 0 || e < 0 || dup2(i, 0) < 0 || dup2(o, 1) < 0 || dup2(e, 2) < 0) _exit(120);
-        std::vector<char*> cargs;
-        for (std::string& a : argv) cargs.push_back(a.data());
-        cargs.push_back(nullptr);
-        execv(cargs[0], cargs.data());
-        _exit(122);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
     Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.code = test::run_to_files(std::move(argv), out, err, /*stdin_null=*/true);
     r.out = file_bytes(out);
     r.err = file_bytes(err);
     return r;

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
+#include "../support/child_process.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/store/store.h"
@@ -54,40 +55,15 @@ using store::test_support::TempDir;
 const fs::path kProtocol = fs::path(ATONLAB_SOURCE_DIR) / "tests/data/run/small_2afc.toml";
 constexpr int kTrials = 24;
 
-/// Exit status, or 128 + N for a child killed by signal N (as a shell reports it).
-int status_code(int status) {
-    if (WIFEXITED(status)) return WEXITSTATUS(status);
-    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-    return -1;
-}
+using test::status_code;
+using test::wait_for;
 
-/// Starts `atonlab run PROTOCOL --db DB --model-observer --headless ARGS...`,
-/// stdout and stderr to files. drop_root: as root, run as "nobody" (root
-/// ignores file permissions).
 pid_t spawn(const fs::path& db, const std::vector<std::string>& args, const fs::path& out, const fs::path& err,
             bool drop_root = false) {
     std::vector<std::string> argv{ATONLAB_BINARY, "run", kProtocol.string(), "--db", db.string(), "--headless"};
     if (std::find(args.begin(), args.end(), "--script") == args.end()) argv.push_back("--model-observer");
     argv.insert(argv.end(), args.begin(), args.end());
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o < 0 || e < 0 || dup2(o, 1) < 0 || dup2(e, 2) < 0) _exit(120);
-        if (drop_root && geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(121);
-        std::vector<char*> cargs;
-        for (std::string& a : argv) cargs.push_back(a.data());
-        cargs.push_back(nullptr);
-        execv(cargs[0], cargs.data());
-        _exit(122);
-    }
-    return pid;
-}
-
-int wait_for(pid_t pid) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return status_code(status);
+    return test::spawn_to_files(std::move(argv), out, err, false, drop_root);
 }
 
 std::string text_of(const fs::path& p) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
+#include "../support/child_process.h"
 #include "atonlab/store/store.h"
 
 #ifndef ATONLAB_BINARY
@@ -39,22 +40,9 @@ using store::test_support::TempDir;
 const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data/runner";
 
 int run_atonlab(const std::vector<std::string>& args, const fs::path& out, const fs::path& err) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o < 0 || e < 0 || dup2(o, 1) < 0 || dup2(e, 2) < 0) _exit(120);
-        std::vector<std::string> argv{ATONLAB_BINARY};
-        argv.insert(argv.end(), args.begin(), args.end());
-        std::vector<char*> cargs;
-        for (std::string& a : argv) cargs.push_back(a.data());
-        cargs.push_back(nullptr);
-        execv(cargs[0], cargs.data());
-        _exit(122);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::vector<std::string> argv{ATONLAB_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return test::run_to_files(std::move(argv), out, err);
 }
 
 /// screen_stall.toml with its scene path made absolute and `extra` added to [timing].
