@@ -11,9 +11,12 @@
 #include <map>
 #include <set>
 
+#include "atonlab/protocols/procedure.h"
 #include "csv.h"
 
 namespace atonlab::analysis {
+
+namespace p = atonlab::protocols;
 
 namespace {
 
@@ -168,8 +171,13 @@ private:
     const std::vector<std::string>& fields_;
 };
 
-const std::set<std::string, std::less<>> kAdjustWords{"coarse_up", "coarse_down", "fine_up",
-                                                      "fine_down", "confirm",     "match"};
+/// An adjustment action's word (protocols' response_word), or "match", which
+/// hand-made CSVs use for a confirmed match.
+bool is_adjust_word(std::string_view word) {
+    if (word == "match") return true;
+    const std::optional<p::Response> r = p::parse_response_word(word);
+    return r && *r != p::Response::Yes && *r != p::Response::No && *r != p::Response::Left && *r != p::Response::Right;
+}
 
 Trial trial_from_row(const RowReader& row, const std::string& file) {
     Trial t;
@@ -201,16 +209,17 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     if (const auto o = row.boolean("outcome")) {
         t.outcome = o;
     } else if (t.task == Task::Adjust) {
-        if (!kAdjustWords.count(t.response))
+        if (!is_adjust_word(t.response))
             row.fail("response", fmt::format("'{}' is not an adjustment action (confirm or match for a match; "
                                              "coarse_up, coarse_down, fine_up, fine_down)",
                                              t.response));
     } else if (const auto b = RowReader::parse_bool(t.response)) {
         t.outcome = b;
-    } else if (t.task == Task::TwoAfc && (t.response == "left" || t.response == "right")) {
+    } else if (const std::optional<p::Response> side = p::parse_response_word(t.response);
+               t.task == Task::TwoAfc && (side == p::Response::Left || side == p::Response::Right)) {
         if (!t.test_on_left)
             row.fail("test_on_left", "is needed to score the answer 'left' or 'right' (where was the test?)");
-        const bool chose_test = (t.response == "left") == *t.test_on_left;
+        const bool chose_test = (side == p::Response::Left) == *t.test_on_left;
         t.outcome = t.level_on == "test" ? chose_test : !chose_test;
     } else if (t.response != "timeout") {
         row.fail("response", fmt::format("'{}' is not an answer: give 1/0, yes/no or true/false (the outcome the "

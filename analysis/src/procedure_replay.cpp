@@ -21,31 +21,6 @@ namespace p = atonlab::protocols;
 
 namespace {
 
-/// P(procedure Yes) the procedure converges on, as the runner's summary
-/// computes its true value (runner/src/run_session.cpp, target_p_yes).
-std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
-    return std::visit(
-        [](const auto& params) -> std::optional<double> {
-            using T = std::decay_t<decltype(params)>;
-            if constexpr (std::is_same_v<T, p::WeightedStaircaseParams>) {
-                return params.target;  // Kaernbach 1991
-            } else if constexpr (std::is_same_v<T, p::StaircaseParams>) {
-                if (params.up_step_ratio != 1.0) return std::nullopt;
-                // Levitt 1971: 1-up/n-down converges on p^n = 0.5, n-up/1-down on (1 - p)^n = 0.5.
-                if (params.n_up == 1) return std::pow(0.5, 1.0 / static_cast<double>(params.n_down));
-                if (params.n_down == 1) return 1.0 - std::pow(0.5, 1.0 / static_cast<double>(params.n_up));
-                return std::nullopt;
-            } else if constexpr (std::is_same_v<T, p::QuestParams>) {
-                return params.p_threshold;
-            } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
-                return params.criterion;
-            } else {
-                return 0.5;  // adjustment: a match
-            }
-        },
-        spec.params);
-}
-
 ConditionDesign condition_design(const p::Condition& c) {
     ConditionDesign d;
     d.condition = &c;
@@ -53,9 +28,8 @@ ConditionDesign condition_design(const p::Condition& c) {
     // The outcome is "chose the level stimulus" (2AFC) or "yes" (yes-no); the
     // procedure's Yes is the protocol's `choice`. They agree when the choice
     // names the stimulus the level is on.
-    const bool yes_is_outcome = c.task != p::Task::TwoAfc ||
-                                ((c.choice == p::ChoiceMapping::ChoseReference) == (c.level_on == p::Role::Reference));
-    const std::optional<double> p_yes = target_p_yes(c.procedure);
+    const bool yes_is_outcome = c.yes_means_level();
+    const std::optional<double> p_yes = c.procedure.target_p_yes();
     if (p_yes) {
         d.target_p = yes_is_outcome ? *p_yes : 1.0 - *p_yes;
     } else if (const auto* s = std::get_if<p::StaircaseParams>(&c.procedure.params)) {
@@ -75,10 +49,6 @@ ConditionDesign condition_design(const p::Condition& c) {
         d.guess_rate = 0.5;
     }
     return d;
-}
-
-p::Response side_of(std::string_view word) {
-    return word == "left" ? p::Response::Left : p::Response::Right;
 }
 
 }  // namespace
@@ -139,12 +109,13 @@ std::string replay_track(const ConditionDesign& design, std::size_t track, const
                 "proposes {}",
                 t.trial_index, t.level, next->level);
         p::Response r{};
+        const std::optional<p::Response> answer = p::parse_response_word(t.response);
         if (c.task == p::Task::TwoAfc) {
-            if ((t.response != "left" && t.response != "right") || !t.test_on_left)
+            if ((answer != p::Response::Left && answer != p::Response::Right) || !t.test_on_left)
                 return fmt::format("trial {} has no side answer (response \"{}\")", t.trial_index, t.response);
-            r = p::ForcedChoice::inner_response(side_of(t.response), *t.test_on_left, c.choice);
-        } else if (t.response == "yes" || t.response == "no") {
-            r = t.response == "yes" ? p::Response::Yes : p::Response::No;
+            r = p::ForcedChoice::inner_response(*answer, *t.test_on_left, c.choice);
+        } else if (answer == p::Response::Yes || answer == p::Response::No) {
+            r = *answer;
         } else {
             return fmt::format("trial {} has no yes/no answer (response \"{}\")", t.trial_index, t.response);
         }

@@ -15,17 +15,13 @@ namespace atonlab::protocols {
 
 namespace {
 
-constexpr std::pair<std::string_view, Response> kWords[] = {{"left", Response::Left},
-                                                            {"first", Response::Left},
-                                                            {"right", Response::Right},
-                                                            {"second", Response::Right},
-                                                            {"yes", Response::Yes},
-                                                            {"no", Response::No},
-                                                            {"coarse_up", Response::CoarseUp},
-                                                            {"coarse_down", Response::CoarseDown},
-                                                            {"fine_up", Response::FineUp},
-                                                            {"fine_down", Response::FineDown},
-                                                            {"confirm", Response::Confirm}};
+/// A script's answer: a response word (response_word), or "first" / "second"
+/// for the intervals of a temporal 2IFC (Left / Right).
+std::optional<Response> scripted_response(std::string_view word) {
+    if (word == "first") return Response::Left;
+    if (word == "second") return Response::Right;
+    return parse_response_word(word);
+}
 
 constexpr std::string_view kWordList =
     "left, right, first, second, yes, no, coarse_up, coarse_down, fine_up, fine_down, confirm";
@@ -86,15 +82,14 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
         std::transform(word.begin(), word.end(), word.begin(), [](char c) {
             return c == '-' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
         });
-        const auto it =
-            std::find_if(std::begin(kWords), std::end(kWords), [&](const auto& w) { return w.first == word; });
-        if (it == std::end(kWords))
+        const std::optional<Response> response = scripted_response(word);
+        if (!response)
             throw ProtocolError(file, number, 0, "",
                                 fmt::format("unknown answer \"{}\"; expected one of {}.", tokens[0], kWordList));
         Line l;
         l.line = number;
         l.word = std::string(tokens[0]);
-        l.answer.response = it->second;
+        l.answer.response = *response;
         if (tokens.size() == 2) {
             double rt = 0.0;
             const auto [ptr, ec] = std::from_chars(tokens[1].data(), tokens[1].data() + tokens[1].size(), rt);

@@ -36,6 +36,37 @@ std::string_view to_string(Response r) noexcept {
     return "?";
 }
 
+std::string_view response_word(Response r) noexcept {
+    switch (r) {
+        case Response::No:
+            return "no";
+        case Response::Yes:
+            return "yes";
+        case Response::Left:
+            return "left";
+        case Response::Right:
+            return "right";
+        case Response::CoarseUp:
+            return "coarse_up";
+        case Response::CoarseDown:
+            return "coarse_down";
+        case Response::FineUp:
+            return "fine_up";
+        case Response::FineDown:
+            return "fine_down";
+        case Response::Confirm:
+            return "confirm";
+    }
+    return "?";
+}
+
+std::optional<Response> parse_response_word(std::string_view word) noexcept {
+    for (const Response r : {Response::No, Response::Yes, Response::Left, Response::Right, Response::CoarseUp,
+                             Response::CoarseDown, Response::FineUp, Response::FineDown, Response::Confirm})
+        if (response_word(r) == word) return r;
+    return std::nullopt;
+}
+
 void Procedure::record(Response r) {
     if (finished()) throw std::logic_error(fmt::format("{}: record() after the procedure finished", kind()));
     do_record(r);  // throws before changing anything for an answer it cannot take

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
+#include <variant>
 
 namespace atonlab::protocols {
 
@@ -204,6 +206,97 @@ std::optional<Action> ResponseMap::button_action(Task task, std::string_view but
 std::optional<Action> ResponseMap::screen_key_action(std::string_view key) const {
     constexpr Action kScreen[] = {Action::Continue};
     return find_binding(keys, kScreen, key);
+}
+
+std::optional<double> ProcedureSpec::target_p_yes() const {
+    return std::visit(
+        [](const auto& p) -> std::optional<double> {
+            using T = std::decay_t<decltype(p)>;
+            if constexpr (std::is_same_v<T, WeightedStaircaseParams>) {
+                return p.target;  // Kaernbach 1991
+            } else if constexpr (std::is_same_v<T, StaircaseParams>) {
+                if (p.up_step_ratio != 1.0) return std::nullopt;
+                // Levitt 1971: 1-up/n-down converges on p^n = 0.5, n-up/1-down on (1 - p)^n = 0.5.
+                if (p.n_up == 1) return std::pow(0.5, 1.0 / static_cast<double>(p.n_down));
+                if (p.n_down == 1) return 1.0 - std::pow(0.5, 1.0 / static_cast<double>(p.n_up));
+                return std::nullopt;
+            } else if constexpr (std::is_same_v<T, QuestParams>) {
+                return p.p_threshold;
+            } else if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
+                return p.criterion;
+            } else {
+                return 0.5;  // adjustment: a match
+            }
+        },
+        params);
+}
+
+std::vector<double> ProcedureSpec::level_bounds() const {
+    return std::visit(
+        [](const auto& p) -> std::vector<double> {
+            using T = std::decay_t<decltype(p)>;
+            std::vector<double> out;
+            if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
+                if (!p.levels.empty()) {
+                    const auto [lo, hi] = std::minmax_element(p.levels.begin(), p.levels.end());
+                    out = {*lo, *hi};
+                }
+            } else {
+                if (p.min_level) out.push_back(*p.min_level);
+                if (p.max_level) out.push_back(*p.max_level);
+            }
+            return out;
+        },
+        params);
+}
+
+std::pair<double, double> ProcedureSpec::search_range() const {
+    return std::visit(
+        [&](const auto& p) -> std::pair<double, double> {
+            using T = std::decay_t<decltype(p)>;
+            if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
+                if (p.levels.empty()) return {-1.0, 1.0};
+                const auto [lo, hi] = std::minmax_element(p.levels.begin(), p.levels.end());
+                return {*lo - 1.0, *hi + 1.0};
+            } else if constexpr (std::is_same_v<T, AdjustmentParams>) {
+                return {p.min_level.value_or(p.start_min - 2.0), p.max_level.value_or(p.start_max + 2.0)};
+            } else {
+                double first = 0.0;
+                if constexpr (std::is_same_v<T, QuestParams>)
+                    first = p.t_guess;
+                else
+                    first = p.start;
+                double lo = first, hi = first;
+                for (const double v : track_starts) {
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+                return {p.min_level.value_or(lo - 3.0), p.max_level.value_or(hi + 3.0)};
+            }
+        },
+        params);
+}
+
+std::optional<std::size_t> ProcedureSpec::max_trials_per_track() const {
+    return std::visit(
+        [](const auto& p) -> std::optional<std::size_t> {
+            using T = std::decay_t<decltype(p)>;
+            if constexpr (std::is_same_v<T, StaircaseParams> || std::is_same_v<T, WeightedStaircaseParams>) {
+                if (p.max_trials) return static_cast<std::size_t>(*p.max_trials);
+                return std::nullopt;
+            } else if constexpr (std::is_same_v<T, QuestParams>) {
+                return static_cast<std::size_t>(p.n_trials);
+            } else if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
+                return p.levels.size() * static_cast<std::size_t>(p.repetitions);
+            } else {
+                return std::nullopt;
+            }
+        },
+        params);
+}
+
+bool Condition::yes_means_level() const noexcept {
+    return task != Task::TwoAfc || ((choice == ChoiceMapping::ChoseReference) == (level_on == Role::Reference));
 }
 
 double Condition::scene_value(double level) const {

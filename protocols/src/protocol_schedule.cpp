@@ -71,6 +71,18 @@ std::string Schedule::state() const {
     return fmt::format("schedule run={} steps={} {}", run_, history_.size(), live_->interleaver.state());
 }
 
+std::optional<std::size_t> Schedule::max_trials() const {
+    std::size_t total = 0;
+    for (const BlockRun& run : runs_) {
+        for (const Condition& c : protocol_.blocks[run.block].conditions) {
+            const std::optional<std::size_t> per_track = c.procedure.max_trials_per_track();
+            if (!per_track) return std::nullopt;
+            total += *per_track * c.procedure.tracks();
+        }
+    }
+    return total;
+}
+
 std::vector<TrackResult> Schedule::results() const {
     std::vector<TrackResult> out;
     auto add = [&](const Run& run, std::size_t r) {

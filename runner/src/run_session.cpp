@@ -1,8 +1,6 @@
 // The engine of `atonlab run` (run_session.h; docs/running.md).
 #include "run_session.h"
 
-#include "json_text.h"
-
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -37,6 +35,7 @@
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
 #include "calibration_policy.h"
+#include "json_text.h"
 #include "session_display.h"
 
 namespace atonlab::runner {
@@ -96,39 +95,6 @@ std::string read_text(const std::filesystem::path& file, std::string_view what) 
 
 InputError input_error(const p::ProtocolError& e) {
     return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
-}
-
-/// The store's response codes: the action words of docs/protocol-file.md.
-std::string_view response_word(p::Response r) {
-    switch (r) {
-        case p::Response::No:
-            return "no";
-        case p::Response::Yes:
-            return "yes";
-        case p::Response::Left:
-            return "left";
-        case p::Response::Right:
-            return "right";
-        case p::Response::CoarseUp:
-            return "coarse_up";
-        case p::Response::CoarseDown:
-            return "coarse_down";
-        case p::Response::FineUp:
-            return "fine_up";
-        case p::Response::FineDown:
-            return "fine_down";
-        case p::Response::Confirm:
-            return "confirm";
-    }
-    return "?";
-}
-
-std::optional<p::Response> response_from_word(std::string_view w) {
-    for (const p::Response r :
-         {p::Response::No, p::Response::Yes, p::Response::Left, p::Response::Right, p::Response::CoarseUp,
-          p::Response::CoarseDown, p::Response::FineUp, p::Response::FineDown, p::Response::Confirm})
-        if (response_word(r) == w) return r;
-    return std::nullopt;
 }
 
 /// The response codes of trials the procedure never saw (docs/running.md,
@@ -372,8 +338,7 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const s::Display
             const int x = x0 + u;
             if (x < 0 || x >= codes.width) continue;
             const std::size_t i =
-                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
-                3;
+                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) * 3;
             const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
             const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
                                     (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
@@ -454,9 +419,8 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
         for (std::size_t i = 0; i < out->windows.size(); ++i)
             out->windows[i].image.background_cd_m2 =
-                placed[i].on_screen
-                    ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
-                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+                placed[i].on_screen ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
+                                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
     }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
     remember(cache_key(frame, lights), out);
@@ -521,27 +485,6 @@ s::Scene condition_scene(const std::string& scene_text, const std::filesystem::p
     }
 }
 
-/// The levels a procedure says it stays within: its min_level and max_level
-/// where given (constant stimuli: its lowest and highest level).
-std::vector<double> level_bounds(const p::ProcedureSpec& spec) {
-    return std::visit(
-        [](const auto& params) -> std::vector<double> {
-            using T = std::decay_t<decltype(params)>;
-            std::vector<double> out;
-            if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
-                if (!params.levels.empty()) {
-                    const auto [lo, hi] = std::minmax_element(params.levels.begin(), params.levels.end());
-                    out = {*lo, *hi};
-                }
-            } else {
-                if (params.min_level) out.push_back(*params.min_level);
-                if (params.max_level) out.push_back(*params.max_level);
-            }
-            return out;
-        },
-        spec.params);
-}
-
 /// Every frame of one proposal through the scene loader, and the judged lights exist.
 void check_stimulus(const p::Protocol& protocol, const std::string& scene_text, const std::filesystem::path& scene_file,
                     const p::Condition& c, const p::Proposal& proposal) {
@@ -578,7 +521,7 @@ void validate_conditions(const p::Protocol& protocol, const std::string& scene_t
             const std::optional<p::Proposal> first = proc->next();
             if (!first) continue;
             std::vector<double> levels{first->level};
-            for (const double b : level_bounds(c.procedure)) levels.push_back(b);
+            for (const double b : c.procedure.level_bounds()) levels.push_back(b);
             p::Proposal proposal = *first;
             for (const double level : levels) {
                 proposal.level = level;
@@ -593,35 +536,6 @@ void validate_conditions(const p::Protocol& protocol, const std::string& scene_t
             }
         }
     }
-}
-
-/// The most trials each track can take, summed over the session; nullopt when
-/// a procedure has no upper bound (staircases without max_trials, adjustment).
-std::optional<std::size_t> trial_bound(const p::Protocol& protocol, const p::Schedule& schedule) {
-    std::size_t total = 0;
-    for (const p::BlockRun& run : schedule.block_runs()) {
-        for (const p::Condition& c : protocol.blocks[run.block].conditions) {
-            const std::optional<std::size_t> per_track = std::visit(
-                [](const auto& params) -> std::optional<std::size_t> {
-                    using T = std::decay_t<decltype(params)>;
-                    if constexpr (std::is_same_v<T, p::StaircaseParams> ||
-                                  std::is_same_v<T, p::WeightedStaircaseParams>) {
-                        if (params.max_trials) return static_cast<std::size_t>(*params.max_trials);
-                        return std::nullopt;
-                    } else if constexpr (std::is_same_v<T, p::QuestParams>) {
-                        return static_cast<std::size_t>(params.n_trials);
-                    } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
-                        return params.levels.size() * static_cast<std::size_t>(params.repetitions);
-                    } else {
-                        return std::nullopt;
-                    }
-                },
-                c.procedure.params);
-            if (!per_track) return std::nullopt;
-            total += *per_track * c.procedure.tracks();
-        }
-    }
-    return total;
 }
 
 }  // namespace
@@ -795,7 +709,7 @@ std::string state_json(const p::Schedule& schedule, const SessionObserver& obser
                                 : observer.model() ? "model"
                                                    : "script"),
                     observer.seed(), json_number(answer_rt_s), step);
-    if (answer) j += fmt::format(",\"answer\":{}", json_string(response_word(*answer)));
+    if (answer) j += fmt::format(",\"answer\":{}", json_string(p::response_word(*answer)));
     if (!input.empty()) j += fmt::format(",\"input\":{}", json_string(input));
     return j + "}";
 }
@@ -907,57 +821,6 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
 
 // --- Summary ----------------------------------------------------------------------
 
-/// The levels the true value is searched in: the procedure's bounds, or its starts ± 3 log10 units.
-std::pair<double, double> level_range(const p::ProcedureSpec& spec) {
-    return std::visit(
-        [&](const auto& params) -> std::pair<double, double> {
-            using T = std::decay_t<decltype(params)>;
-            if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
-                const auto [lo, hi] = std::minmax_element(params.levels.begin(), params.levels.end());
-                return {*lo - 1.0, *hi + 1.0};
-            } else if constexpr (std::is_same_v<T, p::AdjustmentParams>) {
-                return {params.min_level.value_or(params.start_min - 2.0),
-                        params.max_level.value_or(params.start_max + 2.0)};
-            } else {
-                double first = 0.0;
-                if constexpr (std::is_same_v<T, p::QuestParams>)
-                    first = params.t_guess;
-                else
-                    first = params.start;
-                double lo = first, hi = first;
-                for (const double v : spec.track_starts) {
-                    lo = std::min(lo, v);
-                    hi = std::max(hi, v);
-                }
-                return {params.min_level.value_or(lo - 3.0), params.max_level.value_or(hi + 3.0)};
-            }
-        },
-        spec.params);
-}
-
-/// The P(Yes) a procedure converges on, when it has one.
-std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
-    return std::visit(
-        [](const auto& params) -> std::optional<double> {
-            using T = std::decay_t<decltype(params)>;
-            if constexpr (std::is_same_v<T, p::WeightedStaircaseParams>) {
-                return params.target;
-            } else if constexpr (std::is_same_v<T, p::StaircaseParams>) {
-                // Levitt 1971: 1-up/n-down converges on p^n = 0.5.
-                if (params.n_up == 1 && params.up_step_ratio == 1.0)
-                    return std::pow(0.5, 1.0 / static_cast<double>(params.n_down));
-                return std::nullopt;
-            } else if constexpr (std::is_same_v<T, p::QuestParams>) {
-                return params.p_threshold;
-            } else if constexpr (std::is_same_v<T, p::ConstantStimuliParams>) {
-                return params.criterion;
-            } else {
-                return 0.5;
-            }
-        },
-        spec.params);
-}
-
 }  // namespace
 
 /// The model observer's true value for a condition: the level its procedure
@@ -967,9 +830,9 @@ std::optional<double> target_p_yes(const p::ProcedureSpec& spec) {
 /// each level the root finder asks for.
 std::string true_value(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c,
                        const p::ModelObserverParams& params, double& value) {
-    const std::optional<double> p_yes = target_p_yes(c.procedure);
+    const std::optional<double> p_yes = c.procedure.target_p_yes();
     if (!p_yes) return "no target probability for this procedure";
-    const auto [lo, hi] = level_range(c.procedure);
+    const auto [lo, hi] = c.procedure.search_range();
     auto stimulus_at = [&](double level) {
         p::Proposal proposal;
         proposal.level = level;
@@ -1023,9 +886,7 @@ std::string true_value(StimulusRenderer& renderer, const p::Protocol& protocol, 
         if (level_view >= probe.views.size() || other_view >= probe.views.size())
             return "the stimulus has no two views to compare";
         // Yes means "chose the level stimulus" when the choice and level_on name the same role.
-        const bool yes_is_level = c.task == p::Task::Adjust || ((c.choice == p::ChoiceMapping::ChoseReference) ==
-                                                                (c.level_on == p::Role::Reference));
-        const double p_level = yes_is_level ? *p_yes : 1.0 - *p_yes;
+        const double p_level = c.yes_means_level() ? *p_yes : 1.0 - *p_yes;
         const LightWindow level_w = window_at(mid, level_view);
         const LightWindow other_w = window_at(mid, other_view);
         {
@@ -1082,7 +943,7 @@ void print_summary(const p::Protocol& protocol, const p::Schedule& schedule, Sti
                 double v = 0.0;
                 const std::string why = true_value(*renderer, protocol, c, observer.params(), v);
                 if (why.empty()) {
-                    const std::optional<double> pt = target_p_yes(c.procedure);
+                    const std::optional<double> pt = c.procedure.target_p_yes();
                     const bool pse = c.task != p::Task::YesNo && pt && *pt == 0.5;
                     truth = fmt::format("; model's true {} {:.3f}",
                                         pse ? "PSE" : fmt::format("level at P = {:.3f}", *pt), v);
@@ -1235,7 +1096,7 @@ int run_session(const RunOptions& o) {
             const st::TrialRecord& t = logged[row];
             const std::optional<p::ScheduledTrial> next = check.next();
             const bool uncounted = is_uncounted(t.response);
-            const std::optional<p::Response> r = uncounted ? std::nullopt : response_from_word(t.response);
+            const std::optional<p::Response> r = uncounted ? std::nullopt : p::parse_response_word(t.response);
             if (!next || (!uncounted && !r) || next->condition_id != t.condition_id ||
                 next->procedure_id != t.procedure_id || next->proposal.level != t.level ||
                 next->proposal.test_on_left != t.test_on_left)
@@ -1253,18 +1114,21 @@ int run_session(const RunOptions& o) {
                 previous_ended_trial = true;
                 continue;
             }
+            // Counted: r holds the answer (checked above). value_or keeps GCC's
+            // -Wmaybe-uninitialized from misreading the optional's payload.
+            const p::Response answer = r.value_or(p::Response::No);
             if (next->task == p::Task::Adjust) {
                 if (!open_match.empty() && (open_match.front().first.procedure_id != next->procedure_id ||
                                             open_match.front().first.proposal.trial != next->proposal.trial))
                     open_match.clear();
                 open_match.emplace_back(*next, row);
-                if (*r == p::Response::Confirm) open_match.clear();
+                if (answer == p::Response::Confirm) open_match.clear();
             } else {
                 open_match.clear();
             }
-            previous_ended_trial = next->task != p::Task::Adjust || *r == p::Response::Confirm;
-            check.record(*r);
-            responses.push_back(*r);
+            previous_ended_trial = next->task != p::Task::Adjust || answer == p::Response::Confirm;
+            check.record(answer);
+            responses.push_back(answer);
         }
     }
     p::Schedule schedule = p::Schedule::replay(protocol, seed, responses);
@@ -1329,16 +1193,16 @@ int run_session(const RunOptions& o) {
             for (const auto& [step, row] : open_match) {
                 const p::Answer a = observer.answer(step, &renderer);
                 const std::string_view logged_word = logged[row].response;
-                if (response_word(a.response) != logged_word)
+                if (p::response_word(a.response) != logged_word)
                     std::fprintf(stderr,
                                  "atonlab: warning: replaying step %zu of the open adjustment, the model observer "
                                  "answered \"%s\" where the log has \"%s\" (has the scene file changed?)\n",
-                                 step.step, std::string(response_word(a.response)).c_str(),
+                                 step.step, std::string(p::response_word(a.response)).c_str(),
                                  std::string(logged_word).c_str());
             }
         }
 
-        Progress progress(o.quiet, o.progress_every, trial_bound(protocol, schedule));
+        Progress progress(o.quiet, o.progress_every, schedule.max_trials());
         if (!o.quiet) {
             std::printf("atonlab run: %s, observer \"%s\", seed %llu: session %lld in %s (%s)\n", protocol.name.c_str(),
                         code.c_str(), static_cast<unsigned long long>(seed), static_cast<long long>(session.value),
@@ -1372,7 +1236,7 @@ int run_session(const RunOptions& o) {
         }
 
         const std::size_t runs = schedule.block_runs().size();
-        const std::optional<std::size_t> bound = trial_bound(protocol, schedule);
+        const std::optional<std::size_t> bound = schedule.max_trials();
         auto progress_text = [&](const p::ScheduledTrial& t, std::size_t row) {
             return fmt::format("block {} of {}, trial {} of {}{}", t.run + 1, runs, row + 1, bound ? "at most " : "",
                                bound ? fmt::format("{}", *bound) : std::string("?"));
@@ -1459,7 +1323,7 @@ int run_session(const RunOptions& o) {
                 } catch (const p::ProcedureError& e) {
                     throw InputError(SourceLocation{o.script.empty() ? o.protocol : o.script, 0, 0, ""},
                                      fmt::format("trial {} ({}) cannot take the answer \"{}\": {}", t.step + 1,
-                                                 t.condition_id, response_word(*shown.response), e.message()));
+                                                 t.condition_id, p::response_word(*shown.response), e.message()));
                 }
             }
             std::vector<double> frame_times;
@@ -1475,7 +1339,7 @@ int run_session(const RunOptions& o) {
             tr.level = t.proposal.level;
             tr.test_on_left = t.proposal.test_on_left;
             tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json);
-            tr.response = counted ? std::string(response_word(*shown.response))
+            tr.response = counted ? std::string(p::response_word(*shown.response))
                                   : std::string(shown.end == TrialEnd::timeout ? "timeout" : "missed");
             if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;
             tr.response_time_s = std::max(0.0, shown.response_time_s);  // onset to answer

@@ -73,7 +73,7 @@ public:
     stimuli::ImageRGBA32F hdr(const protocols::Frame& frame, const std::vector<std::string>& lights,
                               double& degrees_per_pixel);
 
-    // --- On screen (session_display.cpp) ---------------------------------
+    // --- On screen (SessionDisplay draws through these) ------------------
     /// The frame's code values for the screen: rendered at the moment of its
     /// interval when `lights` are brightest (as the observer's views), kept in a
     /// small LRU (a block's background is shown every trial).
@@ -142,8 +142,8 @@ protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer&
 /// threshold at the target P(yes)), found on the frames the renderer makes.
 /// Returns "" and sets value, or says why there is none (e.g. the display
 /// clips the level stimulus so its brightness never crosses the other's).
-std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol,
-                       const protocols::Condition& c, const protocols::ModelObserverParams& params, double& value);
+std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol, const protocols::Condition& c,
+                       const protocols::ModelObserverParams& params, double& value);
 
 /// Runs `atonlab run` (RunOptions in commands.h). Returns the exit status: 0
 /// when the session completed, 128 + N when signal N stopped it between trials.

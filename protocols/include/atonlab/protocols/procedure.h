@@ -50,7 +50,7 @@ private:
 ///  - a two-alternative forced choice (ForcedChoice) takes Left / Right, the
 ///    side the observer chose (for a temporal 2IFC: Left = first interval);
 ///  - the method of adjustment takes the five adjustment actions.
-/// The numeric values are stable: the store logs them.
+/// The store logs each as its word (response_word), not as its number.
 enum class Response : std::uint8_t {
     No = 0,
     Yes = 1,
@@ -65,6 +65,13 @@ enum class Response : std::uint8_t {
 
 /// "No", "Yes", "Left", ... (for messages and logs).
 std::string_view to_string(Response r) noexcept;
+/// The word a response is stored, scripted and analysed as: "no", "yes",
+/// "left", "right", "coarse_up", "coarse_down", "fine_up", "fine_down",
+/// "confirm" (the action words of docs/protocol-file.md). The store's
+/// `response` column holds these words.
+std::string_view response_word(Response r) noexcept;
+/// The response a word names (the inverse of response_word); nullopt for any other word.
+std::optional<Response> parse_response_word(std::string_view word) noexcept;
 /// Yes for true, No for false.
 constexpr Response binary(bool yes) noexcept {
     return yes ? Response::Yes : Response::No;

@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -106,6 +107,27 @@ struct ProcedureSpec {
     std::vector<double> track_starts;
 
     std::size_t tracks() const noexcept { return track_starts.empty() ? 1 : track_starts.size(); }
+
+    /// The P(Yes) the procedure converges on, where it has one: a weighted
+    /// staircase's target (Kaernbach 1991); a 1-up/n-down staircase 0.5^(1/n)
+    /// and an n-up/1-down one 1 - 0.5^(1/n) (Levitt 1971: the level where n
+    /// Yes, or n No, in a row are as likely as not); QUEST's p_threshold;
+    /// constant stimuli's criterion; adjustment 0.5 (a match). nullopt for an
+    /// n-up/m-down staircase with n, m > 1 or an up_step_ratio other than 1
+    /// (no closed form). Yes is the procedure's Yes: see Condition::yes_means_level.
+    std::optional<double> target_p_yes() const;
+    /// The levels the procedure says it stays within: its min_level and
+    /// max_level where given (constant stimuli: its lowest and highest level);
+    /// empty when it gives neither.
+    std::vector<double> level_bounds() const;
+    /// The levels a true value (the level the procedure should converge on) is
+    /// searched in: the procedure's bounds where given, else its starts ± 3
+    /// (staircases, QUEST), its levels ± 1 (constant stimuli), its start range
+    /// ± 2 (adjustment).
+    std::pair<double, double> search_range() const;
+    /// The most answers one track takes; nullopt when it has no upper bound
+    /// (a staircase without max_trials, adjustment).
+    std::optional<std::size_t> max_trials_per_track() const;
 };
 
 /// One condition of a block: the scene as overridden, the task, the procedure.
@@ -136,6 +158,12 @@ struct Condition {
 
     /// The value written to level_key for a procedure level (10^level or level).
     double scene_value(double level) const;
+    /// Whether the procedure's Yes means "chose (or saw) the stimulus the level
+    /// is on": always for yes-no and adjustment; for 2AFC when `choice` names
+    /// the role the level is on (chose_reference with the level on the
+    /// reference, chose_test with it on the test). When false, the procedure
+    /// converges where the level stimulus is chosen with 1 - target_p_yes().
+    bool yes_means_level() const noexcept;
 };
 
 struct Block {

@@ -66,6 +66,10 @@ public:
     const Protocol& protocol() const noexcept { return protocol_; }
     std::uint64_t seed() const noexcept { return seed_; }
     const std::vector<BlockRun>& block_runs() const noexcept { return runs_; }
+    /// The most trials the whole schedule can take (every track of every
+    /// block run at its ProcedureSpec::max_trials_per_track); nullopt when a
+    /// procedure has no upper bound.
+    std::optional<std::size_t> max_trials() const;
 
     bool finished() const noexcept { return run_ >= runs_.size(); }
     /// The trial to show now; nullopt once finished(). Pure.
