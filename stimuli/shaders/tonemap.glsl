@@ -12,7 +12,7 @@
 #ifndef ATONLAB_TONEMAP_GLSL
 #define ATONLAB_TONEMAP_GLSL
 
-// ToneOperator and HuePreservation (tonemap.h).
+// ToneOperator, HuePreservation and (0 = off) BlueshiftLuminance (tonemap.h).
 const uint TONE_EMPIRICAL = 0u;
 const uint TONE_PERCEPTUAL = 1u;
 const uint TONE_REINHARD = 2u;
@@ -22,6 +22,9 @@ const uint TONE_CLAMP = 5u;
 const uint HUE_NONE = 0u;
 const uint HUE_XYY = 1u;
 const uint HUE_RGB = 2u;
+const uint BLUE_OFF = 0u;
+const uint BLUE_ADAPTATION = 1u;
+const uint BLUE_PIXEL = 2u;
 
 // kMinAdaptationCdM2, kMaxAdaptationCdM2, kMaxInputCdM2, kMaxScotopicRatio (tonemap.h).
 const float TM_MIN_ADAPTATION = 1e-7;
@@ -32,10 +35,10 @@ const float TM_LOG10_E = 0.43429448190325182;  // 1/ln 10
 const float TM_LOG2_10 = 3.3219280948873623;
 
 struct ToneMapParams {
-    uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift 0/1, w: white_cd_m2 given 0/1
+    uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift (BLUE_*), w: white_cd_m2 given 0/1
     vec4 curve;          // x: 1/L_white² (empirical), y: Reinhard key, z: 1/L_white² (Reinhard), w: Kakimoto g
     vec4 display;        // x: Kakimoto k, y: white_cd_m2, z: L_dmax (cd/m²), w: L_da (cd/m²)
-    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27)
+    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), z: largest channel of blue_rgb
     vec4 blue_rgb;       // xyz: blueshift RGB at Y = 1 (eq 4.29); w: blueshift y
     vec4 blue_per_sum;   // xyz: blueshift RGB per unit X+Y+Z (eq 4.28 path)
     vec4 rgb_to_x;       // rows of the Rec.709 RGB -> XYZ matrix
@@ -139,11 +142,19 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     }
     float ld = tone_curve(lw, v, lwa, p);
 
-    // Blueshift weights from the adaptation luminance (eq 4.27); cone weight without 1 - σ.
-    bool blue = p.mode.z != 0u;
+    // Blueshift weights (eq 4.27) from the pixel's own luminance (BLUE_PIXEL) or the
+    // adaptation luminance (BLUE_ADAPTATION); cone weight without 1 - σ.
+    bool blue = p.mode.z != BLUE_OFF;
+    bool per_pixel = p.mode.z == BLUE_PIXEL;
     float sigma0 = p.tvi.y;
-    float rod = blue ? sigma0 / (sigma0 + lwa) : 0.0;
-    float cone = blue ? lwa / (sigma0 + lwa) : 1.0;
+    // The largest channel per unit luminance either end of the mix can have (tonemap.cpp).
+    float largest_per_unit = max(max(c.r, max(c.g, c.b)) / y_w, p.tvi.z);
+    float l_sigma = per_pixel ? lw : lwa;
+    if (per_pixel && p.mode.x == TONE_CLAMP && ld * largest_per_unit > 1.0) {
+        l_sigma = min(l_sigma, lw / (ld * largest_per_unit));  // colour frozen once a channel can clip
+    }
+    float rod = blue ? sigma0 / (sigma0 + l_sigma) : 0.0;
+    float cone = blue ? l_sigma / (sigma0 + l_sigma) : 1.0;
 
     vec3 outc;
     if (p.mode.y == HUE_XYY) {
@@ -153,7 +164,11 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     } else {
         // eq 4.29; eq 4.30 for HUE_RGB.
         outc = ld * ((cone / y_w) * c + rod * p.blue_rgb.xyz);
-        if (p.mode.y == HUE_RGB) outc /= max(1.0, max(outc.r, max(outc.g, outc.b)));
+        if (p.mode.y == HUE_RGB) {
+            // eq 4.30; per pixel, the bound over the mix's ends keeps L monotonic (tonemap.cpp).
+            float largest = per_pixel ? ld * largest_per_unit : max(outc.r, max(outc.g, outc.b));
+            outc /= max(1.0, largest);
+        }
     }
     if (p.mode.x == TONE_CLAMP) outc = clamp(outc, vec3(0.0), vec3(1.0));
     return max(outc, vec3(0.0));

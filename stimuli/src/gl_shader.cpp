@@ -1,11 +1,11 @@
 // Shader programs from embedded files (magnum Shaders/, bgfx .sc -> .bin.h).
 #include <epoxy/gl.h>
+#include <fmt/format.h>
 
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/gl/objects.h"
@@ -14,12 +14,27 @@
 namespace atonlab::gl {
 namespace detail {
 extern const std::pair<std::string_view, std::string_view> embedded_shaders[];
-extern const std::size_t embedded_shader_count;
+extern const std::size_t embedded_shaders_count;
 }  // namespace detail
 
+namespace {
+/// Tables added by add_shader_table (the tests' own shaders), searched after the library's.
+std::vector<std::span<const std::pair<std::string_view, std::string_view>>>& extra_tables() {
+    static std::vector<std::span<const std::pair<std::string_view, std::string_view>>> tables;
+    return tables;
+}
+}  // namespace
+
+void add_shader_table(std::span<const std::pair<std::string_view, std::string_view>> table) {
+    extra_tables().push_back(table);
+}
+
 std::string_view shader_source(std::string_view name) {
-    for (std::size_t i = 0; i < detail::embedded_shader_count; ++i)
+    for (std::size_t i = 0; i < detail::embedded_shaders_count; ++i)
         if (detail::embedded_shaders[i].first == name) return detail::embedded_shaders[i].second;
+    for (const auto& table : extra_tables())
+        for (const auto& [file, text] : table)
+            if (file == name) return text;
     throw Error(fmt::format("no embedded shader named '{}'", name));
 }
 
@@ -140,23 +155,38 @@ Program Program::build(std::initializer_list<ShaderFile> stages, std::initialize
     glGetProgramiv(program.id(), GL_LINK_STATUS, &linked);
     const std::string log = program_log(program.id());
     if (!linked) throw Error(fmt::format("program '{}' failed to link:\n{}", names, log));
-    if (!log.empty()) std::fprintf(stderr, "atonlab: program '%s' linked with warnings:\n%s\n", names.c_str(), log.c_str());
+    if (!log.empty())
+        std::fprintf(stderr, "atonlab: program '%s' linked with warnings:\n%s\n", names.c_str(), log.c_str());
     return program;
 }
 
-void Program::use() const { ATONLAB_GL_CHECK(glUseProgram(id())); }
+void Program::use() const {
+    ATONLAB_GL_CHECK(glUseProgram(id()));
+}
 
 int Program::uniform_location(std::string_view name) const {
     const std::string n(name);
     return glGetUniformLocation(id(), n.c_str());
 }
 
-void Program::set(std::string_view n, float v) const { glProgramUniform1f(id(), uniform_location(n), v); }
-void Program::set(std::string_view n, double v) const { glProgramUniform1d(id(), uniform_location(n), v); }
-void Program::set(std::string_view n, int v) const { glProgramUniform1i(id(), uniform_location(n), v); }
-void Program::set(std::string_view n, unsigned v) const { glProgramUniform1ui(id(), uniform_location(n), v); }
-void Program::set(std::string_view n, int x, int y) const { glProgramUniform2i(id(), uniform_location(n), x, y); }
-void Program::set(std::string_view n, float x, float y) const { glProgramUniform2f(id(), uniform_location(n), x, y); }
+void Program::set(std::string_view n, float v) const {
+    glProgramUniform1f(id(), uniform_location(n), v);
+}
+void Program::set(std::string_view n, double v) const {
+    glProgramUniform1d(id(), uniform_location(n), v);
+}
+void Program::set(std::string_view n, int v) const {
+    glProgramUniform1i(id(), uniform_location(n), v);
+}
+void Program::set(std::string_view n, unsigned v) const {
+    glProgramUniform1ui(id(), uniform_location(n), v);
+}
+void Program::set(std::string_view n, int x, int y) const {
+    glProgramUniform2i(id(), uniform_location(n), x, y);
+}
+void Program::set(std::string_view n, float x, float y) const {
+    glProgramUniform2f(id(), uniform_location(n), x, y);
+}
 void Program::set(std::string_view n, float x, float y, float z) const {
     glProgramUniform3f(id(), uniform_location(n), x, y, z);
 }

@@ -1,9 +1,16 @@
 #include "gl_test_support.h"
 
+#include <cstdlib>
+
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/footprint.h"
+#include "atonlab/stimuli/gl/objects.h"
 
-#include <cstdlib>
+namespace atonlab::gl::detail {
+// The tests' own shaders (tests/shaders/, embedded by tests/CMakeLists.txt).
+extern const std::pair<std::string_view, std::string_view> test_shaders[];
+extern const std::size_t test_shaders_count;
+}  // namespace atonlab::gl::detail
 
 namespace atonlab::test {
 namespace {
@@ -15,6 +22,7 @@ bool g_tried = false;
 gl::Context* gl_context() {
     if (!g_tried) {
         g_tried = true;
+        gl::add_shader_table({gl::detail::test_shaders, gl::detail::test_shaders_count});
         try {
             gl::HeadlessOptions opt;
             opt.debug = std::getenv("ATONLAB_GL_DEBUG") != nullptr;

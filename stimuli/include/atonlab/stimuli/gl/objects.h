@@ -139,8 +139,7 @@ class Program : public Object<detail::delete_program> {
 public:
     Program() = default;
     using Object::Object;
-    static Program build(std::initializer_list<ShaderFile> files,
-                         std::initializer_list<std::string_view> defines = {});
+    static Program build(std::initializer_list<ShaderFile> files, std::initializer_list<std::string_view> defines = {});
     void use() const;
     int uniform_location(std::string_view name) const;  ///< -1 if absent (optimised out)
     void set(std::string_view name, float v) const;
@@ -157,6 +156,11 @@ public:
 
 /// Source text of an embedded shader file; throws gl::Error if unknown.
 std::string_view shader_source(std::string_view name);
+/// Makes a further table of (file name, text) shaders known to shader_source
+/// and Program::build, searched after the library's own: the test suite's
+/// shaders (tests/shaders/) live there, not in the shipped library. The table
+/// must outlive every use; not thread-safe (call before building programs).
+void add_shader_table(std::span<const std::pair<std::string_view, std::string_view>> table);
 /// The text handed to the driver: #version first, then the defines, then the
 /// file with #include lines expanded (and #line directives so logs name lines).
 std::string preprocess_shader(std::string_view name, std::initializer_list<std::string_view> defines);
