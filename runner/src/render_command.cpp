@@ -87,9 +87,12 @@ int run_render(const RenderOptions& o) {
         "black_cd_m2={} bits={}{}",
         stimuli::tone_operator_name(scene.output.tonemap.tone_operator),
         scene.output.adaptation.mode == stimuli::AdaptationMode::dynamic ? "dynamic" : "fixed", adapted,
-        scene.output.tonemap.blueshift, stimuli::hue_preservation_name(scene.output.tonemap.hue_preservation),
-        scene.output.display.name, scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2,
-        scene.output.encode.bits, scene.output.ldr_glare ? " ldr_glare" : "");
+        scene.output.tonemap.blueshift
+            ? std::string(stimuli::blueshift_luminance_name(scene.output.tonemap.blueshift_luminance))
+            : std::string("off"),
+        stimuli::hue_preservation_name(scene.output.tonemap.hue_preservation), scene.output.display.name,
+        scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2, scene.output.encode.bits,
+        scene.output.ldr_glare ? " ldr_glare" : "");
     std::string glare_note;
     for (const auto& g : renderer.glare().report()) {
         const std::string line = fmt::format(

@@ -21,6 +21,10 @@ constexpr std::array<std::string_view, 6> kOperatorNames = {"empirical", "percep
                                                             "kakimoto",  "linear",     "clamp"};
 constexpr std::array<std::string_view, 3> kHueNames = {"none", "xyY", "rgb"};
 
+double max_component(glm::dvec3 v) {
+    return std::max(v.r, std::max(v.g, v.b));
+}
+
 // Rows of the Rec.709 RGB -> XYZ matrix (glm is column-major: m[col][row]).
 glm::dvec3 xyz_row(int row) {
     const Mat3& m = rec709_rgb_to_xyz();
@@ -59,7 +63,6 @@ double reinhard_curve(double l, double inv_white_sq) {
 double inverse_square(double w) {
     return std::isinf(w) ? 0.0 : 1.0 / (w * w);
 }
-
 
 void require_positive(double v, const char* key, const char* what) {
     if (!(v > 0.0) || !std::isfinite(v)) {
@@ -104,6 +107,16 @@ std::optional<HuePreservation> hue_preservation_from_name(std::string_view name)
     for (std::size_t i = 0; i < kHueNames.size(); ++i) {
         if (kHueNames[i] == name) return static_cast<HuePreservation>(i);
     }
+    return std::nullopt;
+}
+
+std::string_view blueshift_luminance_name(BlueshiftLuminance b) {
+    return b == BlueshiftLuminance::adaptation ? "adaptation" : "pixel";
+}
+
+std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name) {
+    if (name == "adaptation") return BlueshiftLuminance::adaptation;
+    if (name == "pixel") return BlueshiftLuminance::pixel;
     return std::nullopt;
 }
 
@@ -292,10 +305,25 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     }
     const double ld = tone_curve(lw, v, lwa, s);
 
-    // Blueshift weights (K2012 eq 4.27-4.29) from the adaptation luminance; the cone weight
-    // is L/(σ₀ + L) rather than 1 - σ, which fp32 would lose in the dark.
-    const double rod = s.blueshift ? rod_sensitivity(lwa) : 0.0;
-    const double cone = s.blueshift ? lwa / (kRodSigmaCdM2 + lwa) : 1.0;
+    // Blueshift weights (K2012 eq 4.27-4.29) from the pixel's own luminance L_w (the
+    // equations' σ(L_w)) or from the adaptation luminance; the cone weight is L/(σ₀ + L)
+    // rather than 1 - σ, which fp32 would lose in the dark.
+    const bool per_pixel = s.blueshift_luminance == BlueshiftLuminance::pixel;
+    // The largest channel per unit luminance either end of the mix can have: no
+    // channel of the mix exceeds ld times it (a channel of a mix is at most the
+    // larger of its ends; eq 4.30 below).
+    const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
+    const double largest_per_unit = std::max(max_component(c) / y_w, max_component(b));
+    double l_sigma = per_pixel ? std::min(lw, kMaxInputCdM2) : lwa;
+    if (per_pixel && s.tone_operator == ToneOperator::clamp && ld * largest_per_unit > 1.0) {
+        // clamp clips each channel. Once a channel can clip (ld · largest > 1) the
+        // colour is frozen at that luminance, lw / (ld · largest) = L_white / largest:
+        // a mix still moving towards a saturated colour would clip more and more of
+        // it, and the output luminance would fall as the light brightens.
+        l_sigma = std::min(l_sigma, lw / (ld * largest_per_unit));
+    }
+    const double rod = s.blueshift ? rod_sensitivity(l_sigma) : 0.0;
+    const double cone = s.blueshift ? l_sigma / (kRodSigmaCdM2 + l_sigma) : 1.0;
 
     glm::dvec3 out(0.0);
     switch (s.hue_preservation) {
@@ -313,9 +341,17 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
         case HuePreservation::none:
         case HuePreservation::rgb: {
             // K2012 eq 4.29: RGB_w · L_d/L_w · (1-σ) + b · L_d · σ, with RGB_w/L_w = c / y_w.
-            out = ld * (cone / y_w * c + rod * blueshift_rgb(s.blueshift_xy));
+            out = ld * (cone / y_w * c + rod * b);
             if (s.hue_preservation == HuePreservation::rgb) {
-                out /= std::max(1.0, std::max(out.r, std::max(out.g, out.b)));  // K2012 eq 4.30
+                // K2012 eq 4.30: divided by max(1, largest channel). With σ of the pixel's
+                // own luminance the mix, and so its largest channel per unit luminance,
+                // changes with L_w: dividing by it would make a saturated light's output
+                // luminance fall as it brightens. So that case divides by ld times the
+                // largest channel either end of the mix can have (a channel of the mix
+                // is at most the larger of its ends), which keeps every channel <= 1,
+                // the ratios, and the output monotonic in L_w.
+                const double largest = per_pixel && s.blueshift ? ld * largest_per_unit : max_component(out);
+                out /= std::max(1.0, largest);
             }
             break;
         }
@@ -348,13 +384,13 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     };
     ToneMapGpuParams p;
     p.mode = {static_cast<std::uint32_t>(s.tone_operator), static_cast<std::uint32_t>(s.hue_preservation),
-              s.blueshift ? 1u : 0u, s.white_cd_m2 ? 1u : 0u};
+              s.blueshift ? static_cast<std::uint32_t>(s.blueshift_luminance) : 0u, s.white_cd_m2 ? 1u : 0u};
     p.curve = {f(inverse_square(s.white_relative)), f(s.reinhard_key), f(inverse_square(s.reinhard_white_relative)),
                f(s.kakimoto_g)};
     const double lda = display_adaptation_cd_m2(s);
     p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
-    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), 0.0f, 0.0f};
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(max_component(b)), 0.0f};
     p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
     const glm::dvec2 bxy = s.blueshift_xy;
     const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));

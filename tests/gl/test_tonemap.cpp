@@ -17,6 +17,7 @@
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/gl/objects.h"
 #include "atonlab/stimuli/tonemap.h"
+#include "blueshift_modes.h"
 #include "gl_test_support.h"
 
 namespace atonlab::test {
@@ -76,11 +77,11 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
     for (ToneOperator op : ops) {
         double worst_op = 0.0, worst_op_abs = 0.0;
         for (HuePreservation h : hues) {
-            for (bool blue : {false, true}) {
+            for (const int blue : atonlab::test::kBlueshiftModes) {
                 ToneMapSettings s;
                 s.tone_operator = op;
                 s.hue_preservation = h;
-                s.blueshift = blue;
+                atonlab::test::set_blueshift(s, blue);
                 if (op == ToneOperator::reinhard) s.reinhard_white_relative = 4.0;  // exercise eq 4
                 const ToneMapGpuParams p = tonemap_gpu_params(s);
                 params.upload(0, sizeof(p), &p);
@@ -100,10 +101,10 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
                         const double diff = std::abs(g - r);
                         // Relative 1e-4, or absolute 1e-6 near 0 (display-relative units).
                         if (diff > 1e-4 * std::abs(r) && diff > 1e-6 && failures++ < 5) {
-                            ADD_FAILURE()
-                                << tone_operator_name(op) << " " << hue_preservation_name(h) << " blue " << blue
-                                << " pixel " << i << " channel " << c << ": gpu " << g << " cpu " << r << " (rgb "
-                                << px[i].r << "," << px[i].g << "," << px[i].b << " adaptation " << px[i].a << ")";
+                            ADD_FAILURE() << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
+                                          << atonlab::test::blueshift_label(blue) << " pixel " << i << " channel " << c
+                                          << ": gpu " << g << " cpu " << r << " (rgb " << px[i].r << "," << px[i].g
+                                          << "," << px[i].b << " adaptation " << px[i].a << ")";
                         }
                         if (std::abs(r) > 1e-6) {
                             if (diff / std::abs(r) > worst) {
@@ -118,10 +119,11 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
                 worst_op = std::max(worst_op, worst);
                 worst_op_abs = std::max(worst_op_abs, worst_abs);
                 std::printf(
-                    "  %-10s hue %-4s blueshift %-3s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), absolute %.2e\n",
+                    "  %-10s hue %-4s blueshift %-10s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), absolute %.2e\n",
                     std::string(tone_operator_name(op)).c_str(), std::string(hue_preservation_name(h)).c_str(),
-                    blue ? "on" : "off", worst, worst_i, luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))),
-                    static_cast<double>(px[worst_i].a), worst_abs);
+                    atonlab::test::blueshift_label(blue), worst, worst_i,
+                    luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))), static_cast<double>(px[worst_i].a),
+                    worst_abs);
             }
         }
         std::printf("worst GPU-vs-CPU error, %-10s: relative %.2e, absolute (near 0) %.2e\n",

@@ -15,6 +15,7 @@
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/tonemap.h"
+#include "blueshift_modes.h"
 
 namespace atonlab::stimuli {
 namespace {
@@ -457,11 +458,11 @@ TEST(ToneMapInvariant, EveryOperatorFiniteAndMonotonicFromZeroToOneE9) {
     long checked = 0;
     for (ToneOperator op : kOperators) {
         for (HuePreservation h : kHues) {
-            for (bool blue : {false, true}) {
+            for (const int blue : atonlab::test::kBlueshiftModes) {
                 ToneMapSettings s;
                 s.tone_operator = op;
                 s.hue_preservation = h;
-                s.blueshift = blue;
+                atonlab::test::set_blueshift(s, blue);
                 for (int a = 0; a < 25; ++a) {
                     const double lwa = std::pow(10.0, -6.0 + 12.0 * a / 24.0);
                     for (const glm::dvec3& col : colours) {
@@ -471,15 +472,16 @@ TEST(ToneMapInvariant, EveryOperatorFiniteAndMonotonicFromZeroToOneE9) {
                             const glm::dvec3 out = tonemap_pixel(unit * l, lwa, s);
                             ++checked;
                             ASSERT_TRUE(finite_non_negative(out))
-                                << tone_operator_name(op) << " " << hue_preservation_name(h) << " blue " << blue
-                                << " L " << l << " Lwa " << lwa;
+                                << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
+                                << atonlab::test::blueshift_label(blue) << " L " << l << " Lwa " << lwa;
                             const double y = luminance_of_linear_rgb(out);
                             if (l == 0.0) {
                                 ASSERT_EQ(y, 0.0);
                             }
                             ASSERT_GE(y, prev * (1.0 - 1e-12))
-                                << tone_operator_name(op) << " " << hue_preservation_name(h) << " blue " << blue
-                                << " L " << l << " Lwa " << lwa << " colour " << col.r << "," << col.g << "," << col.b;
+                                << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
+                                << atonlab::test::blueshift_label(blue) << " L " << l << " Lwa " << lwa << " colour "
+                                << col.r << "," << col.g << "," << col.b;
                             prev = y;
                         }
                     }
@@ -506,11 +508,11 @@ TEST(ToneMapInvariant, HostileInputsStayFiniteAndNonNegative) {
     }};
     for (ToneOperator op : kOperators) {
         for (HuePreservation h : kHues) {
-            for (bool blue : {false, true}) {
+            for (const int blue : atonlab::test::kBlueshiftModes) {
                 ToneMapSettings s;
                 s.tone_operator = op;
                 s.hue_preservation = h;
-                s.blueshift = blue;
+                atonlab::test::set_blueshift(s, blue);
                 for (const glm::dvec3& in : inputs) {
                     for (double lwa : {0.0, -1.0, nan, inf, 1e-12, 1e-6, 1.0, 1e6, 1e20}) {
                         EXPECT_TRUE(finite_non_negative(tonemap_pixel(in, lwa, s)))

@@ -9,10 +9,12 @@
 // the display encoder; outputs are never negative, NaN or infinite.
 //
 // Every operator acts on luminance (the tone curve), then colour is restored in the way
-// HuePreservation names, with the scotopic blueshift mixed in by the rod sensitivity of
-// the *adaptation* luminance (K2012 §4.4's process: "compute rod saturation factor based
-// on adaptation luminance"). docs/tone-mapping.md derives each step and lists where the
-// thesis has a typo.
+// HuePreservation names, with the scotopic blueshift mixed in by the rod sensitivity σ of
+// each pixel's own luminance (K2012 eq 4.27-4.29 write σ(L_w), after Krawczyk et al.
+// 2005), so a bright coloured light keeps its colour at night while its dim glare and a
+// dark background turn blue; the reading of K2012 §4.4's prose, σ of the *adaptation*
+// luminance for every pixel, is kept as BlueshiftLuminance::adaptation.
+// docs/tone-mapping.md derives each step and lists where the thesis has a typo.
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -48,6 +50,15 @@ enum class HuePreservation : std::uint8_t {
     xyY = 1,   ///< K2012 eq 4.28: chromaticity kept (blueshift mixes it in xy), Y_d = min(1, L_d)
     rgb = 2,   ///< K2012 eq 4.29, then eq 4.30: divided by max(1, largest channel)
 };
+/// Whose luminance the blueshift's rod sensitivity σ is taken of (K2012 eq 4.27). The
+/// values match BLUE_* in tonemap.glsl (0 is "off").
+enum class BlueshiftLuminance : std::uint8_t {
+    adaptation = 1,  ///< σ(L_wa): one weight for the whole frame (K2012 §4.4's process list)
+    pixel = 2,       ///< σ(L_w) of each pixel (K2012 eq 4.27-4.29; Krawczyk et al. 2005)
+};
+std::string_view blueshift_luminance_name(BlueshiftLuminance b);  ///< "adaptation", "pixel"
+std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name);
+
 std::string_view hue_preservation_name(HuePreservation h);  ///< "none", "xyY", "rgb"
 std::optional<HuePreservation> hue_preservation_from_name(std::string_view name);
 std::vector<std::string> hue_preservation_names();
@@ -105,8 +116,11 @@ struct ToneMapSettings {
     /// L_da of K2012 eq 4.22 (cd/m²): the viewer's adaptation; nullopt: display_peak / 2 (K2012).
     std::optional<double> display_adaptation_cd_m2;
 
-    /// Scotopic blueshift (K2012 eq 4.27-4.29): mix towards blueshift_xy by σ(L_wa).
+    /// Scotopic blueshift (K2012 eq 4.27-4.29): mix towards blueshift_xy by σ of
+    /// blueshift_luminance.
     bool blueshift = true;
+    /// σ of each pixel's own luminance (default) or of the adaptation luminance.
+    BlueshiftLuminance blueshift_luminance = BlueshiftLuminance::pixel;
     /// The blueshift's CIE 1931 xy: (0.3, 0.3) after Durand & Dorsey 2000 / Hunt 1952.
     /// Must lie inside the Rec.709 gamut.
     glm::dvec2 blueshift_xy{0.3, 0.3};
@@ -201,10 +215,11 @@ ImageRGBA32F tonemap_image(const ImageRGBA32F& hdr, double adaptation_cd_m2, con
 // Upload it into a uniform or storage block and pass the block's member to
 // tonemap_pixel(rgb, adaptation, params) in GLSL.
 struct ToneMapGpuParams {
-    std::array<std::uint32_t, 4> mode{};  ///< operator, hue preservation, blueshift (0/1), white_cd_m2 given (0/1)
-    std::array<float, 4> curve{};         ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
-    std::array<float, 4> display{};       ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};           ///< log10 ε_C(L_da), σ₀ (cd/m²), 0, 0
+    std::array<std::uint32_t, 4>
+        mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
+    std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
+    std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
+    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), largest channel of the blueshift RGB at Y = 1, 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)
