@@ -19,24 +19,14 @@
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/rng.h"
 #include "atonlab/protocols/staircase.h"
+#include "normal_distribution.h"
 
 namespace {
 
 namespace p = atonlab::protocols;
 
-double normal_cdf(double z) {
-    return 0.5 * std::erfc(-z / std::sqrt(2.0));
-}
-
-/// z with normal_cdf(z) = q, by bisection (independent of the code under test).
-double normal_quantile(double q) {
-    double lo = -10, hi = 10;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (normal_cdf(mid) < q ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
+using atonlab::test::normal_cdf;
+using atonlab::test::normal_quantile;
 
 p::ProcedureSpec spec_of(p::ProcedureKind kind, p::ProcedureParams params, std::vector<double> starts = {}) {
     return p::ProcedureSpec{kind, std::move(params), std::move(starts)};

@@ -16,6 +16,7 @@
 #include "atonlab/protocols/rng.h"
 #include "atonlab/protocols/staircase.h"
 #include "atonlab/protocols/weighted_staircase.h"
+#include "normal_distribution.h"
 #include "procedure_error.h"
 
 namespace {
@@ -341,19 +342,8 @@ TEST(WeightedStaircase, DecibelStepListByHand) {
 
 // ---- Convergence on simulated observers -------------------------------------
 
-double normal_cdf(double z) {
-    return 0.5 * std::erfc(-z / std::sqrt(2.0));
-}
-
-/// z with normal_cdf(z) = p, by bisection (independent of the code under test).
-double normal_quantile(double p) {
-    double lo = -10, hi = 10;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (normal_cdf(mid) < p ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
+using atonlab::test::normal_cdf;
+using atonlab::test::normal_quantile;
 
 /// Mean over `runs` seeded runs of the mean of the last `last` reversal levels,
 /// with a yes/no observer P(Yes | x) = Phi((x - mu) / sigma), mu = 0, sigma = 1.
