@@ -1,6 +1,8 @@
 // The engine of `atonlab run` (run_session.h; docs/running.md).
 #include "run_session.h"
 
+#include "json_text.h"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -35,7 +37,6 @@
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
 #include "calibration_policy.h"
-#include "json_text.h"
 #include "session_display.h"
 
 namespace atonlab::runner {
@@ -338,7 +339,8 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const s::Display
             const int x = x0 + u;
             if (x < 0 || x >= codes.width) continue;
             const std::size_t i =
-                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) * 3;
+                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
+                3;
             const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
             const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
                                     (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
@@ -419,8 +421,9 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
         for (std::size_t i = 0; i < out->windows.size(); ++i)
             out->windows[i].image.background_cd_m2 =
-                placed[i].on_screen ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
-                                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+                placed[i].on_screen
+                    ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
+                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
     }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
     remember(cache_key(frame, lights), out);

@@ -142,8 +142,8 @@ protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer&
 /// threshold at the target P(yes)), found on the frames the renderer makes.
 /// Returns "" and sets value, or says why there is none (e.g. the display
 /// clips the level stimulus so its brightness never crosses the other's).
-std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol, const protocols::Condition& c,
-                       const protocols::ModelObserverParams& params, double& value);
+std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol,
+                       const protocols::Condition& c, const protocols::ModelObserverParams& params, double& value);
 
 /// Runs `atonlab run` (RunOptions in commands.h). Returns the exit status: 0
 /// when the session completed, 128 + N when signal N stopped it between trials.

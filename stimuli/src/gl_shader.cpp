@@ -1,11 +1,12 @@
 // Shader programs from embedded files (magnum Shaders/, bgfx .sc -> .bin.h).
 #include <epoxy/gl.h>
-#include <fmt/format.h>
 
 #include <cstdio>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/gl/objects.h"
@@ -155,38 +156,23 @@ Program Program::build(std::initializer_list<ShaderFile> stages, std::initialize
     glGetProgramiv(program.id(), GL_LINK_STATUS, &linked);
     const std::string log = program_log(program.id());
     if (!linked) throw Error(fmt::format("program '{}' failed to link:\n{}", names, log));
-    if (!log.empty())
-        std::fprintf(stderr, "atonlab: program '%s' linked with warnings:\n%s\n", names.c_str(), log.c_str());
+    if (!log.empty()) std::fprintf(stderr, "atonlab: program '%s' linked with warnings:\n%s\n", names.c_str(), log.c_str());
     return program;
 }
 
-void Program::use() const {
-    ATONLAB_GL_CHECK(glUseProgram(id()));
-}
+void Program::use() const { ATONLAB_GL_CHECK(glUseProgram(id())); }
 
 int Program::uniform_location(std::string_view name) const {
     const std::string n(name);
     return glGetUniformLocation(id(), n.c_str());
 }
 
-void Program::set(std::string_view n, float v) const {
-    glProgramUniform1f(id(), uniform_location(n), v);
-}
-void Program::set(std::string_view n, double v) const {
-    glProgramUniform1d(id(), uniform_location(n), v);
-}
-void Program::set(std::string_view n, int v) const {
-    glProgramUniform1i(id(), uniform_location(n), v);
-}
-void Program::set(std::string_view n, unsigned v) const {
-    glProgramUniform1ui(id(), uniform_location(n), v);
-}
-void Program::set(std::string_view n, int x, int y) const {
-    glProgramUniform2i(id(), uniform_location(n), x, y);
-}
-void Program::set(std::string_view n, float x, float y) const {
-    glProgramUniform2f(id(), uniform_location(n), x, y);
-}
+void Program::set(std::string_view n, float v) const { glProgramUniform1f(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, double v) const { glProgramUniform1d(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, int v) const { glProgramUniform1i(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, unsigned v) const { glProgramUniform1ui(id(), uniform_location(n), v); }
+void Program::set(std::string_view n, int x, int y) const { glProgramUniform2i(id(), uniform_location(n), x, y); }
+void Program::set(std::string_view n, float x, float y) const { glProgramUniform2f(id(), uniform_location(n), x, y); }
 void Program::set(std::string_view n, float x, float y, float z) const {
     glProgramUniform3f(id(), uniform_location(n), x, y, z);
 }

@@ -26,8 +26,8 @@
 #include <system_error>
 #include <utility>
 
-#include "atonlab/common/toml_text.h"
 #include "atonlab/stimuli/atmosphere.h"
+#include "atonlab/common/toml_text.h"
 #include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
@@ -48,54 +48,25 @@ constexpr std::string_view kSetPrefix = "--set ";  // source path of an override
 
 using KeyList = std::span<const std::string_view>;
 
-constexpr std::string_view kSections[] = {"display", "camera",  "environment", "eye",
-                                          "glare",   "tonemap", "profiles",    "light"};
-constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",    "viewing_distance_m",
-                                             "peak_cd_m2", "black_cd_m2", "transfer",   "calibration",
+constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light"};
+constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",     "viewing_distance_m",
+                                             "peak_cd_m2", "black_cd_m2", "transfer",    "calibration",
                                              "bits",       "dither",      "dither_seed"};
 constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
 constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride"};
 constexpr std::string_view kTonemapKeys[] = {
-    "operator",   "white_relative",      "reinhard_key", "reinhard_white_relative",
-    "kakimoto_g", "kakimoto_k",          "white_cd_m2",  "display_adaptation_cd_m2",
-    "blueshift",  "blueshift_luminance", "blueshift_xy", "hue_preservation",
+    "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
+    "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
     "ldr_glare"};
-constexpr std::string_view kGlareKeys[] = {"psf_size",
-                                           "spectral_samples",
-                                           "window",
-                                           "radius_deg",
-                                           "area_layers",
-                                           "bloom_sigma_deg",
-                                           "spencer_vision",
-                                           "aperture_image",
-                                           "aperture_width_mm",
-                                           "aperture_with_pupil",
-                                           "seed",
-                                           "halo_radius_deg",
-                                           "plane_width_mm",
-                                           "fresnel_distance_mm",
-                                           "supersampling",
-                                           "clear_pupil",
-                                           "hippus",
-                                           "hippus_amplitude",
-                                           "gratings",
-                                           "grating_count",
-                                           "grating_inner_radius_mm",
-                                           "grating_width_um",
-                                           "grating_opacity",
-                                           "lens_particles",
-                                           "lens_particle_count",
-                                           "lens_particle_diameter_um",
-                                           "vitreous_particles",
-                                           "vitreous_particle_count",
-                                           "vitreous_particle_diameter_um",
-                                           "eyelashes",
-                                           "eyelash_count",
-                                           "eyelash_width_um",
-                                           "eyelid",
-                                           "eyelid_edge_mm"};
+constexpr std::string_view kGlareKeys[] = {
+    "psf_size", "spectral_samples", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
+    "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
+    "fresnel_distance_mm", "supersampling", "clear_pupil", "hippus", "hippus_amplitude", "gratings", "grating_count",
+    "grating_inner_radius_mm", "grating_width_um", "grating_opacity", "lens_particles", "lens_particle_count",
+    "lens_particle_diameter_um", "vitreous_particles", "vitreous_particle_count", "vitreous_particle_diameter_um",
+    "eyelashes", "eyelash_count", "eyelash_width_um", "eyelid", "eyelid_edge_mm"};
 constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
 constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
 constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};
@@ -134,9 +105,7 @@ std::string join(const Range& items, std::string_view quote = "'") {
 }
 
 /// " Did you mean 'x'?" for the nearest allowed key, or "" (common/toml_text.h).
-std::string suggestion(std::string_view key, KeyList allowed) {
-    return text::did_you_mean(key, allowed);
-}
+std::string suggestion(std::string_view key, KeyList allowed) { return text::did_you_mean(key, allowed); }
 
 using text::type_phrase;
 
@@ -707,12 +676,9 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
     g.bloom_sigma_deg = s.number_or("bloom_sigma_deg", g.bloom_sigma_deg);
     s.greater_than("bloom_sigma_deg", g.bloom_sigma_deg, 0.0);
     if (auto v = s.string("spencer_vision")) {
-        if (*v == "photopic")
-            g.spencer_vision = SpencerVision::photopic;
-        else if (*v == "mesopic")
-            g.spencer_vision = SpencerVision::mesopic;
-        else if (*v == "scotopic")
-            g.spencer_vision = SpencerVision::scotopic;
+        if (*v == "photopic") g.spencer_vision = SpencerVision::photopic;
+        else if (*v == "mesopic") g.spencer_vision = SpencerVision::mesopic;
+        else if (*v == "scotopic") g.spencer_vision = SpencerVision::scotopic;
         else if (*v != "auto")
             s.fail(s.get("spencer_vision"), "spencer_vision",
                    fmt::format("unknown vision \"{}\"; it must be \"photopic\", \"mesopic\", \"scotopic\" or \"auto\".",
@@ -795,8 +761,7 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
             try {
                 out.display = display_from_calibration(fit_calibration(read_calibration_file(p)), p.stem().string());
             } catch (const InputError& e) {
-                s.fail(s.get("calibration"), "calibration",
-                       fmt::format("the calibration file is unusable: {}", e.what()));
+                s.fail(s.get("calibration"), "calibration", fmt::format("the calibration file is unusable: {}", e.what()));
             }
         }
         out.encode.bits = s.integer("bits", 1, 16).value_or(out.encode.bits);

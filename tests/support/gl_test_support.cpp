@@ -1,10 +1,10 @@
 #include "gl_test_support.h"
 
-#include <cstdlib>
-
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/gl/objects.h"
+
+#include <cstdlib>
 
 namespace atonlab::gl::detail {
 // The tests' own shaders (tests/shaders/, embedded by tests/CMakeLists.txt).

@@ -121,17 +121,14 @@ struct SessionRecord {
 /// One trial: what was shown, what the observer answered, how well the frames
 /// were timed, and the procedure's state after the answer.
 struct TrialRecord {
-    std::int64_t trial_index = 0;      ///< 0-based within the session, no gaps (the store enforces it)
-    int block = 0;                     ///< 0-based block of the protocol
-    std::string condition_id;          ///< the protocol's condition name
-    std::string procedure_id;          ///< which procedure instance proposed the stimulus
-    double level = 0.0;                ///< the procedure's level, in the procedure's own units (see its docs)
-    std::optional<bool> test_on_left;  ///< 2AFC: where the test stimulus was; none for yes/no and adjustment
-    std::string stimulus_json = "{}";  ///< every stimulus parameter (the resolved scene keys), JSON text
-    /// The answer's word: protocols::response_word ("left", "right", "yes", "no",
-    /// "coarse_up", "coarse_down", "fine_up", "fine_down", "confirm"), or
-    /// "timeout" / "missed" for a trial the procedure never saw.
-    std::string response;
+    std::int64_t trial_index = 0;             ///< 0-based within the session, no gaps (the store enforces it)
+    int block = 0;                            ///< 0-based block of the protocol
+    std::string condition_id;                 ///< the protocol's condition name
+    std::string procedure_id;                 ///< which procedure instance proposed the stimulus
+    double level = 0.0;                       ///< the procedure's level, in the procedure's own units (see its docs)
+    std::optional<bool> test_on_left;         ///< 2AFC: where the test stimulus was; none for yes/no and adjustment
+    std::string stimulus_json = "{}";         ///< every stimulus parameter (the resolved scene keys), JSON text
+    std::string response;                     ///< protocols::response_word of the answer, or "timeout" / "missed"
     std::optional<double> response_value;     ///< method of adjustment: the value the observer set
     double response_time_s = 0.0;             ///< stimulus onset to answer, seconds, >= 0
     double onset_time_s = 0.0;                ///< stimulus onset on the runner's clock, seconds since session start

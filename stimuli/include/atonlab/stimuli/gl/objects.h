@@ -139,7 +139,8 @@ class Program : public Object<detail::delete_program> {
 public:
     Program() = default;
     using Object::Object;
-    static Program build(std::initializer_list<ShaderFile> files, std::initializer_list<std::string_view> defines = {});
+    static Program build(std::initializer_list<ShaderFile> files,
+                         std::initializer_list<std::string_view> defines = {});
     void use() const;
     int uniform_location(std::string_view name) const;  ///< -1 if absent (optimised out)
     void set(std::string_view name, float v) const;
