@@ -29,13 +29,15 @@ std::string_view glare_model_name(GlareModel m) {
             return "spencer";
         case GlareModel::aperture:
             return "aperture";
+        case GlareModel::cie:
+            return "cie";
     }
     return "none";
 }
 
 std::optional<GlareModel> glare_model_from_name(std::string_view name) {
     for (GlareModel m : {GlareModel::none, GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer,
-                         GlareModel::aperture})
+                         GlareModel::aperture, GlareModel::cie})
         if (glare_model_name(m) == name) return m;
     return std::nullopt;
 }
@@ -280,7 +282,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     m.reports.clear();
     m.light_groups.assign(scene.lights.size(), 0u);
     m.envelope_stride = 0;
-    if (gs.model == GlareModel::none) return 0.0;
+    // `cie` has no billboards: the frame renderer convolves the whole frame (veiling_glare.h).
+    if (gs.model == GlareModel::none || gs.model == GlareModel::cie) return 0.0;
 
     // SPD groups in order of first appearance.
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {

@@ -55,7 +55,8 @@ constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width
 constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
-constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride"};
+constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride",
+                                         "cie_age_years", "cie_pigmentation"};
 constexpr std::string_view kTonemapKeys[] = {
     "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_xy", "hue_preservation", "ldr_glare"};
@@ -634,7 +635,7 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         if (!model)
             s.fail(s.get("glare"), "glare",
                    fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
-                               "\"spencer\" or \"aperture\".",
+                               "\"spencer\", \"aperture\" or \"cie\".",
                                *g));
         glare.model = *model;
     }
@@ -642,6 +643,22 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         s.greater_than("pupil_mm", *p, 0.0);
         s.within("pupil_mm", *p, 0.5, 12.0);
         glare.pupil_mm = *p;
+    }
+    // CIE 146:2002 observer of the `cie` model (cie_glare.h).
+    if (auto a = s.number("cie_age_years")) {
+        s.within("cie_age_years", *a, 0.0, 100.0);
+        glare.cie.age_years = *a;
+    }
+    if (auto p = s.number("cie_pigmentation")) {
+        s.within("cie_pigmentation", *p, 0.0, 1.2);
+        glare.cie.pigmentation = *p;
+    }
+    try {
+        (void)cie_glare_spread(glare.cie);
+    } catch (const InputError& err) {
+        // Only a combination of the two can fail here: name the one the file gives (the age first).
+        const std::string key = s.get("cie_age_years") ? "cie_age_years" : "cie_pigmentation";
+        s.fail(s.get(key), key, err.message());
     }
     return adaptation;
 }

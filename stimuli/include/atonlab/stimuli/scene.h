@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/output_settings.h"
@@ -82,13 +83,15 @@ struct Light {
 };
 
 /// The glare stage (DESIGN.md pipeline step 3; K2012 §4.2-4.3). Every model
-/// goes through the same billboards and conserves each light's energy.
+/// conserves each light's energy; all but `cie` go through the same billboards,
+/// `cie` convolves the whole frame (its veil reaches tens of degrees).
 enum class GlareModel : std::uint8_t {
     none,            ///< each light's direct image only
     wave_optics,     ///< the eye model's PSF by FFT (K2012 §4.2, Ritschel et al. 2009)
     gaussian_bloom,  ///< a monochromatic Gaussian blur (K2012 §3.4.1, [Kaw05]/[KMS05])
     spencer,         ///< the analytic PSF of Spencer et al. 1995
     aperture,        ///< the FFT of an obstacle image (Kakimoto et al. 2005)
+    cie,             ///< CIE 146:2002 veiling glare over the whole frame (veiling_glare.h), not a billboard
 };
 std::string_view glare_model_name(GlareModel m);
 std::optional<GlareModel> glare_model_from_name(std::string_view name);
@@ -108,6 +111,7 @@ struct GlareSettings {
     std::string aperture_image;         ///< aperture: PNG or EXR, transmittance = luminance (white = clear)
     double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
     bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
+    CieObserver cie;                    ///< cie: the observer's age and ocular pigmentation
     /// The PSF cache's pupil step (mm): the kernel is computed for the pupil
     /// diameter rounded to a multiple of this step, so a pupil that moves by
     /// less (hippus, a drifting adaptation level) reuses the cached PSF. 0: the
