@@ -61,7 +61,7 @@ constexpr std::string_view kTonemapKeys[] = {
     "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_xy", "hue_preservation", "ldr_glare"};
 constexpr std::string_view kGlareKeys[] = {
-    "psf_size", "spectral_samples", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
+    "psf_size", "spectral_samples", "spectral_path", "spectral_anchors", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
     "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
     "fresnel_distance_mm", "supersampling", "clear_pupil", "hippus", "hippus_amplitude", "gratings", "grating_count",
     "grating_inner_radius_mm", "grating_width_um", "grating_opacity", "lens_particles", "lens_particle_count",
@@ -676,6 +676,15 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
         s.fail(s.get("psf_size"), "psf_size",
                fmt::format("psf_size must be a power of two (the FFT needs one), got {}.", g.psf_size));
     g.spectral_samples = s.integer("spectral_samples", 1, 128).value_or(g.spectral_samples);
+    if (auto p = s.string("spectral_path")) {
+        const auto path = spectral_path_from_name(*p);
+        if (!path)
+            s.fail(s.get("spectral_path"), "spectral_path",
+                   fmt::format("unknown spectral path \"{}\"; it must be \"anchored\", \"rescaled\" or \"exact\".",
+                               *p));
+        g.spectral_path = *path;
+    }
+    g.spectral_anchors = s.integer("spectral_anchors", 1, 128).value_or(g.spectral_anchors);
     if (auto w = s.string("window")) {
         try {
             g.window = glare_window_from_name(*w);

@@ -448,6 +448,19 @@ TEST(SceneFileGlare, CieModelAndObserverAreRead) {
     EXPECT_EQ(set.glare.cie.age_years, 40.0);
 }
 
+TEST(SceneFileGlare, SpectralPathIsRead) {
+    EXPECT_EQ(parse_scene(std::string(kMinimal), "s.toml").glare.spectral_path, SpectralPath::anchored);
+    const Scene s =
+        parse_scene(std::string(kMinimal) + "[glare]\nspectral_path = \"exact\"\nspectral_anchors = 9\n", "s.toml");
+    EXPECT_EQ(s.glare.spectral_path, SpectralPath::exact);
+    EXPECT_EQ(s.glare.spectral_anchors, 9);
+    for (const char* p : {"anchored", "rescaled", "exact"})
+        EXPECT_EQ(spectral_path_name(*spectral_path_from_name(p)), p);
+    const std::string glare = std::string(kMinimal) + "[glare]\n";
+    expect_error_at(glare + "spectral_path = \"fast\"\n", 7, "glare.spectral_path", "unknown spectral path");
+    expect_error_at(glare + "spectral_anchors = 0\n", 7, "glare.spectral_anchors", "between");
+}
+
 TEST(SceneFileGlare, BadCieObserverNamesFileLineAndKey) {
     const std::string eye = std::string(kMinimal) + "[eye]\nglare = \"cie\"\n";
     expect_error_at(eye + "cie_age_years = -3\n", 8, "eye.cie_age_years", "between 0 and 100");

@@ -96,6 +96,15 @@ enum class GlareModel : std::uint8_t {
 std::string_view glare_model_name(GlareModel m);
 std::optional<GlareModel> glare_model_from_name(std::string_view name);
 
+/// How the wave-optics PSF integrates over the spectrum (K2012 §4.2.4; docs/glare.md "The spectral path").
+enum class SpectralPath : std::uint8_t {
+    anchored,  ///< exact FFTs at a few anchor wavelengths, each sample rescaled from its two neighbours (default)
+    rescaled,  ///< one FFT at λ0 rescaled to every sample (K2012 eq 4.9, on the GPU)
+    exact,     ///< one pupil plane and FFT per sample (the reference)
+};
+std::string_view spectral_path_name(SpectralPath p);
+std::optional<SpectralPath> spectral_path_from_name(std::string_view name);
+
 struct GlareSettings {
     GlareModel model = GlareModel::none;
     /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).
@@ -103,6 +112,8 @@ struct GlareSettings {
     EyeModel eye;                       ///< wave-optics; its pupil_diameter_mm is set per frame
     int psf_size = 512;                 ///< N of the PSF (power of two)
     int spectral_samples = 30;          ///< K2012 §6.1: 30 is the compromise between 15 (steps) and 60
+    SpectralPath spectral_path = SpectralPath::anchored;
+    int spectral_anchors = 6;           ///< anchored: exact FFTs (wavelengths placed by the SPD's luminance)
     GlareWindow window = GlareWindow::silverman;  ///< K2012 §5.3.1: Silverman is safe at 16 bits
     std::optional<double> radius_deg;   ///< billboard radius; default per model (see glare_stage.h)
     int area_layers = 16;               ///< at most this many disc layers (K2012 §4.2.6)
