@@ -1,25 +1,25 @@
 #pragma once
 // The default spectral integration of the wave-optics PSF (K2012 §4.2.4): exact
 // per-wavelength PSFs at a few anchor wavelengths, and every spectral sample
-// made from its two neighbouring anchors, each rescaled by eq 4.9 only across
-// the small step from the anchor to the sample.
+// made from its nearest anchors, each rescaled by eq 4.9 only across the small
+// step from the anchor to the sample.
 //
 // Why: eq 4.9 (psf.h spectral_psf_resampled) rescales the one λ0 PSF to every
 // wavelength. That is exact for the diffraction pattern of a fixed aperture
 // (angles scale with λ), but not for anything whose phase depends on λ
 // otherwise — the Fresnel term E of eq 4.6 (defocus, exp(iπr²/(λd))) — nor for
 // the resampling across a factor of 2 (380 … 780 nm around 575 nm). With the
-// default eye it is 0.49 (relative L2) from the exact path. Here each sample λ
-// between anchors λa < λ < λb is
+// default eye it is 0.49 (relative L2) from the exact path. Here a sample λ
+// between the outer anchors is the Lagrange cubic in 1/λ (the variable E's
+// phase is linear in) through its four nearest anchors λk,
 //
-//   F_λ(x) = (1 − t) · F_λa(x λa/λ) (λa/λ)² + t · F_λb(x λb/λ) (λb/λ)²,
-//   t = (1/λ − 1/λa) / (1/λb − 1/λa),
+//   F_λ(x) = Σk ℓk(1/λ) · F_λk(x λk/λ) (λk/λ)²,
 //
-// linear in 1/λ, the variable E's phase is linear in; samples beyond the first
-// or last anchor take that anchor alone. Anchors sit at quantiles of the
-// samples' weight (x̄ + ȳ + z̄ of CMF × SPD), so they are dense where the
-// light is. docs/glare.md "The spectral path" gives the measured errors and
-// times.
+// each term eq 4.9 from λk by separable Lanczos-3; beyond the outer anchors the
+// two nearest extrapolate linearly (the nearest alone for a sample under 1% of
+// the brightest's weight). Anchors sit at quantiles of the samples' weight
+// (x̄ + ȳ + z̄ of CMF × SPD), so they are dense where the light is.
+// docs/glare.md "The spectral path" gives the measured errors and times.
 #include <vector>
 
 #include "atonlab/stimuli/eye_model.h"
