@@ -46,19 +46,15 @@ void bench_cie_veil(Bench& b) {
     const glm::dvec3 source(ci + 0.5 - 0.5 * w, cj + 0.5 - 0.5 * h, f);  // the light's direction (px)
     const double half_width_deg = std::atan(0.5 * w / f) * 180.0 / std::numbers::pi;
     for (double want_deg : {1.0, 2.0, 5.0, 10.0, 15.0, 20.0}) {
+        // The pixel whose direction is nearest want_deg from the light, along +x.
+        const double x = std::tan(std::atan(source.x / f) + want_deg * std::numbers::pi / 180.0) * f;
+        const int i = static_cast<int>(std::lround(x + 0.5 * w - 0.5));
+        if (i >= w) continue;  // beyond the frame: no row (the notes say how far it reaches)
         Row r;
         r.bench = "cie_veil";
         r.setting = fmt::format("θ = {}°", want_deg);
         r.metric = "|L/E ÷ CIE 146 − 1| at the pixel nearest θ to the right of the light (age 25, p = 0.5)";
         r.time = t;
-        // The pixel whose direction is nearest want_deg from the light, along +x.
-        const double x = std::tan(std::atan(source.x / f) + want_deg * std::numbers::pi / 180.0) * f;
-        const int i = static_cast<int>(std::lround(x + 0.5 * w - 0.5));
-        if (i >= w) {
-            r.note = fmt::format("beyond the frame (it holds {:.1f}° to the right)", half_width_deg);
-            b.add(r);
-            continue;
-        }
         const glm::dvec3 pixel(i + 0.5 - 0.5 * w, source.y, f);
         const double theta =
             std::acos(glm::dot(pixel, source) / (glm::length(pixel) * glm::length(source))) * 180.0 / std::numbers::pi;
@@ -66,10 +62,9 @@ void bench_cie_veil(Bench& b) {
         const double ratio = l / e_lux / cie146_veil_per_lux(theta, observer);
         r.error = std::abs(ratio - 1.0);
         r.note = fmt::format(
-            "θ = {:.3f}°: L/E = {:.5g} sr⁻¹, equation {:.5g} sr⁻¹; {}×{} px frame, {:.1f}% of "
-            "the light outside it; first frame {:.0f} ms (kernel built once per display and "
-            "observer)",
-            theta, l / e_lux, cie146_veil_per_lux(theta, observer), w, h, 100.0 * outside.g, first_ms);
+            "θ = {:.3f}°: L/E = {:.5g} sr⁻¹, equation {:.5g} sr⁻¹; {}×{} px frame (reaching {:.1f}° to the right), "
+            "{:.1f}% of the light outside it; first frame {:.0f} ms (kernel built once per display and observer)",
+            theta, l / e_lux, cie146_veil_per_lux(theta, observer), w, h, half_width_deg, 100.0 * outside.g, first_ms);
         b.add(r);
     }
 }
