@@ -25,6 +25,7 @@ struct Entry {
 const Entry kBenches[] = {
     {"psf_size", bench_psf_size},
     {"spectral_samples", bench_spectral_samples},
+    {"cie_veil", bench_cie_veil},
     {"fft", bench_fft},
     {"pupil_tolerance", bench_pupil_tolerance},
     {"area_layers", bench_area_layers},

@@ -18,6 +18,7 @@
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/scene_file.h"
+#include "atonlab/stimuli/spectral_path.h"
 #include "commands.h"
 
 namespace atonlab::runner {
@@ -128,7 +129,9 @@ int run_psf(const PsfOptions& o) {
     gen.generate(stimuli::pupil_plane(eye, o.size, stimuli::kReferenceWavelengthNm, eye.plane_width_mm, o.time_s), dpt,
                  samples);
     const stimuli::MonoPsf mono = gen.read_mono();
-    const stimuli::RgbPsf rgb = gen.read_rgb();
+    // The RGB PSF by the default spectral path (docs/glare.md "The spectral path").
+    const int anchors = stimuli::GlareSettings{}.spectral_anchors;
+    const stimuli::RgbPsf rgb = stimuli::spectral_psf_anchored(eye, o.size, samples, anchors, o.time_s);
 
     // Everything is computed before the first file is written; files are written
     // atomically, and a failure removes the ones already written.
@@ -145,6 +148,7 @@ int run_psf(const PsfOptions& o) {
     stimuli::ExrMetadata rgb_meta = meta;
     rgb_meta.strings["spd"] = o.spd;
     rgb_meta.strings["spectral_samples"] = fmt::format("{}", o.samples);
+    rgb_meta.strings["spectral_path"] = fmt::format("anchored, {} anchor wavelengths", anchors);
     files.emplace_back(o.exr, image_of(o.size, [&](int x, int y) { return rgb.at(x, y); }));
     metas.push_back(rgb_meta);
     stimuli::ExrMetadata mono_meta = meta;

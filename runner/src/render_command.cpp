@@ -104,6 +104,15 @@ int run_render(const RenderOptions& o) {
         meta.strings[fmt::format("glare_{}", g.spd.empty() ? "d65" : g.spd)] = line;
         glare_note += fmt::format("  glare ({}): {}\n", stimuli::glare_model_name(scene.glare.model), line);
     }
+    if (const stimuli::VeilReport& v = renderer.veil_report(); v.applied) {
+        // The `cie` model: what the frame-sized convolution carried beyond the frame.
+        const std::string line = fmt::format(
+            "cie_age_years={} cie_pigmentation={} outside_frame_rgb=[{:.4f}, {:.4f}, {:.4f}] convolution_ms={:.0f}",
+            v.observer.age_years, v.observer.pigmentation, v.outside_frame.r, v.outside_frame.g, v.outside_frame.b,
+            v.cpu_ms);
+        meta.strings["glare_cie"] = line;
+        glare_note += fmt::format("  glare (cie): {}\n", line);
+    }
     if (o.half) {
         // Half floats end at 65504; the core of a bright light is far above that
         // (a 250 cd, 0.1 m light is ~8000 cd/m² ... 1e9 cd/m² sub-pixel). Clamp rather

@@ -93,6 +93,8 @@ struct FrameRenderer::Impl {
     gl::Buffer no_envelope{sizeof(float), nullptr, gl::BufferUsage::static_draw};
     int light_count = 0;
     GlareStage glare;
+    VeilingGlare veil;
+    VeilReport veil_report;
     FrameOptions options;
     double pre_exposure = 1.0;
     gl::GpuTimer timers[3];
@@ -256,6 +258,8 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
 
     // 2. Per-light evaluation, projection and occlusion (compute).
     // The glare kernels first: the light pass culls with the billboard's extent.
+    m.veil_report = {};
+    m.cpu_timings.veil_cpu_ms = 0;
     const auto prepare_started = Clock::now();
     const double glare_extent_px = m.glare.prepare(scene, P, time_s);
     m.cpu_timings.glare_prepare_cpu_ms = ms_since(prepare_started);
@@ -310,19 +314,48 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         glBlendFunc(GL_ONE, GL_ONE);
         glBlendEquation(GL_FUNC_ADD);
         const bool ldr = glare && scene.output.ldr_glare;
-        begin(2);
-        if (glare && !ldr) {
-            // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
-            m.glare.draw(m.light_count, P, m.pre_exposure);
-        } else {
+        const bool veil = scene.glare.model == GlareModel::cie;
+        auto draw_direct = [&](float pre_exposure) {
             m.light_direct.set("image_size", w, h);
             m.light_direct.set("focal_px", f);
-            m.light_direct.set("pre_exposure", pre);
+            m.light_direct.set("pre_exposure", pre_exposure);
             m.light_direct.use();
             m.vao.bind();
             glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
+        };
+        begin(2);
+        if (glare && !ldr && !veil) {
+            // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
+            m.glare.draw(m.light_count, P, m.pre_exposure);
+        } else if (!veil || ldr) {
+            draw_direct(pre);
         }
-        if (ldr) {
+        if (veil) {
+            // `cie`: the direct images alone (cd/m²) convolved over the whole frame
+            // with the CIE 146 GSF (veiling_glare.h), which replaces them in the
+            // HDR frame, or is the glare buffer of the LDR path.
+            const auto veil_started = Clock::now();
+            m.ensure_glare_target();
+            m.glare_fbo.bind();
+            const float zero[4] = {0, 0, 0, 0};
+            glClearBufferfv(GL_COLOR, 0, zero);
+            draw_direct(1.0f);
+            std::vector<float> light = m.glare_only.download_floats();
+            m.veil_report.outside_frame = m.veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
+            m.veil_report.applied = true;
+            m.veil_report.observer = scene.glare.cie;
+            if (ldr) {
+                m.glare_only.upload(light.data());
+            } else {
+                std::vector<float> frame = m.hdr.download_floats();
+                for (std::size_t i = 0; i < frame.size(); ++i)
+                    if (i % 4 != 3) frame[i] += light[i] * pre;
+                m.hdr.upload(frame.data());
+            }
+            m.fbo.bind();
+            m.veil_report.cpu_ms = ms_since(veil_started);
+            m.cpu_timings.veil_cpu_ms = m.veil_report.cpu_ms;
+        } else if (ldr) {
             // K2012 §6.2.2: the glare alone, into its own buffer, for the LDR path.
             m.ensure_glare_target();
             m.glare_fbo.bind();
@@ -399,6 +432,7 @@ FrameStats FrameRenderer::stats() const {
 }
 
 const GlareStage& FrameRenderer::glare() const { return impl_->glare; }
+const VeilReport& FrameRenderer::veil_report() const { return impl_->veil_report; }
 
 const gl::Texture2D* FrameRenderer::glare_texture() const {
     return impl_->glare_only ? &impl_->glare_only : nullptr;

@@ -14,6 +14,7 @@
 #include "atonlab/stimuli/gl/objects.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/psf_generator.h"
+#include "atonlab/stimuli/spectral_path.h"
 
 namespace atonlab::stimuli {
 
@@ -29,14 +30,34 @@ std::string_view glare_model_name(GlareModel m) {
             return "spencer";
         case GlareModel::aperture:
             return "aperture";
+        case GlareModel::cie:
+            return "cie";
     }
     return "none";
 }
 
 std::optional<GlareModel> glare_model_from_name(std::string_view name) {
     for (GlareModel m : {GlareModel::none, GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer,
-                         GlareModel::aperture})
+                         GlareModel::aperture, GlareModel::cie})
         if (glare_model_name(m) == name) return m;
+    return std::nullopt;
+}
+
+std::string_view spectral_path_name(SpectralPath p) {
+    switch (p) {
+        case SpectralPath::anchored:
+            return "anchored";
+        case SpectralPath::rescaled:
+            return "rescaled";
+        case SpectralPath::exact:
+            return "exact";
+    }
+    return "anchored";
+}
+
+std::optional<SpectralPath> spectral_path_from_name(std::string_view name) {
+    for (SpectralPath p : {SpectralPath::anchored, SpectralPath::rescaled, SpectralPath::exact})
+        if (spectral_path_name(p) == name) return p;
     return std::nullopt;
 }
 
@@ -177,11 +198,22 @@ struct GlareStage::Impl {
                 // pupil_mm already holds the hippus of time_s (prepare()); applied once.
                 eye.hippus.enabled = false;
                 eye.validate(gs.psf_size);
-                const double dpt = psf_degrees_per_texel(eye);
-                const auto field = pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
-                GpuPsfGenerator& gen = generator_for(gs.psf_size);
-                gen.generate(field, dpt, samples);
-                g.psf = gen.read_rgb();
+                switch (gs.spectral_path) {
+                    case SpectralPath::anchored:  // docs/glare.md "The spectral path": FFTW double on the CPU
+                        g.psf = spectral_psf_anchored(eye, gs.psf_size, samples, gs.spectral_anchors, time_s);
+                        break;
+                    case SpectralPath::exact:
+                        g.psf = spectral_psf_exact(eye, gs.psf_size, samples, time_s);
+                        break;
+                    case SpectralPath::rescaled: {  // K2012 eq 4.9 on the GPU
+                        const auto field =
+                            pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
+                        GpuPsfGenerator& gen = generator_for(gs.psf_size);
+                        gen.generate(field, psf_degrees_per_texel(eye), samples);
+                        g.psf = gen.read_rgb();
+                        break;
+                    }
+                }
                 break;
             }
             case GlareModel::aperture: {
@@ -280,7 +312,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     m.reports.clear();
     m.light_groups.assign(scene.lights.size(), 0u);
     m.envelope_stride = 0;
-    if (gs.model == GlareModel::none) return 0.0;
+    // `cie` has no billboards: the frame renderer convolves the whole frame (veiling_glare.h).
+    if (gs.model == GlareModel::none || gs.model == GlareModel::cie) return 0.0;
 
     // SPD groups in order of first appearance.
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
@@ -304,7 +337,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     const EyeModel& e = gs.eye;
     std::string common;
     auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
-    add(glare_model_name(gs.model), gs.psf_size, gs.spectral_samples, glare_window_name(gs.window),
+    add(glare_model_name(gs.model), gs.psf_size, gs.spectral_samples, spectral_path_name(gs.spectral_path),
+        gs.spectral_anchors, glare_window_name(gs.window),
         gs.radius_deg.value_or(-1), gs.bloom_sigma_deg, static_cast<int>(spencer_vision_for(scene)));
     // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
     add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd, pupil_now);

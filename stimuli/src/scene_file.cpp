@@ -55,13 +55,14 @@ constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width
 constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
-constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride"};
+constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride",
+                                         "cie_age_years", "cie_pigmentation"};
 constexpr std::string_view kTonemapKeys[] = {
     "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
     "ldr_glare"};
 constexpr std::string_view kGlareKeys[] = {
-    "psf_size", "spectral_samples", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
+    "psf_size", "spectral_samples", "spectral_path", "spectral_anchors", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
     "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
     "fresnel_distance_mm", "supersampling", "clear_pupil", "hippus", "hippus_amplitude", "gratings", "grating_count",
     "grating_inner_radius_mm", "grating_width_um", "grating_opacity", "lens_particles", "lens_particle_count",
@@ -635,7 +636,7 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         if (!model)
             s.fail(s.get("glare"), "glare",
                    fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
-                               "\"spencer\" or \"aperture\".",
+                               "\"spencer\", \"aperture\" or \"cie\".",
                                *g));
         glare.model = *model;
     }
@@ -643,6 +644,22 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         s.greater_than("pupil_mm", *p, 0.0);
         s.within("pupil_mm", *p, 0.5, 12.0);
         glare.pupil_mm = *p;
+    }
+    // CIE 146:2002 observer of the `cie` model (cie_glare.h).
+    if (auto a = s.number("cie_age_years")) {
+        s.within("cie_age_years", *a, 0.0, 100.0);
+        glare.cie.age_years = *a;
+    }
+    if (auto p = s.number("cie_pigmentation")) {
+        s.within("cie_pigmentation", *p, 0.0, 1.2);
+        glare.cie.pigmentation = *p;
+    }
+    try {
+        (void)cie_glare_spread(glare.cie);
+    } catch (const InputError& err) {
+        // Only a combination of the two can fail here: name the one the file gives (the age first).
+        const std::string key = s.get("cie_age_years") ? "cie_age_years" : "cie_pigmentation";
+        s.fail(s.get(key), key, err.message());
     }
     return adaptation;
 }
@@ -660,6 +677,15 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
         s.fail(s.get("psf_size"), "psf_size",
                fmt::format("psf_size must be a power of two (the FFT needs one), got {}.", g.psf_size));
     g.spectral_samples = s.integer("spectral_samples", 1, 128).value_or(g.spectral_samples);
+    if (auto p = s.string("spectral_path")) {
+        const auto path = spectral_path_from_name(*p);
+        if (!path)
+            s.fail(s.get("spectral_path"), "spectral_path",
+                   fmt::format("unknown spectral path \"{}\"; it must be \"anchored\", \"rescaled\" or \"exact\".",
+                               *p));
+        g.spectral_path = *path;
+    }
+    g.spectral_anchors = s.integer("spectral_anchors", 1, 128).value_or(g.spectral_anchors);
     if (auto w = s.string("window")) {
         try {
             g.window = glare_window_from_name(*w);

@@ -149,24 +149,73 @@ TEST_F(GlareFrames, EveryModelPutsTheLightsIlluminanceIntoTheFrame) {
 
 TEST_F(GlareFrames, GlareAndNoGlareFramesHoldTheSameEnergy) {
     // K2012 fig 6.17: four 100 cd lights at 10, 20, 50 and 100 m, plus colour and fog.
-    Scene scene = black_scene(GlareModel::wave_optics);
-    scene.environment.extinction_per_m = 1e-3;
-    const double xs[] = {-0.02, -0.007, 0.007, 0.02};
-    const double ds[] = {10, 20, 50, 100};
-    for (int i = 0; i < 4; ++i) scene.lights.push_back(light_at(glm::dvec3(xs[i], 0.0, -1.0) * ds[i]));
-    scene.lights[1].rgb_per_cd = *iala_colour_rgb("red");
-    scene.lights[2].rgb_per_cd = *iala_colour_rgb("green");
-    const double with_glare = energy(scene);
-    const glm::dvec3 rgb_glare = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
-    scene.glare.model = GlareModel::none;
-    const double without = energy(scene);
-    const glm::dvec3 rgb_direct = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
-    EXPECT_NEAR(with_glare / without, 1.0, 0.01);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb_glare[c] / rgb_direct[c], 1.0, 0.01) << "channel " << c;
-    double expected = 0;
-    for (const Light& L : scene.lights)
-        expected += illuminance_lux(evaluate_light(L, scene.profiles, scene.camera.position_m, 0.0, 1e-3));
-    EXPECT_NEAR(with_glare / expected, 1.0, 0.01);
+    // Every model: the billboards keep all of it, `cie` all but what it reports outside the frame.
+    for (GlareModel model : {GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer, GlareModel::cie}) {
+        Scene scene = black_scene(model);
+        scene.environment.extinction_per_m = 1e-3;
+        const double xs[] = {-0.02, -0.007, 0.007, 0.02};
+        const double ds[] = {10, 20, 50, 100};
+        for (int i = 0; i < 4; ++i) scene.lights.push_back(light_at(glm::dvec3(xs[i], 0.0, -1.0) * ds[i]));
+        scene.lights[1].rgb_per_cd = *iala_colour_rgb("red");
+        scene.lights[2].rgb_per_cd = *iala_colour_rgb("green");
+        const double with_glare = energy(scene);
+        const glm::dvec3 rgb_glare = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
+        const glm::dvec3 kept = glm::dvec3(1.0) - renderer->veil_report().outside_frame;
+        EXPECT_EQ(renderer->veil_report().applied, model == GlareModel::cie);
+        scene.glare.model = GlareModel::none;
+        const double without = energy(scene);
+        const glm::dvec3 rgb_direct = image_illuminance_rgb_lux(renderer->read_hdr(), renderer->projection().focal_px);
+        const std::string name(glare_model_name(model));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(rgb_glare[c] / (rgb_direct[c] * kept[c]), 1.0, 0.01) << name << " channel " << c;
+        double expected = 0;
+        for (const Light& L : scene.lights)
+            expected += illuminance_lux(evaluate_light(L, scene.profiles, scene.camera.position_m, 0.0, 1e-3));
+        const double kept_y = luminance_of_linear_rgb(rgb_glare) / luminance_of_linear_rgb(rgb_direct);
+        EXPECT_NEAR(with_glare / (expected * kept_y), 1.0, 0.01) << name;
+        EXPECT_NEAR(with_glare / without, kept_y, 1e-6) << name;
+        std::printf("%-14s glare/no-glare energy %.6f, outside the frame %.4f\n", name.c_str(), with_glare / without,
+                    1.0 - kept.g);
+    }
+}
+
+TEST_F(GlareFrames, CieVeilOfOneLightIsTheCie146EquationAndKeepsItsEnergy) {
+    // 261×121 px at 12 px per degree (±10.9° × ±5°); a 10⁴ cd light 1 km straight
+    // ahead (E = 0.01 lx) lands in the centre pixel. L/E at 1°, 3° and 10° to the
+    // right is the CIE 146:2002 General Disability Glare equation (age 25, p = 0.5)
+    // written out here from Vos 2003.
+    const double kDeg = std::numbers::pi / 180.0;
+    const double f = 12.0 / kDeg;
+    Scene scene = black_scene(GlareModel::cie);
+    scene.display = {261, 121, 0.9 * 261 / f, 0.9};
+    scene.lights = {light_at({0.0, 0.0, -1000.0}, 1e4, 0.01)};
+    const double e_lux = 1e4 / 1e6;
+    renderer->render(scene, 0.0);
+    ASSERT_NEAR(renderer->projection().focal_px, f, 1e-6 * f);
+    const ImageRGBA32F img = renderer->read_hdr();
+    const double a = std::pow(25.0 / 70.0, 4), p = 0.5;
+    auto cie = [&](double t) {
+        const double x1 = 1 + std::pow(t / 0.0046, 2), x2 = 1 + std::pow(t / 0.045, 2), x3 = 1 + std::pow(t / 0.1, 2);
+        return (1 - 0.08 * a) * (9.2e6 / std::pow(x1, 1.5) + 1.5e5 / std::pow(x2, 1.5)) +
+               (1 + 1.6 * a) * (400 / x3 + 3e-8 * t * t + p * (1300 / std::pow(x3, 1.5) + 0.8 / std::sqrt(x3))) +
+               2.5e-3 * p;
+    };
+    const int ci = 130, cj = 60;
+    for (int dx : {12, 36, 120}) {
+        const double theta = std::atan(dx / f) / kDeg;
+        const float* px = img.pixel(ci + dx, cj);
+        const double y = luminance_of_linear_rgb({px[0], px[1], px[2]});
+        std::printf("cie veil at %.3f°: L/E %.6g sr⁻¹, equation %.6g, ratio %.5f\n", theta, y / e_lux, cie(theta),
+                    y / e_lux / cie(theta));
+        EXPECT_NEAR(y / e_lux / cie(theta), 1.0, 0.01) << theta << "°";
+    }
+    const VeilReport& v = renderer->veil_report();
+    ASSERT_TRUE(v.applied);
+    const double kept = image_illuminance_lux(img, f) / e_lux;
+    std::printf("cie: frame holds %.6f of E, reported outside %.6f\n", kept, v.outside_frame.g);
+    EXPECT_NEAR(kept, 1.0 - v.outside_frame.g, 1e-3);
+    EXPECT_GT(v.outside_frame.g, 0.05);  // the veil reaches far beyond ±5°
+    EXPECT_LT(v.outside_frame.g, 0.5);
 }
 
 TEST_F(GlareFrames, HiddenLightsEmitNothing) {

@@ -440,6 +440,11 @@ TEST(ViewKeys, NamesMoveTurnAndToggle) {
     EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::wave_optics);
     v.press(ViewKey::glare_cycle, 0.0);
     EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::gaussian_bloom);
+    v.press(ViewKey::glare_cycle, 0.0);
+    v.press(ViewKey::glare_cycle, 0.0);
+    EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::cie);  // spencer, then the CIE 146 veil
+    v.press(ViewKey::glare_cycle, 0.0);
+    EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::wave_optics);
 
     v.press(ViewKey::adapt_up, 0.0);
     EXPECT_NEAR(v.scene().output.adaptation.fixed_cd_m2, 0.01 * std::pow(10.0, 0.25), 1e-15);

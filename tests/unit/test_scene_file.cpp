@@ -429,8 +429,48 @@ TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
     EXPECT_FALSE(scene.glare.eye.halo_radius_deg.has_value());
     EXPECT_EQ(scene.glare.eye.seed, 7u);
     // Every model name round-trips; --set switches glare off.
-    for (const char* m : {"none", "wave-optics", "gaussian-bloom", "spencer", "aperture"})
+    for (const char* m : {"none", "wave-optics", "gaussian-bloom", "spencer", "aperture", "cie"})
         EXPECT_EQ(glare_model_name(*glare_model_from_name(m)), m);
+}
+
+TEST(SceneFileGlare, CieModelAndObserverAreRead) {
+    const std::string text =
+        std::string(kMinimal) + "[eye]\nglare = \"cie\"\ncie_age_years = 62\ncie_pigmentation = 1.0\n";
+    const Scene scene = parse_scene(text, "cie.toml");
+    EXPECT_EQ(scene.glare.model, GlareModel::cie);
+    EXPECT_EQ(scene.glare.cie.age_years, 62.0);
+    EXPECT_EQ(scene.glare.cie.pigmentation, 1.0);
+    // Defaults: CIE 146's 25-year-old, brown eyes (p = 0.5); and --set reaches both keys.
+    const Scene plain = parse_scene(std::string(kMinimal), "cie.toml");
+    EXPECT_EQ(plain.glare.cie.age_years, 25.0);
+    EXPECT_EQ(plain.glare.cie.pigmentation, 0.5);
+    const Scene set = parse_scene(text, "cie.toml", sets({"eye.cie_age_years=40", "eye.glare=\"cie\""}));
+    EXPECT_EQ(set.glare.cie.age_years, 40.0);
+}
+
+TEST(SceneFileGlare, SpectralPathIsRead) {
+    EXPECT_EQ(parse_scene(std::string(kMinimal), "s.toml").glare.spectral_path, SpectralPath::anchored);
+    const Scene s =
+        parse_scene(std::string(kMinimal) + "[glare]\nspectral_path = \"exact\"\nspectral_anchors = 9\n", "s.toml");
+    EXPECT_EQ(s.glare.spectral_path, SpectralPath::exact);
+    EXPECT_EQ(s.glare.spectral_anchors, 9);
+    for (const char* p : {"anchored", "rescaled", "exact"})
+        EXPECT_EQ(spectral_path_name(*spectral_path_from_name(p)), p);
+    const std::string glare = std::string(kMinimal) + "[glare]\n";
+    expect_error_at(glare + "spectral_path = \"fast\"\n", 7, "glare.spectral_path", "unknown spectral path");
+    expect_error_at(glare + "spectral_anchors = 0\n", 7, "glare.spectral_anchors", "between");
+}
+
+TEST(SceneFileGlare, BadCieObserverNamesFileLineAndKey) {
+    const std::string eye = std::string(kMinimal) + "[eye]\nglare = \"cie\"\n";
+    expect_error_at(eye + "cie_age_years = -3\n", 8, "eye.cie_age_years", "between 0 and 100");
+    expect_error_at(eye + "cie_pigmentation = 2\n", 8, "eye.cie_pigmentation", "between 0 and 1.2");
+    // Each within range, together beyond what a positive GSF can conserve.
+    expect_error_at(eye + "cie_age_years = 100\ncie_pigmentation = 1.2\n", 8, "eye.cie_age_years",
+                    "more than all of it");
+    const InputError e = error_of(std::string(kMinimal), sets({"eye.cie_age_years=-1"}));
+    EXPECT_EQ(e.where()->file, "--set");
+    EXPECT_EQ(e.where()->key, "eye.cie_age_years");
 }
 
 TEST(SceneFileOutput, TonemapDisplayAndAdaptationAreRead) {

@@ -22,6 +22,7 @@
 #include "atonlab/stimuli/gl/objects.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/scene.h"
+#include "atonlab/stimuli/veiling_glare.h"
 
 namespace atonlab::stimuli {
 
@@ -104,6 +105,7 @@ struct FrameTimings {
     double light_eval_gpu_ms = 0;
     double lights_draw_gpu_ms = 0;  ///< direct images or glare billboards (both passes with ldr_glare)
     double glare_prepare_cpu_ms = 0;  ///< kernels, layers, crop tables (PSF rebuilds included)
+    double veil_cpu_ms = 0;           ///< the `cie` model's frame convolution (0 for other models)
     double total_cpu_ms = 0;          ///< render() from entry to return (GPU work may still run)
     double gpu_ms() const { return background_gpu_ms + light_eval_gpu_ms + lights_draw_gpu_ms; }
 };
@@ -135,9 +137,12 @@ public:
 
     /// The glare stage of the last frame: kernels, layers, what it reported.
     const GlareStage& glare() const;
+    /// The `cie` model's last frame (applied = false for every other model).
+    const VeilReport& veil_report() const;
     const gl::Texture2D& hdr_texture() const;
-    /// With scene.output.ldr_glare and a glare model: the glare billboards alone
-    /// (cd/m²), while hdr_texture() holds the scene with direct images; else nullptr.
+    /// With scene.output.ldr_glare and a glare model: the glare alone (the
+    /// billboards, or the `cie` veil; cd/m²), while hdr_texture() holds the scene
+    /// with direct images; else nullptr.
     const gl::Texture2D* glare_texture() const;
     const gl::Texture2D& view_depth_texture() const;
 

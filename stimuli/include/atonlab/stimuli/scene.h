@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/output_settings.h"
@@ -82,16 +83,27 @@ struct Light {
 };
 
 /// The glare stage (DESIGN.md pipeline step 3; K2012 §4.2-4.3). Every model
-/// goes through the same billboards and conserves each light's energy.
+/// conserves each light's energy; all but `cie` go through the same billboards,
+/// `cie` convolves the whole frame (its veil reaches tens of degrees).
 enum class GlareModel : std::uint8_t {
     none,            ///< each light's direct image only
     wave_optics,     ///< the eye model's PSF by FFT (K2012 §4.2, Ritschel et al. 2009)
     gaussian_bloom,  ///< a monochromatic Gaussian blur (K2012 §3.4.1, [Kaw05]/[KMS05])
     spencer,         ///< the analytic PSF of Spencer et al. 1995
     aperture,        ///< the FFT of an obstacle image (Kakimoto et al. 2005)
+    cie,             ///< CIE 146:2002 veiling glare over the whole frame (veiling_glare.h), not a billboard
 };
 std::string_view glare_model_name(GlareModel m);
 std::optional<GlareModel> glare_model_from_name(std::string_view name);
+
+/// How the wave-optics PSF integrates over the spectrum (K2012 §4.2.4; docs/glare.md "The spectral path").
+enum class SpectralPath : std::uint8_t {
+    anchored,  ///< exact FFTs at a few anchor wavelengths, each sample rescaled from its two neighbours (default)
+    rescaled,  ///< one FFT at λ0 rescaled to every sample (K2012 eq 4.9, on the GPU)
+    exact,     ///< one pupil plane and FFT per sample (the reference)
+};
+std::string_view spectral_path_name(SpectralPath p);
+std::optional<SpectralPath> spectral_path_from_name(std::string_view name);
 
 struct GlareSettings {
     GlareModel model = GlareModel::none;
@@ -100,6 +112,8 @@ struct GlareSettings {
     EyeModel eye;                       ///< wave-optics; its pupil_diameter_mm is set per frame
     int psf_size = 512;                 ///< N of the PSF (power of two)
     int spectral_samples = 30;          ///< K2012 §6.1: 30 is the compromise between 15 (steps) and 60
+    SpectralPath spectral_path = SpectralPath::anchored;
+    int spectral_anchors = 6;           ///< anchored: exact FFTs (wavelengths placed by the SPD's luminance)
     GlareWindow window = GlareWindow::silverman;  ///< K2012 §5.3.1: Silverman is safe at 16 bits
     std::optional<double> radius_deg;   ///< billboard radius; default per model (see glare_stage.h)
     int area_layers = 16;               ///< at most this many disc layers (K2012 §4.2.6)
@@ -108,6 +122,7 @@ struct GlareSettings {
     std::string aperture_image;         ///< aperture: PNG or EXR, transmittance = luminance (white = clear)
     double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
     bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
+    CieObserver cie;                    ///< cie: the observer's age and ocular pigmentation
     /// The PSF cache's pupil step (mm): the kernel is computed for the pupil
     /// diameter rounded to a multiple of this step, so a pupil that moves by
     /// less (hippus, a drifting adaptation level) reuses the cached PSF. 0: the

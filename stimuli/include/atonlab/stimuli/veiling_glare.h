@@ -1,0 +1,73 @@
+#pragma once
+// Wide-angle veiling glare over a whole frame (the `cie` glare model): the
+// lights' direct images convolved with the CIE 146:2002 glare spread function
+// (cie_glare.h) by a frame-sized FFT convolution, in double precision (FFTW).
+//
+// Energy: each pixel's light is its illuminance e = L·Ω (lux; L in cd/m², Ω the
+// pixel's exact pinhole solid angle); the kernel K(d) is the GSF integrated over
+// the solid angle of the pixel at offset d from a source on the optical axis, so
+// e_out(q) = Σ_p e(p) K(q − p) and L_out(q) = e_out(q) / Ω(q). Σ_q K over the
+// whole plane and the hemisphere behind it is 1, so Σ L_out·Ω over the frame is
+// Σ e minus what falls outside the frame, which apply() reports.
+//
+// The convolution is linear (zero-padded to at least 2W − 1 × 2H − 1), so a
+// light anywhere in the frame reaches every pixel, and nothing wraps around.
+// Like the billboards' kernels, the kernel is the one of a source on the optical
+// axis, used for every source (shift-invariant): off axis the pinhole's
+// stretching of angles makes it approximate (at 15° off axis, angles on the
+// image plane are stretched by about 1/cos²15° = 7% radially).
+#include <glm/glm.hpp>
+#include <memory>
+#include <vector>
+
+#include "atonlab/stimuli/cie_glare.h"
+
+namespace atonlab::stimuli {
+
+/// The kernel K of one frame: (2W − 1) × (2H − 1) energy fractions, offsets
+/// (dx, dy) ∈ [−(W−1), W−1] × [−(H−1), H−1] px, K(dx, dy) = ∫ GSF dΩ over the pixel
+/// square centred at (dx, dy) on the image plane at focal length f (px). Exposed
+/// for tests and the bench; the convolution builds its own.
+struct VeilKernelQuadrant {
+    int width = 0, height = 0;  ///< W, H: offsets 0 … W−1, 0 … H−1 (the kernel is symmetric in x and y)
+    std::vector<double> value;  ///< H*W, row-major: value[dy * W + dx]
+    double at(int dx, int dy) const { return value[static_cast<std::size_t>(dy) * width + dx]; }
+};
+VeilKernelQuadrant veil_kernel_quadrant(const CieGlareSpread& gsf, int width, int height, double focal_px);
+
+/// Pixel (i, j)'s exact solid angle (sr) in a W×H frame of focal length f (px),
+/// the principal point at the frame's centre.
+double frame_pixel_solid_angle_sr(int i, int j, int width, int height, double focal_px);
+
+/// What the `cie` model did in the last frame (FrameRenderer::veil_report()).
+struct VeilReport {
+    bool applied = false;  ///< false unless the last frame's glare model was `cie`
+    CieObserver observer;
+    glm::dvec3 outside_frame{0.0};  ///< per channel: energy fraction the GSF carried outside the frame
+    double cpu_ms = 0;              ///< read-back, convolution (kernel build included) and upload
+};
+
+class VeilingGlare {
+public:
+    VeilingGlare();
+    ~VeilingGlare();
+    VeilingGlare(const VeilingGlare&) = delete;
+    VeilingGlare& operator=(const VeilingGlare&) = delete;
+
+    /// Convolves the RGBA image (width × height, 4 floats per pixel, luminance in
+    /// cd/m², any row order) in place with the observer's GSF; alpha is left as
+    /// it is. Returns per channel the fraction of the image's energy that the GSF
+    /// carried outside the frame (0 for a channel without energy). The kernel's
+    /// spectrum is cached for the last (size, focal length, observer).
+    /// Throws InputError (cie_glare_spread()) for a bad observer.
+    glm::dvec3 apply(std::vector<float>& rgba, int width, int height, double focal_px, const CieObserver& observer);
+
+    /// How often the kernel was built (since construction).
+    int kernel_builds() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace atonlab::stimuli
