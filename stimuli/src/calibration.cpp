@@ -389,7 +389,10 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
 
     std::vector<Measurement> out;
     out.reserve(rows.size());
-    for (const auto& [tokens, line_no] : rows) {
+    for (const auto& row : rows) {
+        // Not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda below.
+        const auto& tokens = row.first;
+        const auto line_no = row.second;
         if (tokens.size() != fields.size())
             throw error(line_no, 0, "",
                         fmt::format("this data line has {} values but BEGIN_DATA_FORMAT (line {}) names {} fields",
