@@ -18,6 +18,19 @@ if(ATONLAB_SANITIZE)
   target_link_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined)
 endif()
 
+# The fuzz build (fuzz/, docs/fuzzing.md): every library instrumented for
+# libFuzzer's coverage, with ASan and UBSan; only the fuzz targets link the
+# fuzzer's main (-fsanitize=fuzzer). clang only.
+if(ATONLAB_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "ATONLAB_FUZZ needs clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++ "
+                        "-DCMAKE_C_COMPILER=clang, as scripts/fuzz.sh does")
+  endif()
+  target_compile_options(atonlab_sanitize INTERFACE -fsanitize=fuzzer-no-link,address,undefined
+                         -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined)
+endif()
+
 # Every atonlab library and executable links this.
 add_library(atonlab_policy INTERFACE)
 target_link_libraries(atonlab_policy INTERFACE atonlab_warnings atonlab_sanitize)

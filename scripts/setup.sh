@@ -17,6 +17,7 @@ packages=(
   gnuplot-nox
   xvfb xauth
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
 )
 
 missing=()

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Set up, build with warnings as errors, and run every test (unit, GL on the
-# headless EGL context, end-to-end). ATONLAB_SANITIZE=1 builds with ASan/UBSan
+# headless EGL context, end-to-end), then a short fuzz run of the loaders. ATONLAB_SANITIZE=1 builds with ASan/UBSan
 # into build-asan/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,3 +14,7 @@ else
 fi
 bash scripts/setup.sh
 ctest --test-dir "${ATONLAB_BUILD_DIR:-build}" --output-on-failure --parallel "$(nproc)" --timeout 600
+# The loaders' fuzz targets, built with clang into build-fuzz/, 20 s each (docs/fuzzing.md).
+if [ "${ATONLAB_SANITIZE:-0}" != 1 ]; then
+  bash scripts/fuzz.sh
+fi

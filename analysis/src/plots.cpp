@@ -13,6 +13,7 @@
 
 #include "atonlab/store/error.h"
 #include "atonlab/store/json.h"
+#include "atonlab/store/sha256.h"
 #include "csv.h"
 #include "gnuplot.h"
 
@@ -548,6 +549,41 @@ std::string file_slug(const std::string& name) {
     return out.empty() ? std::string("_") : out;
 }
 
+std::map<std::string, std::string> condition_slugs(const std::vector<std::string>& names) {
+    const std::set<std::string> unique(names.begin(), names.end());
+    std::map<std::string, int> count;
+    for (const std::string& n : unique) ++count[file_slug(n)];
+    std::map<std::string, std::string> out;
+    std::set<std::string> used;
+    for (const std::string& n : unique) {
+        const std::string slug = file_slug(n);
+        if (count[slug] == 1) {
+            out[n] = slug;
+            used.insert(slug);
+        }
+    }
+    for (const std::string& n : unique) {
+        if (out.count(n)) continue;
+        // The name's own hash: 8 hex digits, or more in the (2^-32) case that
+        // they meet another file name.
+        const std::string hash = store::sha256_hex(n);
+        std::string slug;
+        for (std::size_t digits = 8; digits <= hash.size(); digits += 8) {
+            slug = fmt::format("{}-{}", file_slug(n), hash.substr(0, digits));
+            if (!used.count(slug)) break;
+        }
+        out[n] = slug;
+        used.insert(slug);
+    }
+    return out;
+}
+
+std::map<std::string, std::string> condition_slugs(const StudyResults& results) {
+    std::vector<std::string> names;
+    for (const ConditionInfo& c : results.conditions) names.push_back(c.condition);
+    return condition_slugs(names);
+}
+
 std::optional<double> model_grey_luminance_cd_m2(const std::string& fit_json, double v) {
     try {
         const store::JsonReader j(fit_json, "fit_json");
@@ -596,10 +632,9 @@ PlotResult make_figures(const fs::path& out_dir, const Dataset& data, const Stud
     PlotResult out;
     fs::create_directories(out_dir / "figures");
     Drawer d(out_dir, options, out);
-    std::set<std::string> used;
+    const std::map<std::string, std::string> slugs = condition_slugs(results);
     for (const ConditionInfo& c : results.conditions) {
-        std::string slug = file_slug(c.condition);
-        for (int i = 2; !used.insert(slug).second; ++i) slug = fmt::format("{}-{}", file_slug(c.condition), i);
+        const std::string& slug = slugs.at(c.condition);
         if (c.task != Task::Adjust) psychometric_figure(d, results, c, slug);
         tracks_figure(d, results, c, slug);
     }

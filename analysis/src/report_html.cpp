@@ -125,6 +125,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     const StudyResults& r = *ctx.results;
     const Dataset& d = *ctx.data;
     const std::filesystem::path out_dir = file.parent_path();
+    const std::map<std::string, std::string> slugs = condition_slugs(r);  // the anchors, one per condition
     std::map<std::string, std::vector<const Figure*>> by_condition;
     std::map<std::string, const Figure*> by_kind;
     if (ctx.plots) {
@@ -179,7 +180,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
             "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(file_slug(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))), esc(c.procedure),
+            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))), esc(c.procedure),
             g3(c.adaptation_cd_m2), esc(c.tone_operator), esc(c.glare_test), esc(c.glare_reference),
             g3(c.test_intensity_cd), esc(g->observer), g->n_scored, f3(e.value), ci_text(e.ci), esc(c.level_unit()),
             enh, yes_no(e.reliable, e.reason));
@@ -190,7 +191,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
 
     // --- per condition
     for (const ConditionInfo& c : r.conditions) {
-        h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(file_slug(c.condition)), esc(c.condition));
+        h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(slugs.at(c.condition)), esc(c.condition));
         h += fmt::format(
             "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
             "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/protocols/observer.h"
 
 namespace atonlab::protocols {
@@ -106,19 +107,10 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
 }
 
 ScriptedObserver ScriptedObserver::load(const std::filesystem::path& file) {
-    std::FILE* f = std::fopen(file.c_str(), "rb");
-    if (f == nullptr)
-        throw ProtocolError(
-            file.string(), 0, 0, "",
-            fmt::format("cannot read the answer file: {}.", std::error_code(errno, std::generic_category()).message()));
-    std::string text;
-    char buffer[65536];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    const bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed) throw ProtocolError(file.string(), 0, 0, "", "cannot read the answer file: a read error occurred.");
-    return parse(text, file.string());
+    text::FileText read = text::read_text_file(file);  // only up to a limit (/dev/zero is refused)
+    if (!read.ok())
+        throw ProtocolError(file.string(), 0, 0, "", fmt::format("cannot read the answer file: {}.", read.error));
+    return parse(read.text, file.string());
 }
 
 Answer ScriptedObserver::answer(const Shown& shown) {

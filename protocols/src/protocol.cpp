@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "atonlab/common/input_text.h"
+
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -20,9 +22,10 @@ std::string format_error(const std::string& file, int line, const std::string& k
         if (line > 0) s += fmt::format(":{}", line);
         s += ": ";
     }
-    if (!key.empty()) s += fmt::format("key '{}': ", key);
+    if (!key.empty()) s += fmt::format("key '{}': ", text::echo(key));
     s += message;
-    return s;
+    // One line of bounded length, whatever the message echoes.
+    return text::one_line(s);
 }
 
 /// Looks `text` up in a table of (name, value) pairs.
@@ -103,7 +106,7 @@ ProtocolError::ProtocolError(std::string file, int line, int column, std::string
       line_(line),
       column_(column),
       key_(std::move(key)),
-      message_(message) {}
+      message_(text::one_line(message)) {}
 
 std::string_view to_string(Task t) noexcept {
     return name_of(kTasks, t);

@@ -15,6 +15,8 @@
 #include <set>
 #include <system_error>
 
+#include "atonlab/common/input_limits.h"
+#include "atonlab/common/input_text.h"
 #include "protocol_reader.h"
 
 namespace atonlab::protocols {
@@ -473,6 +475,7 @@ private:
         p.seed = static_cast<std::uint64_t>(v);
         adaptation_s_ = s.number("adaptation_s").value_or(0.0);
         s.at_least("adaptation_s", adaptation_s_, 0.0);
+        s.duration_at_most("adaptation_s", adaptation_s_);
     }
 
     void read_display(const Section& root, Protocol& p) {
@@ -484,12 +487,19 @@ private:
         Section s(doc_, *t, "display", "the [display] table");
         s.allow(kDisplayKeys);
         auto px = [&](std::string_view key, std::string_view what) {
-            auto v = s.integer(key, 1, 65536);
+            // What every GL 4.5 context can allocate (common/input_limits.h).
+            auto v = s.integer(key, 1, limits::kMaxDisplaySidePx);
             if (!v) s.missing(key, what);
             return *v;
         };
         p.display.width_px = px("width_px", "the display's width in pixels");
         p.display.height_px = px("height_px", "the display's height in pixels");
+        const long long pixels = static_cast<long long>(p.display.width_px) * p.display.height_px;
+        if (pixels > limits::kMaxDisplayPixels)
+            s.fail("height_px", fmt::format("a display of {}×{} px has {} pixels, more than the {} (8192×8192) the "
+                                            "renderer's full-frame targets are sized for.",
+                                            p.display.width_px, p.display.height_px, pixels,
+                                            limits::kMaxDisplayPixels));
         p.display.width_m = s.required_number("width_m", "the picture's visible width in metres");
         s.greater_than("width_m", p.display.width_m, 0.0);
         p.display.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen in metres");
@@ -503,6 +513,7 @@ private:
             s.greater_than("max_calibration_age_days", *days, 0.0);
             p.display.max_calibration_age_days = *days;
         }
+        for (auto&& [k, v] : *t) p.display.lines[std::string(k.str())] = Document::line_of(&v);
     }
 
     void read_timing(const Section& root, Protocol& p) {
@@ -512,18 +523,22 @@ private:
         s.allow(kTimingKeys);
         if (auto v = s.number("stimulus_s")) {
             s.greater_than("stimulus_s", *v, 0.0);
+            s.duration_at_most("stimulus_s", *v);
             p.timing.stimulus_s = *v;
         }
         if (auto v = s.number("inter_stimulus_s")) {
             s.at_least("inter_stimulus_s", *v, 0.0);
+            s.duration_at_most("inter_stimulus_s", *v);
             p.timing.inter_stimulus_s = *v;
         }
         if (auto v = s.number("inter_trial_s")) {
             s.at_least("inter_trial_s", *v, 0.0);
+            s.duration_at_most("inter_trial_s", *v);
             p.timing.inter_trial_s = *v;
         }
         if (auto v = s.number("response_timeout_s")) {
             s.greater_than("response_timeout_s", *v, 0.0);
+            s.duration_at_most("response_timeout_s", *v);
             p.timing.response_timeout_s = *v;
         }
         if (const toml::node* n = s.get("repeat_missed"))
@@ -685,6 +700,7 @@ private:
                 bs.fail("name", fmt::format("a block called \"{}\" already exists (line {}).", b.name, it->second));
             b.adaptation_s = bs.number("adaptation_s").value_or(adaptation_s_);
             bs.at_least("adaptation_s", b.adaptation_s, 0.0);
+            bs.duration_at_most("adaptation_s", b.adaptation_s);
             b.repetitions = bs.integer("repetitions", 1, 1000).value_or(1);
             if (auto s = bs.string("interleave")) {
                 try {
@@ -859,19 +875,12 @@ private:
 };
 
 std::string read_text(const std::filesystem::path& file) {
-    std::FILE* f = std::fopen(file.c_str(), "rb");
-    if (f == nullptr)
-        throw ProtocolError(file.string(), 0, 0, "",
-                            fmt::format("cannot read the protocol file: {}.",
-                                        std::error_code(errno, std::generic_category()).message()));
-    std::string text;
-    char buffer[65536];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    const bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed) throw ProtocolError(file.string(), 0, 0, "", "cannot read the protocol file: a read error occurred.");
-    return text;
+    // Only up to a limit: /dev/zero given by mistake is refused, not read until
+    // the memory runs out.
+    text::FileText read = text::read_text_file(file);
+    if (!read.ok())
+        throw ProtocolError(file.string(), 0, 0, "", fmt::format("cannot read the protocol file: {}.", read.error));
+    return std::move(read.text);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Strict TOML reading for the protocol file (protocol_reader.h).
 #include "protocol_reader.h"
 
+#include "atonlab/common/input_limits.h"
 #include "atonlab/common/toml_text.h"
 
 #include <fmt/format.h>
@@ -276,6 +277,12 @@ void Section::at_least(std::string_view key, double v, double min) const {
 void Section::greater_than(std::string_view key, double v, double min) const {
     if (!(v > min))
         fail(key, fmt::format("{} must be greater than {}, got {}.", key, number_text(min), number_text(v)));
+}
+
+void Section::duration_at_most(std::string_view key, double v) const {
+    if (!(v <= limits::kMaxDurationS))
+        fail(key, fmt::format("{} must be at most {} s (a day; durations are counted in whole refreshes), got {}.",
+                              key, number_text(limits::kMaxDurationS), number_text(v)));
 }
 
 }  // namespace atonlab::protocols::detail

@@ -96,6 +96,8 @@ public:
     // Range checks, one sentence each, at the key's line.
     void at_least(std::string_view key, double v, double min) const;
     void greater_than(std::string_view key, double v, double min) const;
+    /// A duration in seconds: at most limits::kMaxDurationS (a frame count must hold it).
+    void duration_at_most(std::string_view key, double v) const;
 
 private:
     const Document& doc_;

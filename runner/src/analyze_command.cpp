@@ -203,6 +203,7 @@ std::vector<an::SnapshotImage> make_snapshots(const an::Dataset& data, const an:
     std::vector<an::SnapshotImage> out;
     std::set<std::string> done;
     std::map<std::string, std::unique_ptr<store::Store>> open;
+    const std::map<std::string, std::string> slugs = an::condition_slugs(results);  // one file per condition
     for (const an::SnapshotRef& ref : data.snapshots) {
         if (done.count(ref.condition)) continue;
         const an::ConditionInfo* c = results.condition(ref.condition);
@@ -215,7 +216,7 @@ std::vector<an::SnapshotImage> make_snapshots(const an::Dataset& data, const an:
             if (!snap) continue;
             done.insert(ref.condition);
             fs::create_directories(out_dir / "figures");
-            const fs::path rel = fs::path("figures") / ("snapshot-" + an::file_slug(ref.condition) + ".png");
+            const fs::path rel = fs::path("figures") / ("snapshot-" + slugs.at(ref.condition) + ".png");
             std::string caption;
             const std::string why = snapshot_png(*snap, *c, out_dir / rel, caption);
             if (!why.empty()) {

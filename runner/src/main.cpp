@@ -35,7 +35,9 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help exits 0; a bad option or value (CLI11's own codes, 105 for a
+        // value out of range) is bad input like any other: exit status 2.
+        return app.exit(e) == 0 ? 0 : 2;
     }
     try {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);

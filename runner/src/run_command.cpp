@@ -6,7 +6,9 @@
 // line and the exit statuses of a study-file failure (4) and of a display whose
 // timing is refused (5).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/runner/screen_presenter.h"
@@ -15,6 +17,19 @@
 #include "run_session.h"
 
 namespace atonlab::runner {
+
+namespace {
+
+/// A finite number: CLI::Range compares with < and >, so "nan" passes it.
+const CLI::Validator kFinite(
+    [](std::string& text) {
+        double v = 0.0;
+        if (CLI::detail::lexical_cast(text, v) && !std::isfinite(v)) return std::string("must be a finite number");
+        return std::string();
+    },
+    "FINITE");
+
+}  // namespace
 
 void add_run_command(CLI::App& app, RunOptions& o) {
     CLI::App* cmd = app.add_subcommand(
@@ -62,18 +77,18 @@ void add_run_command(CLI::App& app, RunOptions& o) {
     cmd->add_option("--software-vsync", o.software_vsync_hz,
                     "A display with no vertical blank (Xvfb, some virtual machines): pace flips with a timer at this "
                     "rate, Hz. For testing only")
-        ->check(CLI::Range(1.0, 1000.0))
+        ->check(kFinite & CLI::Range(1.0, 1000.0))
         ->group(screen);
     cmd->add_flag("--skip-sync-test", o.skip_sync_test,
                   "Start even when the refresh measurement fails (reported, not enforced). For testing only")
         ->group(screen);
     cmd->add_option("--sync-sd-max-ms", o.sync_sd_max_ms,
                     "The start-up measurement's flip intervals must have an SD below this, ms (default 1)")
-        ->check(CLI::Range(0.001, 100.0))
+        ->check(kFinite & CLI::Range(0.001, 100.0))
         ->group(screen);
     cmd->add_option("--refresh-tolerance", o.refresh_tolerance,
                     "The measured refresh rate may differ from the nominal by this fraction (default 0.02)")
-        ->check(CLI::Range(0.0001, 1.0))
+        ->check(kFinite & CLI::Range(0.0001, 1.0))
         ->group(screen);
     cmd->add_option("--font", o.font, "TrueType font for the screens (default DejaVu Sans, fonts-dejavu-core)")
         ->group(screen);

@@ -14,6 +14,7 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -23,6 +24,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/rng.h"
@@ -88,10 +90,13 @@ private:
 // ---------------------------------------------------------------------------
 // Small helpers
 
-std::string read_text(const std::filesystem::path& file, std::string_view what) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(SourceLocation{file.string(), 0, 0, ""}, fmt::format("cannot read the {}.", what));
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+std::string read_text(const std::filesystem::path& file, std::string_view what,
+                      std::uintmax_t max_bytes = text::kMaxInputFileBytes) {
+    text::FileText read = text::read_text_file(file, max_bytes);  // only up to a limit (/dev/zero is refused)
+    if (!read.ok())
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the {}: {}.", what, read.error));
+    return std::move(read.text);
 }
 
 InputError input_error(const p::ProtocolError& e) {
@@ -452,13 +457,26 @@ OverrideSource override_source(const p::Condition& c, const std::string& key, co
     return {c.line, 0};
 }
 
+/// A frame's override parsed; one of the protocol's [display] keys keeps its
+/// line, so that a limit the scene derives from the display (a glare billboard
+/// too wide for it) names the protocol's line rather than "--set".
+s::SceneOverride parsed_override(const p::Protocol& protocol, const std::string& text) {
+    s::SceneOverride o = s::SceneOverride::parse(text);
+    const std::vector<std::string> display = protocol.display_overrides();
+    if (std::find(display.begin(), display.end(), text) != display.end())
+        if (auto it = protocol.display.lines.find(o.key.substr(o.key.find('.') + 1));
+            it != protocol.display.lines.end())
+            o.origin = SourceLocation{protocol.file, it->second, 0, o.key};
+    return o;
+}
+
 /// The scene of one of a condition's frames, with an error in an override
 /// re-thrown at the protocol's line that wrote it (the condition named).
 s::Scene condition_scene(const std::string& scene_text, const std::filesystem::path& scene_file,
                          const p::Protocol& protocol, const p::Condition& condition, const p::Frame& frame) {
     try {
         std::vector<s::SceneOverride> parsed;
-        for (const std::string& o : frame.overrides) parsed.push_back(s::SceneOverride::parse(o));
+        for (const std::string& o : frame.overrides) parsed.push_back(parsed_override(protocol, o));
         s::Scene scene = s::parse_scene(scene_text, scene_file.string(), parsed);
         s::validate_output_settings(scene.output);
         return scene;
@@ -809,7 +827,7 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
     s::write_exr(tmp, stacked, meta);
     std::string bytes;
     try {
-        bytes = read_text(tmp, "snapshot");
+        bytes = read_text(tmp, "snapshot", std::numeric_limits<std::uintmax_t>::max());  // written just now
     } catch (...) {
         std::error_code ec;
         std::filesystem::remove(tmp, ec);
@@ -1012,7 +1030,7 @@ int run_session(const RunOptions& o) {
     s::Scene display_scene;
     {
         std::vector<s::SceneOverride> display;
-        for (const std::string& d : protocol.display_overrides()) display.push_back(s::SceneOverride::parse(d));
+        for (const std::string& d : protocol.display_overrides()) display.push_back(parsed_override(protocol, d));
         display_scene = s::parse_scene(scene_text, scene_file.string(), display);
     }
     validate_conditions(protocol, scene_text, scene_file);

@@ -13,6 +13,7 @@
 #include <optional>
 #include <sstream>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
 
@@ -53,11 +54,12 @@ std::optional<double> parse_number(std::string_view s) {
 }
 
 std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(SourceLocation{path.string(), 0, 0, ""}, "the calibration file cannot be opened");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    text::FileText read = text::read_text_file(path);  // only up to a limit (/dev/zero is refused)
+    if (!read.ok())
+        throw InputError(SourceLocation{path.string(), 0, 0, ""},
+                         fmt::format("the calibration file cannot be {}: {}", read.opened ? "read" : "opened",
+                                     read.error));
+    return std::move(read.text);
 }
 
 /// Splits text into lines (without the newline), 1-based numbering by index + 1.
@@ -387,7 +389,10 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
 
     std::vector<Measurement> out;
     out.reserve(rows.size());
-    for (const auto& [tokens, line_no] : rows) {
+    for (const auto& row : rows) {
+        // Not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda below.
+        const auto& tokens = row.first;
+        const auto line_no = row.second;
         if (tokens.size() != fields.size())
             throw error(line_no, 0, "",
                         fmt::format("this data line has {} values but BEGIN_DATA_FORMAT (line {}) names {} fields",

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "atonlab/common/input_text.h"
+
 namespace atonlab {
 namespace {
 
@@ -12,16 +14,18 @@ std::string format_error(const SourceLocation& w, const std::string& message) {
         if (w.line > 0) s += fmt::format(":{}", w.line);
         s += ": ";
     }
-    if (!w.key.empty()) s += fmt::format("key '{}': ", w.key);
+    if (!w.key.empty()) s += fmt::format("key '{}': ", text::echo(w.key));
     s += message;
-    return s;
+    // One line of bounded length, whatever the message echoes.
+    return text::one_line(s);
 }
 
 }  // namespace
 
 InputError::InputError(SourceLocation where, const std::string& message)
-    : std::runtime_error(format_error(where, message)), where_(std::move(where)), message_(message) {}
+    : std::runtime_error(format_error(where, message)), where_(std::move(where)), message_(text::one_line(message)) {}
 
-InputError::InputError(const std::string& message) : std::runtime_error(message), message_(message) {}
+InputError::InputError(const std::string& message)
+    : std::runtime_error(text::one_line(message)), message_(text::one_line(message)) {}
 
 }  // namespace atonlab

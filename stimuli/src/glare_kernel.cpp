@@ -15,7 +15,7 @@ namespace atonlab::stimuli {
 
 namespace {
 
-constexpr int kMaxKernelSize = 4097;
+constexpr int kMaxKernelSize = kMaxGlareKernelPx;
 
 int kernel_size_for(double pixels_per_degree, double radius_deg) {
     if (!(radius_deg > 0) || !std::isfinite(radius_deg))
@@ -25,8 +25,7 @@ int kernel_size_for(double pixels_per_degree, double radius_deg) {
         throw InputError(
             SourceLocation{"", 0, 0, "pixels_per_degree"},
             fmt::format("the display must have a positive number of pixels per degree, not {}.", pixels_per_degree));
-    const double r_px = radius_deg * pixels_per_degree;
-    const double size = 2.0 * std::ceil(r_px) + 1.0;
+    const double size = glare_kernel_width_px(pixels_per_degree, radius_deg);
     if (size > kMaxKernelSize)
         throw InputError(SourceLocation{"", 0, 0, "radius_deg"},
                          fmt::format("a glare billboard of {} degrees is {} pixels wide at {:.1f} pixels per degree; "
@@ -34,6 +33,14 @@ int kernel_size_for(double pixels_per_degree, double radius_deg) {
                                      radius_deg, size, pixels_per_degree, kMaxKernelSize));
     return static_cast<int>(size);
 }
+
+}  // namespace
+
+double glare_kernel_width_px(double pixels_per_degree, double radius_deg) {
+    return 2.0 * std::ceil(radius_deg * pixels_per_degree) + 1.0;
+}
+
+namespace {
 
 // Applies the window at R, reports the cut against `total`, renormalises each channel.
 void window_and_normalise(GlareKernel& k, const std::vector<glm::dvec3>& energy, glm::dvec3 total, GlareWindow window) {

@@ -27,11 +27,15 @@
 #include <utility>
 
 #include "atonlab/stimuli/atmosphere.h"
+#include "atonlab/common/input_limits.h"
+#include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
 #include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/fft.h"
+#include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/light_model.h"  // orientation_from_yaw_pitch_roll: the camera's convention
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -152,8 +156,15 @@ public:
     }
 
     /// Records an applied override: its key as typed and its schema key
-    /// ("light.buoy.intensity_cd" -> "light[0].intensity_cd").
-    void note_override(const std::string& typed, const std::string& schema_key) { override_keys_[typed] = schema_key; }
+    /// ("light.buoy.intensity_cd" -> "light[0].intensity_cd"), and where it
+    /// was written when a file gave it (SceneOverride::origin).
+    void note_override(const std::string& typed, const std::string& schema_key, const SourceLocation& origin) {
+        override_keys_[typed] = schema_key;
+        if (origin.file.empty())
+            origins_.erase(typed);
+        else
+            origins_[typed] = origin;
+    }
     /// A table created to hold an override's value (it has no source of its own).
     void note_made_for_override(const toml::node* table, const std::string& typed) {
         made_for_override_[table] = typed;
@@ -173,11 +184,14 @@ private:
         std::string key = typed;
         if (auto it = override_keys_.find(typed); it != override_keys_.end() && schema_key.starts_with(it->second))
             key += schema_key.substr(it->second.size());
+        if (auto it = origins_.find(typed); it != origins_.end())
+            return {it->second.file, it->second.line, it->second.column, key};
         return {std::string(kSetFile), 0, 0, key};
     }
 
     std::string file_;
     std::map<std::string, std::string> override_keys_;
+    std::map<std::string, SourceLocation> origins_;  // typed key -> where a file wrote it
     std::map<const toml::node*, std::string> made_for_override_;
     std::map<std::string, std::string> string_fallbacks_;
 };
@@ -213,7 +227,7 @@ public:
         for (auto&& [k, v] : table_) {
             if (contains(allowed, k.str())) continue;
             throw InputError(doc_.where(k, key_path(k.str())),
-                             fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
+                             fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", text::echo(k.str()), title_,
                                          suggestion(k.str(), allowed), join(allowed)));
         }
     }
@@ -518,12 +532,14 @@ Profiles read_profiles(const Document& doc, const Section& root) {
             if (contains(vertical ? KeyList(kBuiltinVertical) : KeyList(kBuiltinHorizontal), k.str()))
                 throw InputError(
                     doc.where(k, path),
-                    fmt::format("'{}' is the name of a builtin {} profile; choose another name.", k.str(), kind));
+                    fmt::format("'{}' is the name of a builtin {} profile; choose another name.", text::echo(k.str()),
+                                kind));
             if (!v.is_table())
                 doc.fail(
                     &v, path,
-                    fmt::format("expected a table [profiles.{}.{}], got {}.", kind, k.str(), type_phrase(v.type())));
-            Section s(doc, *v.as_table(), path, fmt::format("[profiles.{}.{}]", kind, k.str()));
+                    fmt::format("expected a table [profiles.{}.{}], got {}.", kind, text::echo(k.str()),
+                                type_phrase(v.type())));
+            Section s(doc, *v.as_table(), path, fmt::format("[profiles.{}.{}]", kind, text::echo(k.str())));
             if (vertical)
                 out.vertical.emplace(std::string(k.str()), read_vertical_profile(s));
             else
@@ -545,13 +561,19 @@ DisplayGeometry read_display(const Document& doc, const Section& root) {
     Section s(doc, *t, "display", "the [display] table");
     s.allow(kDisplayKeys);
     DisplayGeometry d;
-    constexpr int max_px = 65536;
+    // What every GL 4.5 context can allocate (common/input_limits.h).
+    constexpr int max_px = limits::kMaxDisplaySidePx;
     auto w = s.integer("width_px", 1, max_px);
     if (!w) s.missing("width_px", "the display's width in pixels");
     auto h = s.integer("height_px", 1, max_px);
     if (!h) s.missing("height_px", "the display's height in pixels");
     d.width_px = *w;
     d.height_px = *h;
+    if (static_cast<long long>(*w) * *h > limits::kMaxDisplayPixels)
+        s.fail(s.get("height_px"), "height_px",
+               fmt::format("a display of {}×{} px has {} pixels, more than the {} (8192×8192) the renderer's "
+                           "full-frame targets are sized for.",
+                           *w, *h, static_cast<long long>(*w) * *h, limits::kMaxDisplayPixels));
     d.width_m = s.required_number("width_m", "the picture's visible width in metres");
     s.greater_than("width_m", d.width_m, 0.0);
     d.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen distance in metres");
@@ -591,7 +613,7 @@ Environment read_environment(const Document& doc, const Section& root) {
             e.background = Background::sky_sea;
         else
             s.fail(s.get("background"), "background",
-                   fmt::format("unknown background \"{}\"; it must be \"uniform\" or \"sky-sea\".", *bg));
+                   fmt::format("unknown background \"{}\"; it must be \"uniform\" or \"sky-sea\".", text::echo(*bg)));
     }
     e.luminance_cd_m2 = s.number_or("luminance_cd_m2", e.luminance_cd_m2);
     s.at_least("luminance_cd_m2", e.luminance_cd_m2, 0.0);
@@ -805,7 +827,7 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
         auto v = tone_operator_from_name(*op);
         if (!v)
             s.fail(s.get("operator"), "operator",
-                   fmt::format("unknown tone-mapping operator \"{}\"; it must be one of {}.", *op,
+                   fmt::format("unknown tone-mapping operator \"{}\"; it must be one of {}.", text::echo(*op),
                                join(tone_operator_names(), "\"")));
         tm.tone_operator = *v;
     }
@@ -831,7 +853,7 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
         auto v = hue_preservation_from_name(*h);
         if (!v)
             s.fail(s.get("hue_preservation"), "hue_preservation",
-                   fmt::format("unknown hue preservation \"{}\"; it must be one of {}.", *h,
+                   fmt::format("unknown hue preservation \"{}\"; it must be one of {}.", text::echo(*h),
                                join(hue_preservation_names(), "\"")));
         tm.hue_preservation = *v;
     }
@@ -854,7 +876,7 @@ glm::dvec3 read_colour(const Section& s) {
     if (auto name = s.string("colour")) {
         if (auto rgb = iala_colour_rgb(*name)) return *rgb;
         s.fail(s.get("colour"), "colour",
-               fmt::format("unknown colour \"{}\"; IALA colours are {} (or give xy or spd).", *name,
+               fmt::format("unknown colour \"{}\"; IALA colours are {} (or give xy or spd).", text::echo(*name),
                            join(iala_colour_names(), "\"")));
     }
     if (auto xy = s.numbers("xy", 2)) {
@@ -869,7 +891,8 @@ glm::dvec3 read_colour(const Section& s) {
     if (auto spd = s.string("spd")) {
         if (auto spectrum = named_spectrum(*spd)) return normalised_rgb_from_spectrum(*spectrum);
         s.fail(s.get("spd"), "spd",
-               fmt::format("unknown spectrum \"{}\"; named spectra are {}.", *spd, join(spectrum_names(), "\"")));
+               fmt::format("unknown spectrum \"{}\"; named spectra are {}.", text::echo(*spd),
+                           join(spectrum_names(), "\"")));
     }
     return *iala_colour_rgb("white");
 }
@@ -887,7 +910,8 @@ struct SceneBuilder {
         std::vector<std::string> known(std::begin(kBuiltinVertical), std::end(kBuiltinVertical));
         for (const auto& [n, p] : profiles.vertical) known.push_back(n);
         s.fail(s.get("vertical_profile"), "vertical_profile",
-               fmt::format("unknown vertical profile \"{}\"; known profiles are {}.", name, join(known, "\"")));
+               fmt::format("unknown vertical profile \"{}\"; known profiles are {}.", text::echo(name),
+                           join(known, "\"")));
     }
 
     int horizontal_index(const Section& s, const std::string& name) {
@@ -897,14 +921,16 @@ struct SceneBuilder {
         std::vector<std::string> known(std::begin(kBuiltinHorizontal), std::end(kBuiltinHorizontal));
         for (const auto& [n, p] : profiles.horizontal) known.push_back(n);
         s.fail(s.get("horizontal_profile"), "horizontal_profile",
-               fmt::format("unknown horizontal profile \"{}\"; known profiles are {}.", name, join(known, "\"")));
+               fmt::format("unknown horizontal profile \"{}\"; known profiles are {}.", text::echo(name),
+                           join(known, "\"")));
     }
 
     void claim_name(const Section& s, const std::string& name) {
         const toml::node* at = s.has("name") ? s.get("name") : &s.table();
         if (auto it = names.find(name); it != names.end())
             s.fail(at, "name",
-                   fmt::format("the light name \"{}\" is already used by {}; names must be unique.", name, it->second));
+                   fmt::format("the light name \"{}\" is already used by {}; names must be unique.", text::echo(name),
+                               it->second));
         names.emplace(name, s.path());
     }
 
@@ -919,8 +945,8 @@ struct SceneBuilder {
         Light light;
         light.name = s.string("name").value_or(fmt::format("light{}", index));
         if (light.name.empty()) s.fail(s.get("name"), "name", "a light's name must not be empty.");
-        s.set_context(fmt::format("in light \"{}\", ", light.name));
-        s.set_title(fmt::format("[[light]] \"{}\" ({})", light.name, path));
+        s.set_context(fmt::format("in light \"{}\", ", text::echo(light.name)));
+        s.set_title(fmt::format("[[light]] \"{}\" ({})", text::echo(light.name), path));
 
         auto position = s.vec3("position_m");
         if (!position) s.missing("position_m", "the light's position [x, y, z] in metres");
@@ -968,10 +994,11 @@ struct SceneBuilder {
                 if (why.starts_with(prefix)) why.erase(0, prefix.size());
             if (!why.empty() && why.back() != '.') why += '.';
             s.fail(s.has("rhythm") ? s.get("rhythm") : &s.table(), "rhythm",
-                   fmt::format("invalid rhythm \"{}\": {}", rhythm_text, why));
+                   fmt::format("invalid rhythm \"{}\": {}", text::echo(rhythm_text), why));
         }
         if (rhythm.channels.empty())
-            s.fail(s.get("rhythm"), "rhythm", fmt::format("the rhythm \"{}\" has no channel.", rhythm_text));
+            s.fail(s.get("rhythm"), "rhythm",
+                   fmt::format("the rhythm \"{}\" has no channel.", text::echo(rhythm_text)));
         light.rhythm_period_s = rhythm.period_s;
 
         // A character that names its colours (Al.WR) gives each channel the
@@ -980,7 +1007,8 @@ struct SceneBuilder {
                                                [](const RhythmChannel& c) { return !c.colour.empty(); });
         if (chart_colours && !given.empty())
             s.fail(s.get(given[0]), given[0],
-                   fmt::format("the rhythm \"{}\" gives the colours itself; remove {}.", rhythm_text, given[0]));
+                   fmt::format("the rhythm \"{}\" gives the colours itself; remove {}.", text::echo(rhythm_text),
+                               given[0]));
 
         const toml::node* name_node = s.has("name") ? s.get("name") : &s.table();
         if (rhythm.channels.size() == 1) {
@@ -1016,6 +1044,50 @@ struct SceneBuilder {
     }
 };
 
+/// A derived limit: the glare billboard, the model's radius in degrees times
+/// the display's pixels per degree, must fit the glare kernel (4097 px). The
+/// sentence names every key the width comes from, with its line (or --set).
+void check_billboard(const Document& doc, const Section& root, const Scene& scene) {
+    const double radius_deg = glare_billboard_radius_deg(scene.glare);
+    if (!(radius_deg > 0.0)) return;  // no glare: no billboard
+    const double ppd = scene.display.pixels_per_degree_at_centre();
+    const double width_px = glare_kernel_width_px(ppd, radius_deg);
+    if (width_px <= kMaxGlareKernelPx) return;
+    const auto node_in = [&](std::string_view table, std::string_view key) -> const toml::node* {
+        const toml::node* t = root.get(table);
+        return t != nullptr && t->is_table() ? t->as_table()->get(key) : nullptr;
+    };
+    const auto at = [&](std::string_view table, std::string_view key) {
+        const toml::node* n = node_in(table, key);
+        if (n == nullptr) return std::string(" (not given)");
+        const SourceLocation w = doc.where(n, fmt::format("{}.{}", table, key));
+        if (w.file == kSetFile) return std::string(" (--set)");
+        if (w.file != doc.file()) return fmt::format(" ({}:{})", w.file, w.line);  // e.g. a protocol's [display]
+        return w.line > 0 ? fmt::format(" (line {})", w.line) : std::string();
+    };
+    const toml::node* radius_node = node_in("glare", "radius_deg");
+    const std::string radius_text =
+        radius_node != nullptr
+            ? fmt::format("glare.radius_deg = {}{}", number_text(radius_deg), at("glare", "radius_deg"))
+            : fmt::format("{:.4g}°, the {} model's default radius{}", radius_deg,
+                          glare_model_name(scene.glare.model),
+                          scene.glare.model == GlareModel::wave_optics || scene.glare.model == GlareModel::aperture
+                              ? " for its psf_size"
+                              : "");
+    const std::string message = fmt::format(
+        "the glare billboard is {} px wide, more than the {} px a glare kernel may be: its radius ({}) at "
+        "{:.1f} px per degree, from display.width_px = {}{}, display.width_m = {}{} and "
+        "display.viewing_distance_m = {}{}. Check the display's size and viewing distance, or give a smaller "
+        "glare.radius_deg.",
+        number_text(width_px), kMaxGlareKernelPx, radius_text, ppd, scene.display.width_px,
+        at("display", "width_px"), number_text(scene.display.width_m), at("display", "width_m"),
+        number_text(scene.display.viewing_distance_m), at("display", "viewing_distance_m"));
+    // At the radius when the file gives it, else at the viewing distance (the
+    // usual culprit: a distance in mm written as metres).
+    if (radius_node != nullptr) doc.fail(radius_node, "glare.radius_deg", message);
+    doc.fail(node_in("display", "viewing_distance_m"), "display.viewing_distance_m", message);
+}
+
 Scene build_scene(const Document& doc, const toml::table& root_table) {
     Section root(doc, root_table, "", "the scene");
     {
@@ -1024,8 +1096,8 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
             if (contains(kSections, k.str())) continue;
             throw InputError(
                 doc.where(k, std::string(k.str())),
-                fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key", k.str(),
-                            suggestion(k.str(), kSections), join(kSections)));
+                fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key",
+                            text::echo(k.str()), suggestion(k.str(), kSections), join(kSections)));
         }
     }
     Scene scene;
@@ -1036,6 +1108,7 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
     read_glare(doc, root, scene.glare);
     read_output(doc, root, scene.output);
+    check_billboard(doc, root, scene);
     const Profiles profiles = read_profiles(doc, root);
 
     if (const toml::node* lights = root.get("light")) {
@@ -1082,14 +1155,15 @@ toml::table parse_override_value(const SceneOverride& o, std::string& note) {
     try {
         return toml::parse("v = " + o.value, std::string_view(source));
     } catch (const toml::parse_error& e) {
-        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", o.value,
+        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", text::echo(o.value),
                            std::string(e.description()));
     }
     try {
         return toml::parse("v = " + toml_quoted(o.value), std::string_view(source));
     } catch (const toml::parse_error& e) {
         override_error(o.key,
-                       fmt::format("the value \"{}\" cannot be read: {}.", o.value, std::string(e.description())));
+                       fmt::format("the value \"{}\" cannot be read: {}.", text::echo(o.value),
+                                   std::string(e.description())));
     }
 }
 
@@ -1158,7 +1232,8 @@ std::pair<toml::table*, std::string> light_for_override(const Document& doc, tom
             known.push_back(light_name);
         }
         if (!found)
-            override_error(o.key, fmt::format("no light is named \"{}\"; the lights are {}.", name, join(known, "\"")));
+            override_error(o.key, fmt::format("no light is named \"{}\"; the lights are {}.", text::echo(name),
+                                              join(known, "\"")));
     }
     toml::node* light = lights.get(index);
     if (!light->is_table()) {
@@ -1175,7 +1250,8 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
     std::string schema_key;  // canonical dotted path, e.g. "light[0].intensity_cd"
 
     const auto unknown = [&](std::string_view section, KeyList allowed, std::string_view leaf) {
-        override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", leaf, section,
+        override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", text::echo(leaf),
+                                      text::echo(section),
                                       suggestion(leaf, allowed), join(allowed)));
     };
 
@@ -1206,7 +1282,8 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
         const auto dot = k.find('.');
         const std::string section = k.substr(0, dot);
         if (!contains(kSections, section))
-            override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", k, join(kSections)));
+            override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", text::echo(k),
+                                          join(kSections)));
         if (dot == std::string::npos || dot + 1 == k.size())
             override_error(k, fmt::format("--set takes a key inside [{}], e.g. {}.{}.", section, section,
                                           section == "display" ? "width_px" : "yaw_deg"));
@@ -1245,7 +1322,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
         for (std::string_view other : group)
             if (other != key) target->erase(other);
     }
-    doc.note_override(k, schema_key);
+    doc.note_override(k, schema_key, o.origin);
     doc.note_string_fallback(k, note);
     value->visit([&](auto& concrete) { target->insert_or_assign(key, std::move(concrete)); });
 }
@@ -1261,13 +1338,13 @@ SceneOverride SceneOverride::parse(std::string_view text) {
     const auto eq = text.find('=');
     if (eq == std::string_view::npos)
         throw InputError(SourceLocation{std::string(kSetFile), 0, 0, std::string(trim(text))},
-                         fmt::format("expected KEY=VALUE, e.g. camera.yaw_deg=45, got \"{}\".", text));
+                         fmt::format("expected KEY=VALUE, e.g. camera.yaw_deg=45, got \"{}\".", text::echo(text)));
     SceneOverride o;
     o.key = std::string(trim(text.substr(0, eq)));
     o.value = std::string(trim(text.substr(eq + 1)));
     if (o.key.empty())
         throw InputError(SourceLocation{std::string(kSetFile), 0, 0, ""},
-                         fmt::format("the key before '=' is empty in \"{}\".", text));
+                         fmt::format("the key before '=' is empty in \"{}\".", text::echo(text)));
     return o;
 }
 
@@ -1287,20 +1364,13 @@ Scene parse_scene(std::string_view toml_text, std::string_view file_label,
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
-    std::FILE* f = std::fopen(file.c_str(), "rb");
-    if (f == nullptr)
-        throw InputError(
-            SourceLocation{file.string(), 0, 0, ""},
-            fmt::format("cannot read the scene file: {}.", std::error_code(errno, std::generic_category()).message()));
-    std::string text;
-    char buffer[65536];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    const bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed)
-        throw InputError(SourceLocation{file.string(), 0, 0, ""}, "cannot read the scene file: a read error occurred.");
-    return parse_scene(text, file.string(), overrides);
+    // Read only up to a limit: /dev/zero or a video file given by mistake is
+    // refused, not read until the memory runs out.
+    const text::FileText read = text::read_text_file(file);
+    if (!read.ok())
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the scene file: {}.", read.error));
+    return parse_scene(read.text, file.string(), overrides);
 }
 
 }  // namespace atonlab::stimuli

@@ -7,6 +7,7 @@
 
 #include <cctype>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "../store/store_test_support.h"
@@ -263,6 +264,50 @@ TEST(AnalysisReport, WithoutGnuplotTheReportSaysSoAndIsStillWritten) {
     const std::string html = file_bytes(dir / "report.html");
     EXPECT_NE(html.find("gnuplot could not be started"), std::string::npos);
     expect_well_formed_and_self_contained(html);
+}
+
+TEST(AnalysisReport, ConditionFileNamesAreUniqueAndTheHashOnlyWhereSlugsCollide) {
+    // Expected hashes: printf 'a<b' | sha256sum, printf 'a>b' | sha256sum (first 8 hex digits).
+    const auto slugs = condition_slugs(std::vector<std::string>{"a<b", "a>b", "plain", "x y", "night-empirical"});
+    EXPECT_EQ(slugs.at("a<b"), "a_b-4a826aac");
+    EXPECT_EQ(slugs.at("a>b"), "a_b-998a5be8");
+    EXPECT_EQ(slugs.at("plain"), "plain");
+    EXPECT_EQ(slugs.at("x y"), "x_y") << "no collision: the slug alone";
+    EXPECT_EQ(slugs.at("night-empirical"), "night-empirical");
+    // A name keeps its file name whatever else the study has.
+    EXPECT_EQ(condition_slugs(std::vector<std::string>{"a<b", "a>b", "other"}).at("a<b"), "a_b-4a826aac");
+}
+
+TEST(AnalysisReport, ConditionsWhoseNamesShareASlugGetTheirOwnFigures) {
+    // Two yes-no conditions, "a<b" and "a>b" (both "a_b" as a file name), with
+    // different data: each must get its own psychometric figure.
+    Dataset d;
+    d.sources = {"synthetic"};
+    SessionInfo s;
+    s.key = "synthetic#P";
+    s.source = "synthetic";
+    s.observer = "P";
+    s.protocol_conditions = {"a<b", "a>b"};
+    d.sessions.push_back(s);
+    for (double l : {1.0, 2.0, 3.0, 4.0})
+        for (int i = 0; i < 8; ++i) d.trials.push_back(trial("a<b", l, i < 2 * l));
+    for (double l : {6.0, 7.0, 8.0, 9.0})
+        for (int i = 0; i < 8; ++i) d.trials.push_back(trial("a>b", l, i < 2 * (l - 5.0)));
+    for (std::size_t i = 0; i < d.trials.size(); ++i) d.trials[i].trial_index = static_cast<std::int64_t>(i);
+    AnalysisOptions o;
+    o.bootstrap = 0;
+    const StudyResults r = analyze_study(d, o);
+    if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (Debian package gnuplot-nox)";
+    TempDir dir;
+    const PlotResult plots = make_figures(dir.path(), d, r);
+    std::map<std::string, const Figure*> psychometric;
+    for (const Figure& f : plots.figures)
+        if (f.kind == "psychometric") psychometric[f.condition] = &f;
+    ASSERT_EQ(psychometric.size(), 2u);
+    EXPECT_EQ(psychometric.at("a<b")->png, fs::path("figures/psychometric-a_b-4a826aac.png"));
+    EXPECT_EQ(psychometric.at("a>b")->png, fs::path("figures/psychometric-a_b-998a5be8.png"));
+    EXPECT_NE(file_bytes(dir / psychometric.at("a<b")->png.c_str()), file_bytes(dir / psychometric.at("a>b")->png.c_str()))
+        << "each figure draws its own condition's data";
 }
 
 TEST(AnalysisReport, Base64MatchesRfc4648Vectors) {

@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "atonlab/runner/frame_clock.h"
@@ -105,6 +107,45 @@ TEST(SyncTest, PassesACleanDisplayAndRefusesWithOneSentence) {
     SyncCriteria relaxed = c;
     relaxed.max_sd_s = 0.01;
     EXPECT_EQ(sync_verdict(jittery, 60.0, relaxed), "");
+}
+
+TEST(SyncTest, RefusesFlipRatesNoDisplayRefreshesAtAndSaysVsyncSeemsOff) {
+    SyncCriteria c;  // plausible 20 to 500 Hz
+    // Flips that did not wait for a refresh: 0.3 ms apart (3333 Hz; Xvfb
+    // without --software-vsync measured 0.29 ms), 1 ms (1000 Hz); and a rate no
+    // display refreshes at, 10 Hz. Regular, so the SD test alone would pass them.
+    for (const double period : {0.0003, 0.00029, 0.001, 0.1}) {
+        const RefreshEstimate e = estimate_refresh(regular(100, period));
+        ASSERT_EQ(e.valid, 99);
+        ASSERT_LT(e.sd_s, c.max_sd_s);
+        for (const std::optional<double> nominal : {std::optional<double>(), std::optional<double>(1.0 / period)}) {
+            const std::string why = sync_verdict(e, nominal, c);
+            EXPECT_NE(why.find("vertical sync seems"), std::string::npos) << period << ": " << why;
+            EXPECT_NE(why.find("--software-vsync"), std::string::npos) << why;
+            EXPECT_NE(why.find("20 to 500 Hz"), std::string::npos) << why;
+            EXPECT_EQ(why.find('\n'), std::string::npos);
+        }
+    }
+    EXPECT_NE(sync_verdict(estimate_refresh(regular(100, 0.0003)), std::nullopt, c).find("faster"), std::string::npos);
+    EXPECT_NE(sync_verdict(estimate_refresh(regular(100, 0.1)), std::nullopt, c).find("slower"), std::string::npos);
+
+    // Real refresh rates pass, with or without a nominal rate, jittered by
+    // ±0.1 ms (intervals P ± 0.2 ms, SD 0.2 ms, under the 1 ms limit; over an
+    // even number of intervals the mean is P exactly).
+    for (const double hz : {60.0, 120.0, 144.0, 240.0}) {
+        std::vector<double> t;
+        for (int i = 0; i < 101; ++i) t.push_back(3.0 + i / hz + (i % 2 ? 1e-4 : -1e-4));
+        const RefreshEstimate e = estimate_refresh(t);
+        EXPECT_NEAR(e.hz(), hz, 1e-6 * hz);
+        EXPECT_EQ(sync_verdict(e, std::nullopt, c), "") << hz;
+        EXPECT_EQ(sync_verdict(e, hz, c), "") << hz;
+    }
+    // Just inside the range accepted, just beyond it refused (1 % either side:
+    // the rate from summed intervals is exact to ~1e-12, not to the last bit).
+    EXPECT_EQ(sync_verdict(estimate_refresh(regular(100, 1.0 / 495.0)), std::nullopt, c), "");
+    EXPECT_EQ(sync_verdict(estimate_refresh(regular(100, 1.0 / 20.2)), std::nullopt, c), "");
+    EXPECT_NE(sync_verdict(estimate_refresh(regular(100, 1.0 / 505.0)), std::nullopt, c), "");
+    EXPECT_NE(sync_verdict(estimate_refresh(regular(100, 1.0 / 19.8)), std::nullopt, c), "");
 }
 
 TEST(FrameClock, DurationsAreWholeRefreshes) {

@@ -687,6 +687,13 @@ TEST(ProtocolErrors, EveryMalformedFileNamesFileLineAndKey) {
         {"missing-scene.toml", 3, "protocol.scene", "the scene file \"no-such-scene.toml\" does not exist"},
         {"negative-seed.toml", 4, "protocol.seed", "seed must be at least 0, got -3."},
         {"no-blocks.toml", 0, "block", "the protocol file has no [[block]], which is required"},
+        // Extreme values: each refused where it is read, none reaching an internal error.
+        {"duration-two-to-the-31.toml", 13, "timing.stimulus_s",
+         "stimulus_s must be at most 86400 s (a day; durations are counted in whole refreshes), got 2147483648."},
+        {"duration-1e9.toml", 13, "timing.inter_stimulus_s",
+         "inter_stimulus_s must be at most 86400 s (a day; durations are counted in whole refreshes), got 1000000000."},
+        {"block-adaptation-1e9.toml", 14, "block[0].adaptation_s", "adaptation_s must be at most 86400 s"},
+        {"display-too-wide.toml", 7, "display.width_px", "width_px must be between 1 and 16384, got 16385."},
         {"yes-no-two-interval.toml", 19, "block[0].condition[0].presentation",
          "a yes-no task shows one stimulus: presentation must be \"single\", got \"two-interval\"."},
     };

@@ -50,6 +50,18 @@ std::string sync_verdict(const RefreshEstimate& e, std::optional<double> nominal
             "only {} of the flip intervals in {:g} s were regular ({} rejected as missed or doubled flips), fewer "
             "than the {} needed to trust the refresh period",
             e.valid, c.max_duration_s, e.rejected, c.min_samples);
+    // Before the SD: flips at 3425 Hz are regular, and only their rate shows
+    // that nothing waited for a refresh.
+    if (!(e.hz() >= c.min_hz && e.hz() <= c.max_hz)) {
+        const bool fast = e.hz() > c.max_hz;
+        return fmt::format(
+            "the flips came every {:.3f} ms ({:.1f} Hz), {} than any display refreshes ({:g} to {:g} Hz), so vertical "
+            "sync seems {}: turn it on in the graphics driver's settings (Mesa: vblank_mode=3; NVIDIA: "
+            "__GL_SYNC_TO_VBLANK=1) and in the compositor, or, on a display without a refresh such as Xvfb, pace the "
+            "flips with --software-vsync HZ (testing only)",
+            e.period_s * 1e3, e.hz(), fast ? "faster" : "slower", c.min_hz, c.max_hz,
+            fast ? "off" : "broken (or the driver stalls every flip)");
+    }
     if (!(e.sd_s < c.max_sd_s))
         return fmt::format(
             "the flip intervals vary too much to trust the frame timing: {:.3f} ms ± {:.3f} ms (SD) over {} flips, "

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <map>
+
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/study_analysis.h"
 
@@ -51,6 +53,15 @@ PlotResult make_figures(const std::filesystem::path& out_dir, const Dataset& dat
 /// The file-name form of a name: letters, digits, '.', '-' and '_' kept,
 /// anything else '_'.
 std::string file_slug(const std::string& name);
+
+/// The file-name form of each condition name, all distinct, for figures,
+/// snapshots and the report's anchors: file_slug(name) where no other name
+/// has the same slug; where two do ("a<b" and "a>b" are both "a_b"), the slug
+/// plus "-" and the first 8 hex digits of the name's SHA-256, so a name keeps
+/// its file name whatever other conditions a study has. Keyed by name.
+std::map<std::string, std::string> condition_slugs(const std::vector<std::string>& names);
+/// The same for a study's conditions (StudyResults::conditions).
+std::map<std::string, std::string> condition_slugs(const StudyResults& results);
 
 /// The display model's luminance of a grey drive level V in [0, 1] (all
 /// channels at V), cd/m², from a calibration's fit_json (docs/analysis.md

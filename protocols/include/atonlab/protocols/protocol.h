@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <map>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -188,6 +189,10 @@ struct Display {
     std::string name;
     /// `atonlab run` warns when the calibration is older than this, days (> 0).
     std::optional<double> max_calibration_age_days;
+    /// The line of each key in the protocol file ("viewing_distance_m" -> 9),
+    /// so that a limit the scene derives from them (a glare billboard too wide
+    /// for the display) names the protocol's lines.
+    std::map<std::string, int> lines;
 };
 
 struct Timing {

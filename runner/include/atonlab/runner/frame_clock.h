@@ -38,13 +38,23 @@ struct SyncCriteria {
     double max_sd_s = 0.001;      ///< the kept intervals' SD must be below this, s
     double max_deviation = 0.02;  ///< |measured − nominal| / nominal must be below this
     double max_duration_s = 5.0;  ///< stop sampling after this long, pass or fail
+    /// The plausible refresh rates, Hz: displays refresh at 24 to 360 Hz
+    /// (500 Hz panels exist); a measured rate outside this range means the
+    /// flips are not tied to a refresh (vertical sync off, a virtual display)
+    /// or a driver stalls every flip.
+    double min_hz = 20.0;
+    double max_hz = 500.0;
 };
+
 
 /// Sampling may stop: enough valid samples with an SD already below the maximum.
 bool sync_sampling_done(const RefreshEstimate& e, const SyncCriteria& c);
 
 /// Empty when the measurement passes; otherwise one sentence saying why.
 /// nominal_hz: the display mode's refresh rate, when it has one (> 0).
+/// A rate outside [c.min_hz, c.max_hz] is refused first, whatever the mode
+/// says: flips faster than any display refreshes (or slower) mean vertical
+/// sync is off or broken, and the sentence says how to turn it on.
 std::string sync_verdict(const RefreshEstimate& e, std::optional<double> nominal_hz, const SyncCriteria& c);
 
 /// Whole refreshes for a duration: round(duration / period), at least `min_frames`.

@@ -43,6 +43,15 @@ struct GlareKernel {
     const glm::vec4& at(int i, int j) const { return rgba[static_cast<std::size_t>(j) * size + i]; }
 };
 
+/// The widest kernel a billboard may have, px (M): 4097 = 2 · 2048 + 1, the
+/// largest PSF (psf_size 2048) at one display pixel per PSF texel.
+inline constexpr int kMaxGlareKernelPx = 4097;
+
+/// The kernel width M (px) a billboard of radius_deg needs at
+/// pixels_per_degree: 2⌈R · ppd⌉ + 1 (any size; may exceed kMaxGlareKernelPx,
+/// +∞ for a non-finite product).
+double glare_kernel_width_px(double pixels_per_degree, double radius_deg);
+
 /// Resamples an RGB PSF to display pixels by exact box overlap (each pixel
 /// receives the PSF energy of the angles it covers), windows it at radius_deg
 /// and renormalises each channel to unit sum. Throws InputError (key

@@ -43,6 +43,12 @@ struct GlareBuildCounts {
 /// 4σ for the Gaussian bloom, 6° for Spencer's PSF.
 double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_per_texel);
 
+/// The billboard radius (degrees) the stage will use for `glare`: radius_deg
+/// when given, else the model's default, with the FFT models' texel known from
+/// the eye model (wave-optics) or the aperture's width (aperture); 0 for
+/// GlareModel::none. Needs no GL: the scene file checks it against the display.
+double glare_billboard_radius_deg(const GlareSettings& glare);
+
 /// Pupil diameter (mm) a scene's glare uses: the given one, or eq 3.15 from the adaptation.
 double glare_pupil_mm(const Scene& scene);
 

@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/scene.h"
 
 namespace atonlab::stimuli {
@@ -15,6 +16,10 @@ namespace atonlab::stimuli {
 struct SceneOverride {
     std::string key;
     std::string value;
+    /// Where the value was written when it comes from a file (a protocol's
+    /// [display] key): errors about the value then name that file and line.
+    /// Empty file: the command line, and errors name "--set KEY".
+    SourceLocation origin;
     /// Parses "key=value"; throws InputError for a missing '=' or an empty key.
     static SceneOverride parse(std::string_view text);
 };
