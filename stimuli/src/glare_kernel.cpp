@@ -17,7 +17,9 @@ namespace {
 
 constexpr int kMaxKernelSize = 4097;
 
-int kernel_size_for(double pixels_per_degree, double radius_deg) {
+}  // namespace
+
+int glare_kernel_size_px(double pixels_per_degree, double radius_deg) {
     if (!(radius_deg > 0) || !std::isfinite(radius_deg))
         throw InputError(SourceLocation{"", 0, 0, "radius_deg"},
                          fmt::format("the glare billboard radius must be positive, not {} degrees.", radius_deg));
@@ -34,6 +36,8 @@ int kernel_size_for(double pixels_per_degree, double radius_deg) {
                                      radius_deg, size, pixels_per_degree, kMaxKernelSize));
     return static_cast<int>(size);
 }
+
+namespace {
 
 // Applies the window at R, reports the cut against `total`, renormalises each channel.
 void window_and_normalise(GlareKernel& k, const std::vector<glm::dvec3>& energy, glm::dvec3 total, GlareWindow window) {
@@ -121,7 +125,7 @@ double glare_window_weight(GlareWindow w, double rho) {
 
 GlareKernel glare_kernel_from_psf(const RgbPsf& psf, double ppd, double radius_deg, GlareWindow window) {
     GlareKernel k;
-    k.size = kernel_size_for(ppd, radius_deg);
+    k.size = glare_kernel_size_px(ppd, radius_deg);
     k.pixels_per_degree = ppd;
     k.radius_px = radius_deg * ppd;
     const int m = k.size, h = k.half(), n = psf.n;
@@ -153,7 +157,7 @@ GlareKernel glare_kernel_from_psf(const RgbPsf& psf, double ppd, double radius_d
 GlareKernel glare_kernel_from_radial(const RadialDensity& density, const SpectralSamples& samples, double ppd,
                                      double radius_deg, GlareWindow window) {
     GlareKernel k;
-    k.size = kernel_size_for(ppd, radius_deg);
+    k.size = glare_kernel_size_px(ppd, radius_deg);
     k.pixels_per_degree = ppd;
     k.radius_px = radius_deg * ppd;
     const int m = k.size, h = k.half();

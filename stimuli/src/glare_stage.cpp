@@ -72,6 +72,23 @@ double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_p
     }
 }
 
+double glare_psf_degrees_per_texel(const GlareSettings& glare) {
+    switch (glare.model) {
+        case GlareModel::wave_optics:
+            return psf_degrees_per_texel(glare.eye);
+        case GlareModel::aperture:
+            return kReferenceWavelengthNm * 1e-6 / glare.aperture_width_mm * 180.0 / std::numbers::pi;
+        default:
+            return 0.0;
+    }
+}
+
+void check_glare_billboard(const Scene& scene) {
+    if (scene.glare.model == GlareModel::none || scene.lights.empty()) return;
+    glare_kernel_size_px(scene.display.pixels_per_degree_at_centre(),
+                         default_glare_radius_deg(scene.glare, glare_psf_degrees_per_texel(scene.glare)));
+}
+
 namespace {
 
 Spectrum spd_for(const std::string& name) {
@@ -188,7 +205,7 @@ struct GlareStage::Impl {
                 if (!is_power_of_two(gs.psf_size))
                     throw InputError(SourceLocation{"", 0, 0, "psf_size"},
                                      fmt::format("the PSF size must be a power of two, not {}.", gs.psf_size));
-                const double dpt = kReferenceWavelengthNm * 1e-6 / gs.aperture_width_mm * 180.0 / std::numbers::pi;
+                const double dpt = glare_psf_degrees_per_texel(gs);
                 GpuPsfGenerator& gen = generator_for(gs.psf_size);
                 gen.generate(aperture_field(gs, gs.psf_size, pupil_mm), dpt, samples);
                 g.psf = gen.read_rgb();

@@ -108,11 +108,19 @@ void harden(sql::Connection& db) {
     db.exec("PRAGMA cell_size_check = ON", "turn on cell_size_check");
 }
 
-// One line of at most 160 characters, for a sentence quoting SQLite's report.
-std::string one_line(std::string text) {
-    std::replace(text.begin(), text.end(), '\n', ';');
-    if (text.size() > 160) text = text.substr(0, 157) + "...";
-    return text;
+// One line of at most 160 characters, for a sentence quoting SQLite's report
+// (its lines joined by "; ", without integrity_check's "*** in database main ***").
+std::string one_line(const std::string& text) {
+    std::string out;
+    std::size_t at = 0;
+    while (at <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        const std::string line = text.substr(at, end - at);
+        if (!line.empty() && line.rfind("*** in database", 0) != 0) out += (out.empty() ? "" : "; ") + line;
+        at = end + 1;
+    }
+    if (out.size() > 160) out = out.substr(0, 157) + "...";
+    return out;
 }
 
 // PRAGMA integrity_check, stopped at its first problem: b-tree structure,
@@ -127,7 +135,8 @@ void verify(sql::Connection& db) {
         // A lock or the OS failing is not damage; anything else SQLite says
         // while reading the schema and walking every page is ("database disk
         // image is malformed", "unsupported file format", ...).
-        if (e.kind() == StoreErrc::busy || e.kind() == StoreErrc::io_error) throw;
+        if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other && e.kind() != StoreErrc::not_a_database)
+            throw;
         report = sqlite3_errmsg(db.get());
     }
     if (report == "ok") return;
@@ -246,8 +255,9 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
                              "changed",
                              str(path), sqlite3_errstr(e.sqlite_code())));
         }
-        if (e.kind() == StoreErrc::busy || e.kind() == StoreErrc::io_error || e.kind() == StoreErrc::cannot_open)
-            throw;
+        // A lock, the OS or permissions failing is not damage; SQLite's
+        // "malformed" or "unsupported file format" is.
+        if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other) throw;
         fail(StoreErrc::corrupt, path,
              fmt::format("{} is damaged: SQLite cannot read its header or schema ({}, {}); it was not changed "
                          "(restore it from a backup, or read what is left with atonlab analyze --salvage)",

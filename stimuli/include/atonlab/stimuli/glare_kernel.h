@@ -43,6 +43,12 @@ struct GlareKernel {
     const glm::vec4& at(int i, int j) const { return rgba[static_cast<std::size_t>(j) * size + i]; }
 };
 
+/// The kernel's width, 2⌈R·ppd⌉ + 1 pixels, for a billboard of radius_deg at
+/// pixels_per_degree. Throws InputError (key "radius_deg") for a radius ≤ 0 or
+/// a kernel wider than 4097 px, and (key "pixels_per_degree") for a
+/// non-positive pixel density: the checks every kernel builder makes.
+int glare_kernel_size_px(double pixels_per_degree, double radius_deg);
+
 /// Resamples an RGB PSF to display pixels by exact box overlap (each pixel
 /// receives the PSF energy of the angles it covers), windows it at radius_deg
 /// and renormalises each channel to unit sum. Throws InputError (key
