@@ -196,8 +196,8 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         protocol_text = db.protocol_text(s.id);
     } catch (const store::StoreError& e) {
         if (!salvage) throw;
-        d.notes.push_back(fmt::format("{} session {}: its protocol text could not be read from the damaged file",
-                                      file, s.id.value));
+        d.notes.push_back(
+            fmt::format("{} session {}: its protocol text could not be read from the damaged file", file, s.id.value));
     }
     const detail::ProtocolDesign design = detail::design_of(protocol_text, s.protocol_name);
     if (!design.protocol)
@@ -296,7 +296,8 @@ Dataset read_store(const store::Store& db, const std::string& file) {
     Dataset d;
     d.sources.push_back(file);
     std::set<std::int64_t> calibrations;
-    for (const store::SessionRecord& s : db.sessions()) add_session(d, db, file, s, db.trials(s.id), calibrations, false);
+    for (const store::SessionRecord& s : db.sessions())
+        add_session(d, db, file, s, db.trials(s.id), calibrations, false);
     add_calibrations(d, db, file, calibrations, false);
     return d;
 }

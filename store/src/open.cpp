@@ -98,10 +98,9 @@ void check_header(const fs::path& path) {
 // untrusted schema could not be written; with extensions off, no function a
 // file's schema can name has a side effect.
 void harden(sql::Connection& db) {
-    for (const auto& [option, value] : {std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1},
-                                        std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0},
-                                        std::pair{SQLITE_DBCONFIG_DQS_DDL, 0},
-                                        std::pair{SQLITE_DBCONFIG_DQS_DML, 0}}) {
+    for (const auto& [option, value] :
+         {std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1}, std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0},
+          std::pair{SQLITE_DBCONFIG_DQS_DDL, 0}, std::pair{SQLITE_DBCONFIG_DQS_DML, 0}}) {
         const int rc = sqlite3_db_config(db.get(), option, value, nullptr);
         if (rc != SQLITE_OK) db.fail(rc, fmt::format("set SQLite's defensive option {}", option));
     }
@@ -244,9 +243,10 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
         app_id = db->query_int("PRAGMA application_id", "read the file header");
         version = static_cast<int>(db->query_int("PRAGMA user_version", "read the schema version"));
         objects = db->query_int("SELECT count(*) FROM sqlite_schema", "list the file's tables");
-        study_tables = db->query_int("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN "
-                                     "('schema_history', 'sessions', 'trials')",
-                                     "look for the study's tables") == 3;
+        study_tables = db->query_int(
+                           "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN "
+                           "('schema_history', 'sessions', 'trials')",
+                           "look for the study's tables") == 3;
         look.commit();
     } catch (const StoreError& e) {
         if (e.kind() == StoreErrc::not_a_database) {

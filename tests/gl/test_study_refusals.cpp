@@ -287,8 +287,8 @@ TEST_F(StudyRefusals, EveryHeadlessRefusalOfRunLeavesNoFileAndChangesNone) {
         SCOPED_TRACE(c.name);
         for (const fs::path& db : {absent, existing}) {
             if (c.on_existing_only && db == absent) continue;
-            std::vector<std::string> args{"run", c.protocol.string(), "--db", db.string(), "--headless",
-                                          "--model-observer"};
+            std::vector<std::string> args{"run",       c.protocol.string(), "--db",
+                                          db.string(), "--headless",        "--model-observer"};
             args.insert(args.end(), c.extra.begin(), c.extra.end());
             const Result r = atonlab(args, tmp_.path());
             EXPECT_EQ(r.code, c.code) << r.err;
@@ -307,7 +307,7 @@ TEST_F(StudyRefusals, EveryHeadlessRefusalOfRunLeavesNoFileAndChangesNone) {
             setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/egl_vendor.json", 1);
             setenv("__EGL_VENDOR_LIBRARY_DIRS", "/nonexistent", 1);
             setenv("EGL_PLATFORM", "surfaceless", 1);
-            const std::vector<std::string> a{ATONLAB_BINARY, "run",        kTiny.string(),   "--db",
+            const std::vector<std::string> a{ATONLAB_BINARY, "run",        kTiny.string(),    "--db",
                                              db.string(),    "--headless", "--model-observer"};
             _exit(test::wait_for(test::spawn_to_files(a, out, err, false, false)));
         }

@@ -157,7 +157,7 @@ struct SnapshotRef {
 /// what is wrong with it and how much could still be read.
 struct DamagedInput {
     std::string file;
-    std::string problem;                  ///< the store's sentence saying what is wrong
+    std::string problem;  ///< the store's sentence saying what is wrong
     std::size_t sessions_read = 0;
     std::size_t trials_read = 0;
     std::int64_t sessions_unreadable = 0;  ///< session rows that could not be read
