@@ -419,6 +419,7 @@ void merge(Dataset& into, Dataset&& more) {
     append(into.calibrations, more.calibrations);
     append(into.snapshots, more.snapshots);
     append(into.notes, more.notes);
+    append(into.damaged, more.damaged);
     append(into.temporaries, more.temporaries);
 }
 

@@ -206,6 +206,16 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
     JsonWriter j;
     j.begin_object();
     j.field("format", "atonlab-analysis-summary").field("format_version", 1);
+    // First, so a reader cannot miss it: inputs that were damaged and salvaged.
+    j.key("damaged_inputs").begin_array();
+    for (const DamagedInput& x : d.damaged) {
+        j.begin_object().field("file", x.file).field("problem", x.problem);
+        j.field("sessions_read", static_cast<std::int64_t>(x.sessions_read));
+        j.field("trials_read", static_cast<std::int64_t>(x.trials_read));
+        j.field("sessions_unreadable", x.sessions_unreadable).field("trials_unreadable", x.trials_unreadable);
+        j.end_object();
+    }
+    j.end_array();
     j.field("software_version", ctx.software_version);
     j.key("inputs").begin_array();
     for (const std::string& s : d.sources) j.value(s);

@@ -140,6 +140,13 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += "<title>atonlab analysis</title>\n<style>\n" + std::string(kStyle) + "\n</style>\n</head>\n<body>\n";
     h += "<h1>atonlab analysis</h1>\n";
+    // First, so a reader cannot miss it: inputs that were damaged and salvaged.
+    for (const DamagedInput& x : d.damaged)
+        h += fmt::format(
+            "<div class=\"warn\"><p><b>Damaged input: <code>{}</code></b> was read with <code>--salvage</code>: "
+            "{} session(s) and {} trial(s) were read; {} trial row(s) and {} session row(s) could not be read. "
+            "What is wrong: {}</p></div>\n",
+            esc(x.file), x.sessions_read, x.trials_read, x.trials_unreadable, x.sessions_unreadable, esc(x.problem));
     h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version),
                      esc(ctx.command_line));
     h += "<p>Inputs:</p>\n<ul>\n";

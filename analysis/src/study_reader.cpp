@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -136,14 +137,16 @@ std::string kind_from_state(const std::string& state_json) {
 namespace {
 
 Dataset read_store(const store::Store& db, const std::string& file);
+Dataset salvage_store(const std::filesystem::path& study_file, const store::StoreError& damage);
 
 }  // namespace
 
-Dataset read_study(const std::filesystem::path& study_file) {
+Dataset read_study(const std::filesystem::path& study_file, bool salvage) {
     const std::string file = study_file.string();
     try {
         return read_store(store::Store::open_read_only(study_file), file);
     } catch (const store::StoreError& e) {
+        if (salvage && e.kind() == store::StoreErrc::corrupt) return salvage_store(study_file, e);
         if (e.kind() != store::StoreErrc::older_schema) throw;
     }
     // A file of an older schema can only be migrated by a writer, and the input
@@ -166,110 +169,172 @@ Dataset read_study(const std::filesystem::path& study_file) {
 
 namespace {
 
+/// One session and its trials into `d`: stimulus parameters, outcomes, the
+/// procedures replayed. `salvage`: a protocol text that cannot be read is a
+/// note, not an error.
+void add_session(Dataset& d, const store::Store& db, const std::string& file, const store::SessionRecord& s,
+                 const std::vector<store::TrialRecord>& records, std::set<std::int64_t>& calibrations, bool salvage) {
+    SessionInfo info;
+    info.key = fmt::format("{}#{}", file, s.id.value);
+    info.source = file;
+    info.id = s.id.value;
+    info.observer = s.observer_code;
+    info.protocol_name = s.protocol_name;
+    info.protocol_sha256 = s.protocol_sha256;
+    info.software_version = s.software_version;
+    info.seed = s.seed;
+    info.started_at = s.started_at;
+    info.ended_at = s.ended_at.value_or("");
+    info.status = store::to_string(s.status);
+    info.trial_count = s.trial_count;
+    if (s.calibration) {
+        info.calibration_id = s.calibration->value;
+        calibrations.insert(s.calibration->value);
+    }
+    std::string protocol_text;
+    try {
+        protocol_text = db.protocol_text(s.id);
+    } catch (const store::StoreError& e) {
+        if (!salvage) throw;
+        d.notes.push_back(
+            fmt::format("{} session {}: its protocol text could not be read from the damaged file", file, s.id.value));
+    }
+    const detail::ProtocolDesign design = detail::design_of(protocol_text, s.protocol_name);
+    if (!design.protocol)
+        d.notes.push_back(
+            fmt::format("{} session {}: its protocol text could not be read ({}); the procedures "
+                        "are taken from the trials' state, guess rates 0 and targets 0.5",
+                        file, s.id.value, design.error));
+    info.protocol_conditions = design.order;
+    for (const auto& [name, cd] : design.conditions)
+        if (!cd.note.empty()) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, cd.note));
+
+    const std::size_t first = d.trials.size();
+    std::vector<std::string> problems;
+    for (const store::TrialRecord& r : records) {
+        Trial t;
+        t.source = file;
+        t.session = info.key;
+        t.observer = s.observer_code;
+        t.trial_index = r.trial_index;
+        t.block = r.block;
+        t.condition = r.condition_id;
+        t.track = r.procedure_id;
+        t.level = r.level;
+        t.response = r.response;
+        t.test_on_left = r.test_on_left;
+        t.response_value = r.response_value;
+        t.response_time_s = r.response_time_s;
+        t.onset_time_s = r.onset_time_s;
+        t.dropped_frames = r.dropped_frames;
+        t.missed_deadline = r.missed_deadline;
+        read_stimulus(t, r.stimulus_json, problems);
+        t.outcome = outcome_of(t);
+        if (const auto it = design.conditions.find(t.condition); it != design.conditions.end()) {
+            t.procedure = it->second.procedure;
+            t.guess_rate = it->second.guess_rate;
+            t.target_p = it->second.target_p;
+        } else {
+            t.procedure = kind_from_state(r.procedure_state_json);
+        }
+        d.trials.push_back(std::move(t));
+    }
+    for (const std::string& p : problems) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, p));
+
+    // Replay each adaptive track through the protocol's procedure.
+    std::map<std::string, std::vector<Trial*>> tracks;
+    std::set<std::string> conditions_seen;
+    for (std::size_t i = first; i < d.trials.size(); ++i) {
+        tracks[d.trials[i].track].push_back(&d.trials[i]);
+        conditions_seen.insert(d.trials[i].condition);
+    }
+    for (auto& [id, trials] : tracks) {
+        const auto it = design.conditions.find(trials.front()->condition);
+        if (it == design.conditions.end()) continue;
+        const auto track = detail::track_number(id);
+        if (!track) continue;
+        const std::string why = detail::replay_track(it->second, *track, trials);
+        if (!why.empty())
+            d.notes.push_back(
+                fmt::format("{} session {}: track {} could not be replayed ({}); its reversals "
+                            "or QUEST posterior are not reported",
+                            file, s.id.value, id, why));
+    }
+    for (const std::string& c : conditions_seen) d.snapshots.push_back({file, s.id.value, info.key, c, file});
+    d.sessions.push_back(std::move(info));
+}
+
+/// The calibrations the sessions used. `salvage`: one that cannot be read is a note.
+void add_calibrations(Dataset& d, const store::Store& db, const std::string& file,
+                      const std::set<std::int64_t>& calibrations, bool salvage) {
+    for (const std::int64_t id : calibrations) {
+        try {
+            const store::Calibration c = db.calibration(store::CalibrationId{id});
+            CalibrationInfo ci;
+            ci.source = file;
+            ci.id = id;
+            ci.display_name = c.display_name;
+            ci.width_px = c.width_px;
+            ci.height_px = c.height_px;
+            ci.width_m = c.width_m;
+            ci.height_m = c.height_m;
+            ci.viewing_distance_m = c.viewing_distance_m;
+            ci.fit_json = c.fit_json;
+            ci.how = c.source;
+            ci.measured_at = c.measured_at;
+            for (const store::CalibrationReading& r : db.calibration_readings(store::CalibrationId{id}))
+                ci.readings.push_back({r.patch, r.channel, r.level, r.luminance_cd_m2});
+            d.calibrations.push_back(std::move(ci));
+        } catch (const store::StoreError&) {
+            if (!salvage) throw;
+            d.notes.push_back(fmt::format("{}: calibration {} could not be read from the damaged file", file, id));
+        }
+    }
+}
+
 Dataset read_store(const store::Store& db, const std::string& file) {
     Dataset d;
     d.sources.push_back(file);
     std::set<std::int64_t> calibrations;
-    for (const store::SessionRecord& s : db.sessions()) {
-        SessionInfo info;
-        info.key = fmt::format("{}#{}", file, s.id.value);
-        info.source = file;
-        info.id = s.id.value;
-        info.observer = s.observer_code;
-        info.protocol_name = s.protocol_name;
-        info.protocol_sha256 = s.protocol_sha256;
-        info.software_version = s.software_version;
-        info.seed = s.seed;
-        info.started_at = s.started_at;
-        info.ended_at = s.ended_at.value_or("");
-        info.status = store::to_string(s.status);
-        info.trial_count = s.trial_count;
-        if (s.calibration) {
-            info.calibration_id = s.calibration->value;
-            calibrations.insert(s.calibration->value);
-        }
-        const detail::ProtocolDesign design = detail::design_of(db.protocol_text(s.id), s.protocol_name);
-        if (!design.protocol)
-            d.notes.push_back(
-                fmt::format("{} session {}: its protocol text could not be read ({}); the procedures "
-                            "are taken from the trials' state, guess rates 0 and targets 0.5",
-                            file, s.id.value, design.error));
-        info.protocol_conditions = design.order;
-        for (const auto& [name, cd] : design.conditions)
-            if (!cd.note.empty()) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, cd.note));
+    for (const store::SessionRecord& s : db.sessions())
+        add_session(d, db, file, s, db.trials(s.id), calibrations, false);
+    add_calibrations(d, db, file, calibrations, false);
+    return d;
+}
 
-        const std::size_t first = d.trials.size();
-        std::vector<std::string> problems;
-        for (const store::TrialRecord& r : db.trials(s.id)) {
-            Trial t;
-            t.source = file;
-            t.session = info.key;
-            t.observer = s.observer_code;
-            t.trial_index = r.trial_index;
-            t.block = r.block;
-            t.condition = r.condition_id;
-            t.track = r.procedure_id;
-            t.level = r.level;
-            t.response = r.response;
-            t.test_on_left = r.test_on_left;
-            t.response_value = r.response_value;
-            t.response_time_s = r.response_time_s;
-            t.onset_time_s = r.onset_time_s;
-            t.dropped_frames = r.dropped_frames;
-            t.missed_deadline = r.missed_deadline;
-            read_stimulus(t, r.stimulus_json, problems);
-            t.outcome = outcome_of(t);
-            if (const auto it = design.conditions.find(t.condition); it != design.conditions.end()) {
-                t.procedure = it->second.procedure;
-                t.guess_rate = it->second.guess_rate;
-                t.target_p = it->second.target_p;
-            } else {
-                t.procedure = kind_from_state(r.procedure_state_json);
-            }
-            d.trials.push_back(std::move(t));
-        }
-        for (const std::string& p : problems) d.notes.push_back(fmt::format("{} session {}: {}", file, s.id.value, p));
-
-        // Replay each adaptive track through the protocol's procedure.
-        std::map<std::string, std::vector<Trial*>> tracks;
-        std::set<std::string> conditions_seen;
-        for (std::size_t i = first; i < d.trials.size(); ++i) {
-            tracks[d.trials[i].track].push_back(&d.trials[i]);
-            conditions_seen.insert(d.trials[i].condition);
-        }
-        for (auto& [id, trials] : tracks) {
-            const auto it = design.conditions.find(trials.front()->condition);
-            if (it == design.conditions.end()) continue;
-            const auto track = detail::track_number(id);
-            if (!track) continue;
-            const std::string why = detail::replay_track(it->second, *track, trials);
-            if (!why.empty())
-                d.notes.push_back(
-                    fmt::format("{} session {}: track {} could not be replayed ({}); its reversals "
-                                "or QUEST posterior are not reported",
-                                file, s.id.value, id, why));
-        }
-        for (const std::string& c : conditions_seen) d.snapshots.push_back({file, s.id.value, info.key, c, file});
-        d.sessions.push_back(std::move(info));
+// A damaged file, read row by row: every session and trial SQLite can still
+// read. The file is opened read-only without the integrity check (it has just
+// failed it); nothing in it is changed.
+Dataset salvage_store(const std::filesystem::path& study_file, const store::StoreError& damage) {
+    const std::string file = study_file.string();
+    store::StoreOptions options;
+    options.verify = false;
+    std::optional<store::Store> db;
+    try {
+        db.emplace(store::Store::open_read_only(study_file, options));
+    } catch (const store::StoreError&) {
+        throw damage;  // not even the header and schema can be read: nothing to salvage
     }
-    for (const std::int64_t id : calibrations) {
-        const store::Calibration c = db.calibration(store::CalibrationId{id});
-        CalibrationInfo ci;
-        ci.source = file;
-        ci.id = id;
-        ci.display_name = c.display_name;
-        ci.width_px = c.width_px;
-        ci.height_px = c.height_px;
-        ci.width_m = c.width_m;
-        ci.height_m = c.height_m;
-        ci.viewing_distance_m = c.viewing_distance_m;
-        ci.fit_json = c.fit_json;
-        ci.how = c.source;
-        ci.measured_at = c.measured_at;
-        for (const store::CalibrationReading& r : db.calibration_readings(store::CalibrationId{id}))
-            ci.readings.push_back({r.patch, r.channel, r.level, r.luminance_cd_m2});
-        d.calibrations.push_back(std::move(ci));
+    const store::Salvage got = db->salvage();
+    Dataset d;
+    d.sources.push_back(file);
+    std::set<std::int64_t> calibrations;
+    for (const store::SessionRecord& s : got.sessions) {
+        std::vector<store::TrialRecord> records;
+        for (const store::SalvagedTrial& t : got.trials)
+            if (t.session == s.id) records.push_back(t.trial);
+        add_session(d, *db, file, s, records, calibrations, true);
     }
+    add_calibrations(d, *db, file, calibrations, true);
+    DamagedInput damaged;
+    damaged.file = file;
+    damaged.problem = damage.what();
+    damaged.sessions_read = got.sessions.size();
+    for (const store::SessionRecord& s : got.sessions) damaged.trials_read += static_cast<std::size_t>(s.trial_count);
+    damaged.sessions_unreadable = got.unreadable_sessions;
+    damaged.trials_unreadable = got.unreadable_trials;
+    for (const std::string& p : got.problems) d.notes.push_back(fmt::format("{}: {}", file, p));
+    d.damaged.push_back(std::move(damaged));
     return d;
 }
 

@@ -56,6 +56,9 @@ void add_analyze_command(CLI::App& app, AnalyzeOptions& o) {
         ->check(CLI::Range(1, 256));
     cmd->add_option("--gnuplot", o.gnuplot, "The gnuplot program that draws the figures");
     cmd->add_flag("--quiet", o.quiet, "Print nothing but errors");
+    cmd->add_flag("--salvage", o.salvage,
+                  "Read what SQLite can still read of a damaged study file instead of refusing it; the report and "
+                  "summary.json say first which file was damaged and how many rows were read");
 }
 
 namespace {
@@ -211,7 +214,12 @@ std::vector<an::SnapshotImage> make_snapshots(const an::Dataset& data, const an:
         try {
             const std::string& file = ref.read_from.empty() ? ref.source : ref.read_from;
             auto& db = open[file];
-            if (!db) db = std::make_unique<store::Store>(store::Store::open_read_only(file));
+            if (!db) {
+                // read_study has checked the file (or salvaged it): not a second integrity check.
+                store::StoreOptions options;
+                options.verify = false;
+                db = std::make_unique<store::Store>(store::Store::open_read_only(file, options));
+            }
             const auto snap = db->get_snapshot(store::SessionId{ref.session_id}, ref.condition);
             if (!snap) continue;
             done.insert(ref.condition);
@@ -241,6 +249,7 @@ std::string command_line_text(const AnalyzeOptions& o) {
     if (o.bootstrap) s += fmt::format(" --bootstrap {}", *o.bootstrap);
     if (o.seed) s += fmt::format(" --seed {}", *o.seed);
     if (!o.family.empty()) s += " --family " + o.family;
+    if (o.salvage) s += " --salvage";
     return s;
 }
 
@@ -267,7 +276,7 @@ int run_analyze(const AnalyzeOptions& o) {
     // --- read every input: nothing is written before all of them are read.
     an::Dataset data;
     try {
-        for (const std::string& f : o.studies) an::merge(data, an::read_study(f));
+        for (const std::string& f : o.studies) an::merge(data, an::read_study(f, o.salvage));
         for (const std::string& f : o.csv) an::merge(data, an::read_trials_csv(f));
     } catch (const store::StoreError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
@@ -289,6 +298,12 @@ int run_analyze(const AnalyzeOptions& o) {
                      ec ? ec.message().c_str() : "a file of that name exists");
         return 2;
     }
+
+    for (const an::DamagedInput& x : data.damaged)
+        std::fprintf(stderr,
+                     "atonlab: warning: %s is damaged; salvaged %zu session(s) and %zu trial(s), %lld trial row(s) "
+                     "unreadable\n",
+                     x.file.c_str(), x.sessions_read, x.trials_read, static_cast<long long>(x.trials_unreadable));
 
     const auto started = std::chrono::steady_clock::now();
     BootstrapProgress progress(o.quiet);

@@ -67,14 +67,14 @@ void apply_display_model(stimuli::Scene& scene, const stimuli::DisplayModel& mod
     scene.output.tonemap.display_peak_cd_m2 = model.peak_cd_m2;
 }
 
-SessionCalibration session_calibration(const store::Store& store, const protocols::Display& display,
+SessionCalibration session_calibration(const store::Store* store, const protocols::Display& display,
                                        std::optional<store::CalibrationId> resumed_with, const std::string& today,
                                        const std::string& db) {
     SessionCalibration out;
     std::optional<store::Calibration> cal;
-    if (resumed_with) {
+    if (resumed_with && store) {
         // A session continues with what it began with.
-        store::Calibration c = store.calibration(*resumed_with);
+        store::Calibration c = store->calibration(*resumed_with);
         if (!is_measured(c)) return out;
         cal = std::move(c);
     } else if (display.name.empty()) {
@@ -83,7 +83,7 @@ SessionCalibration session_calibration(const store::Store& store, const protocol
             "used: the session encodes for the scene's nominal display model (docs/calibration.md)");
         return out;
     } else {
-        cal = latest_measured_calibration(store, display.name);
+        if (store) cal = latest_measured_calibration(*store, display.name);
         if (!cal) {
             out.warnings.push_back(fmt::format(
                 "display \"{}\" has no calibration in {}: the session encodes for the scene's nominal display "
@@ -96,7 +96,7 @@ SessionCalibration session_calibration(const store::Store& store, const protocol
     out.display = display_model_of(*cal);
     const std::string which = fmt::format("calibration {} of display \"{}\" (measured {})", cal->id.value,
                                           cal->display_name, cal->measured_at);
-    if (const auto check = store.latest_calibration_check(cal->id); check && !check->passed)
+    if (const auto check = store->latest_calibration_check(cal->id); check && !check->passed)
         out.warnings.push_back(
             fmt::format("the latest check of {} failed on {} ({}): recalibrate the display "
                         "with `atonlab calibrate measure`",

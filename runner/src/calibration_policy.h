@@ -34,11 +34,12 @@ struct SessionCalibration {
     std::vector<std::string> notes;
 };
 
-/// The decision for a session. `resumed_with`: the calibration a resumed
-/// session recorded when it began (that one is used again, measured or not).
-/// `today`: YYYY-MM-DD (UTC), the date ages are counted to; `db` names the
-/// study file in messages.
-SessionCalibration session_calibration(const store::Store& store, const protocols::Display& display,
+/// The decision for a session. `store`: the study file, or nullptr when it
+/// does not exist yet (so holds no calibration). `resumed_with`: the
+/// calibration a resumed session recorded when it began (that one is used
+/// again, measured or not). `today`: YYYY-MM-DD (UTC), the date ages are
+/// counted to; `db` names the study file in messages.
+SessionCalibration session_calibration(const store::Store* store, const protocols::Display& display,
                                        std::optional<store::CalibrationId> resumed_with, const std::string& today,
                                        const std::string& db);
 

@@ -95,6 +95,7 @@ struct AnalyzeOptions {
     std::optional<int> threads;
     std::string gnuplot = "gnuplot";
     bool quiet = false;
+    bool salvage = false;  ///< read what is left of a damaged study file instead of refusing it
 };
 
 void add_analyze_command(CLI::App& app, AnalyzeOptions& options);

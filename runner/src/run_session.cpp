@@ -33,6 +33,7 @@
 #include "atonlab/runner/text.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
+#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/rhythm.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/stimuli/tonemap.h"
@@ -479,6 +480,9 @@ s::Scene condition_scene(const std::string& scene_text, const std::filesystem::p
         for (const std::string& o : frame.overrides) parsed.push_back(parsed_override(protocol, o));
         s::Scene scene = s::parse_scene(scene_text, scene_file.string(), parsed);
         s::validate_output_settings(scene.output);
+        // The billboard the glare stage will build for it fits the display (a
+        // GL-free check, so that a session refuses it before it opens anything).
+        s::check_glare_billboard(scene);
         return scene;
     } catch (const InputError& e) {
         const std::optional<SourceLocation>& w = e.where();
@@ -987,6 +991,32 @@ void print_summary(const p::Protocol& protocol, const p::Schedule& schedule, Sti
 
 // ---------------------------------------------------------------------------
 
+/// The study file opened read-only when it has content: checked by the store
+/// (an atonlab study, undamaged, no newer than this build) before anything is
+/// written. std::nullopt for a file that does not exist yet or is empty (a new
+/// study; created when the session begins). A file of an older schema is
+/// migrated first (a reader cannot migrate it), the one write made before the
+/// session's other checks.
+std::optional<st::Store> read_existing_study(const std::string& db, const st::StoreOptions& options) {
+    std::error_code ec;
+    const std::filesystem::path path(db);
+    if (!std::filesystem::exists(path, ec)) return std::nullopt;
+    if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) == 0 &&
+        !std::filesystem::exists(db + "-wal", ec))
+        return std::nullopt;
+    // The session will write to it: a write-protected file is refused now, with
+    // the store's sentence for it (opening it for writing finds it read-only
+    // before anything is written).
+    if (::access(path.c_str(), W_OK) != 0) st::Store::open_existing(path, options);
+    try {
+        return st::Store::open_read_only(path, options);
+    } catch (const st::StoreError& e) {
+        if (e.kind() != st::StoreErrc::older_schema) throw;
+    }
+    { st::Store migrate = st::Store::create_or_open(path, options); }
+    return st::Store::open_read_only(path, options);
+}
+
 int run_session(const RunOptions& o) {
     // Installed first: a signal during the setup ends the session before its first trial.
     StopSignals signals;
@@ -1036,11 +1066,16 @@ int run_session(const RunOptions& o) {
     validate_conditions(protocol, scene_text, scene_file);
     const double interval_s = protocol.timing.stimulus_s;
 
-    // --- The study file: its errors (newer schema, write-protected, ...) come
-    // before anything is rendered.
+    // --- The study file, read-only: checked (a study, undamaged, not newer:
+    // exit 4) and read for the session to continue and the display's
+    // calibration. Nothing is created or written until every check that can
+    // refuse the session has passed (docs/running.md, "Before the session").
     st::StoreOptions store_options;
     store_options.max_size_bytes = o.db_max_bytes;
-    st::Store store = st::Store::create_or_open(o.db, store_options);
+    std::optional<st::Store> existing = read_existing_study(o.db, store_options);
+    if (!existing && (o.resume || o.resume_last))
+        throw InputError(SourceLocation{o.resume ? "--resume" : "--resume-last", 0, 0, ""},
+                         fmt::format("{} does not exist (or is empty): there is no session to continue.", o.db));
     std::uint64_t seed = o.seed.value_or(protocol.seed);
     st::SessionId session{};
     std::vector<st::TrialRecord> logged;
@@ -1049,7 +1084,7 @@ int run_session(const RunOptions& o) {
         st::SessionRecord rec;
         if (o.resume) {
             try {
-                rec = store.session(st::SessionId{*o.resume});
+                rec = existing->session(st::SessionId{*o.resume});
             } catch (const st::StoreError& e) {
                 if (e.kind() != st::StoreErrc::not_found) throw;
                 throw InputError(SourceLocation{"--resume", 0, 0, ""},
@@ -1057,7 +1092,7 @@ int run_session(const RunOptions& o) {
             }
         } else {
             std::optional<st::SessionRecord> last;
-            for (const st::SessionRecord& r : store.sessions())
+            for (const st::SessionRecord& r : existing->sessions())
                 if (r.protocol_sha256 == protocol_sha && r.observer_code == code &&
                     r.status != st::SessionStatus::completed && (!last || r.id > last->id))
                     last = r;
@@ -1086,7 +1121,7 @@ int run_session(const RunOptions& o) {
                 fmt::format("session {} in {} runs with seed {}, not {}.", rec.id.value, o.db, rec.seed, *o.seed));
         seed = rec.seed;
         session = rec.id;
-        logged = store.resume_point(session).trials;
+        logged = existing->resume_point(session).trials;
         resumed = true;
     }
 
@@ -1158,8 +1193,9 @@ int run_session(const RunOptions& o) {
 
     // --- The display's calibration (calibration_policy.h): warnings before the
     // session; a measured calibration's model encodes every frame.
-    const SessionCalibration calibration = session_calibration(
-        store, protocol.display, resumed ? store.session(session).calibration : std::nullopt, utc_today(), o.db);
+    const SessionCalibration calibration =
+        session_calibration(existing ? &*existing : nullptr, protocol.display,
+                            resumed ? existing->session(session).calibration : std::nullopt, utc_today(), o.db);
     print_calibration_warnings(calibration, o.quiet);
     if (calibration.display) apply_display_model(display_scene, *calibration.display);
 
@@ -1181,7 +1217,10 @@ int run_session(const RunOptions& o) {
     StimulusRenderer renderer(scene_text, scene_file, observer.params().window_radius_deg, interval_s);
     if (calibration.display) renderer.use_display_model(*calibration.display);
 
-    // --- Begin or reopen the session.
+    // --- Every check has passed: open the study file for writing (creating it
+    // if it does not exist), then begin or reopen the session.
+    existing.reset();
+    st::Store store = st::Store::create_or_open(o.db, store_options);
     if (resumed) {
         const st::ResumePoint rp = store.resume_session(session);
         if (static_cast<std::size_t>(rp.next_trial_index) != logged.size())

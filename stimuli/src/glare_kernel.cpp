@@ -17,7 +17,9 @@ namespace {
 
 constexpr int kMaxKernelSize = kMaxGlareKernelPx;
 
-int kernel_size_for(double pixels_per_degree, double radius_deg) {
+}  // namespace
+
+int glare_kernel_size_px(double pixels_per_degree, double radius_deg) {
     if (!(radius_deg > 0) || !std::isfinite(radius_deg))
         throw InputError(SourceLocation{"", 0, 0, "radius_deg"},
                          fmt::format("the glare billboard radius must be positive, not {} degrees.", radius_deg));
@@ -33,8 +35,6 @@ int kernel_size_for(double pixels_per_degree, double radius_deg) {
                                      radius_deg, size, pixels_per_degree, kMaxKernelSize));
     return static_cast<int>(size);
 }
-
-}  // namespace
 
 double glare_kernel_width_px(double pixels_per_degree, double radius_deg) {
     return 2.0 * std::ceil(radius_deg * pixels_per_degree) + 1.0;
@@ -128,7 +128,7 @@ double glare_window_weight(GlareWindow w, double rho) {
 
 GlareKernel glare_kernel_from_psf(const RgbPsf& psf, double ppd, double radius_deg, GlareWindow window) {
     GlareKernel k;
-    k.size = kernel_size_for(ppd, radius_deg);
+    k.size = glare_kernel_size_px(ppd, radius_deg);
     k.pixels_per_degree = ppd;
     k.radius_px = radius_deg * ppd;
     const int m = k.size, h = k.half(), n = psf.n;
@@ -160,7 +160,7 @@ GlareKernel glare_kernel_from_psf(const RgbPsf& psf, double ppd, double radius_d
 GlareKernel glare_kernel_from_radial(const RadialDensity& density, const SpectralSamples& samples, double ppd,
                                      double radius_deg, GlareWindow window) {
     GlareKernel k;
-    k.size = kernel_size_for(ppd, radius_deg);
+    k.size = glare_kernel_size_px(ppd, radius_deg);
     k.pixels_per_degree = ppd;
     k.radius_px = radius_deg * ppd;
     const int m = k.size, h = k.half();

@@ -77,28 +77,18 @@ SpencerVision spencer_vision_for(const Scene& scene) {
     return SpencerVision::mesopic;
 }
 
-namespace {
-
-/// The aperture model's PSF texel, degrees: λ0 / the aperture plane's width (the FFT's angular step).
-double aperture_degrees_per_texel(const GlareSettings& gs) {
-    return kReferenceWavelengthNm * 1e-6 / gs.aperture_width_mm * 180.0 / std::numbers::pi;
-}
-
-}  // namespace
-
 double glare_billboard_radius_deg(const GlareSettings& glare) {
     switch (glare.model) {
         case GlareModel::none:
+        case GlareModel::cie:  // the whole frame, no billboard
             return 0.0;
         case GlareModel::wave_optics:
-            return default_glare_radius_deg(glare, psf_degrees_per_texel(glare.eye));
         case GlareModel::aperture:
-            return default_glare_radius_deg(glare, aperture_degrees_per_texel(glare));
         case GlareModel::gaussian_bloom:
         case GlareModel::spencer:
             break;
     }
-    return default_glare_radius_deg(glare, 0.0);
+    return default_glare_radius_deg(glare, glare_psf_degrees_per_texel(glare));
 }
 
 double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_per_texel) {
@@ -115,6 +105,23 @@ double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_p
             return (glare.psf_size / 2 - 1) * psf_degrees_per_texel * SpectralSamples::kFirstNm /
                    kReferenceWavelengthNm;
     }
+}
+
+double glare_psf_degrees_per_texel(const GlareSettings& glare) {
+    switch (glare.model) {
+        case GlareModel::wave_optics:
+            return psf_degrees_per_texel(glare.eye);
+        case GlareModel::aperture:
+            return kReferenceWavelengthNm * 1e-6 / glare.aperture_width_mm * 180.0 / std::numbers::pi;
+        default:
+            return 0.0;
+    }
+}
+
+void check_glare_billboard(const Scene& scene) {
+    const double radius_deg = glare_billboard_radius_deg(scene.glare);
+    if (radius_deg == 0.0 || scene.lights.empty()) return;
+    glare_kernel_size_px(scene.display.pixels_per_degree_at_centre(), radius_deg);
 }
 
 namespace {
@@ -244,7 +251,7 @@ struct GlareStage::Impl {
                 if (!is_power_of_two(gs.psf_size))
                     throw InputError(SourceLocation{"", 0, 0, "psf_size"},
                                      fmt::format("the PSF size must be a power of two, not {}.", gs.psf_size));
-                const double dpt = aperture_degrees_per_texel(gs);
+                const double dpt = glare_psf_degrees_per_texel(gs);
                 GpuPsfGenerator& gen = generator_for(gs.psf_size);
                 gen.generate(aperture_field(gs, gs.psf_size, pupil_mm), dpt, samples);
                 g.psf = gen.read_rgb();

@@ -3,8 +3,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstring>
+#include <fstream>
 #include <string>
 #include <system_error>
+#include <thread>
 
 #include "atonlab/store/version.h"
 
@@ -42,6 +48,120 @@ void check_path(const fs::path& path, Access access) {
     }
 }
 
+// The first look at an existing file, before SQLite sees it: SQLite treats a
+// file shorter than its 100-byte header as an empty database and would write a
+// new schema over it (a study file truncated to 1 byte would silently become a
+// new, empty study). 0 bytes is a new file (or one whose content is still in
+// its -wal file, which SQLite reads). The header layout: sqlite.org/fileformat2.html.
+void check_header(const fs::path& path) {
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec || size == 0) return;  // absent (created by SQLite) or empty
+    if (size < 100) {
+        fail(StoreErrc::not_a_database, path,
+             fmt::format("{} is not an SQLite database, so not an atonlab study file: it is {} byte{} long, shorter "
+                         "than SQLite's 100-byte header (a truncated file?); it was not changed",
+                         str(path), size, size == 1 ? "" : "s"));
+    }
+    std::array<unsigned char, 100> h{};
+    std::ifstream in(path, std::ios::binary);
+    if (!in.read(reinterpret_cast<char*>(h.data()), static_cast<std::streamsize>(h.size()))) return;  // SQLite will say
+    if (std::memcmp(h.data(), "SQLite format 3", 16) != 0) return;  // SQLite's "file is not a database"
+    const auto be32 = [&](std::size_t at) {
+        return (std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) | (std::uint32_t{h[at + 2]} << 8) |
+               std::uint32_t{h[at + 3]};
+    };
+    // Page size: bytes 16-17, big-endian; the value 1 means 65536.
+    const std::uint32_t page = (std::uint32_t{h[16]} << 8 | h[17]) == 1 ? 65536u : (std::uint32_t{h[16]} << 8 | h[17]);
+    // The header's page count (bytes 28-31) is valid when the change counter
+    // (24-27) equals the version-valid-for number (92-95). A -wal file may hold
+    // pages beyond it, but never take pages away: a file shorter than its own
+    // page count was cut short.
+    const std::uint32_t pages = be32(28);
+    if (page >= 512 && pages > 0 && be32(24) == be32(92) &&
+        size < static_cast<std::uintmax_t>(pages) * static_cast<std::uintmax_t>(page)) {
+        fail(StoreErrc::corrupt, path,
+             fmt::format("{} is damaged: it is {} bytes long but its header says {} pages of {} bytes ({} bytes), "
+                         "so it was cut short; it was not changed (restore it from a backup, or read what is "
+                         "left with atonlab analyze --salvage)",
+                         str(path), size, pages, page, static_cast<std::uintmax_t>(pages) * page));
+    }
+}
+
+// SQLite's own hardening for files that may come from anywhere
+// (sqlite.org/security.html, "Untrusted SQLite Database Files"): defensive
+// mode (no writable_schema, no journal_mode=OFF, no writes to shadow tables),
+// no extensions, no double-quoted string literals, and cell_size_check (a
+// malformed b-tree cell is an error when read, not a wrong answer).
+// SQLITE_DBCONFIG_TRUSTED_SCHEMA stays on: the schema's CHECKs call
+// json_valid(), which SQLite 3.40 (Debian 12) does not mark innocuous, so an
+// untrusted schema could not be written; with extensions off, no function a
+// file's schema can name has a side effect.
+void harden(sql::Connection& db) {
+    for (const auto& [option, value] :
+         {std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1}, std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0},
+          std::pair{SQLITE_DBCONFIG_DQS_DDL, 0}, std::pair{SQLITE_DBCONFIG_DQS_DML, 0}}) {
+        const int rc = sqlite3_db_config(db.get(), option, value, nullptr);
+        if (rc != SQLITE_OK) db.fail(rc, fmt::format("set SQLite's defensive option {}", option));
+    }
+    db.exec("PRAGMA cell_size_check = ON", "turn on cell_size_check");
+}
+
+// One line of at most 160 characters, for a sentence quoting SQLite's report
+// (its lines joined by "; ", without integrity_check's "*** in database main ***").
+std::string one_line(const std::string& text) {
+    std::string out;
+    std::size_t at = 0;
+    while (at <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        const std::string line = text.substr(at, end - at);
+        if (!line.empty() && line.rfind("*** in database", 0) != 0) out += (out.empty() ? "" : "; ") + line;
+        at = end + 1;
+    }
+    if (out.size() > 160) out = out.substr(0, 157) + "...";
+    return out;
+}
+
+// PRAGMA integrity_check, stopped at its first problem: b-tree structure,
+// free list, every record's format, CHECK and NOT NULL constraints, and that
+// every index matches its table (quick_check skips that last part). Measured
+// at about 1 s for a 100 MB study (docs/store.md, "Opening").
+void verify(sql::Connection& db) {
+    std::string report;
+    try {
+        report = db.query_text("PRAGMA integrity_check(1)", "check the file's integrity");
+    } catch (const StoreError& e) {
+        // A lock or the OS failing is not damage; anything else SQLite says
+        // while reading the schema and walking every page is ("database disk
+        // image is malformed", "unsupported file format", ...).
+        if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other && e.kind() != StoreErrc::not_a_database)
+            throw;
+        report = sqlite3_errmsg(db.get());
+    }
+    if (report == "ok") return;
+    fail(StoreErrc::corrupt, db.path(),
+         fmt::format("{} is damaged (SQLite's integrity check: {}); it was not changed (restore it from a backup, "
+                     "or read what is left with atonlab analyze --salvage)",
+                     str(db.path()), one_line(report)));
+}
+
+// PRAGMA journal_mode = WAL needs an exclusive lock on a file not yet in WAL
+// mode, and SQLite does not call the busy handler for it when two connections
+// both hold a read lock and want it (it would deadlock): one of them gets
+// SQLITE_BUSY at once. Two sessions creating the same new study file meet
+// exactly this, so the switch is retried here within the busy timeout.
+std::string switch_to_wal(sql::Connection& db, int busy_timeout_ms) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(busy_timeout_ms);
+    for (int attempt = 0;; ++attempt) {
+        try {
+            return db.query_text("PRAGMA journal_mode = WAL", "switch to the WAL journal");
+        } catch (const StoreError& e) {
+            if (e.kind() != StoreErrc::busy || std::chrono::steady_clock::now() >= deadline) throw;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(std::min(1 << std::min(attempt, 6), 50)));
+    }
+}
+
 // PRAGMA arguments cannot be bound parameters. Every value formatted into one
 // here is an integer of the program's own (a schema version, a page count), so
 // nothing from outside ever becomes SQL text.
@@ -61,7 +181,9 @@ void migrate(sql::Connection& db, std::span<const Migration> steps) {
                          "it was not changed, open it with a newer atonlab",
                          str(db.path()), version, latest));
     }
-    if (version == latest) return;  // nothing to do; the transaction ends with no change
+    // A study from before application_id was stamped gets it with its next writer.
+    const bool stamped = db.query_int("PRAGMA application_id", "read the file header") == application_id;
+    if (version == latest && stamped) return;  // nothing to do; the transaction ends with no change
     for (const Migration& step : steps) {
         if (step.to_version <= version) continue;
         if (step.to_version != version + 1) {
@@ -92,10 +214,12 @@ void migrate(sql::Connection& db, std::span<const Migration> steps) {
 std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access, const StoreOptions& options,
                                             std::span<const Migration> steps) {
     check_path(path, access);
+    check_header(path);
     const int flags = access == Access::read_only       ? SQLITE_OPEN_READONLY
                       : access == Access::open_existing ? SQLITE_OPEN_READWRITE
                                                         : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
     auto db = std::make_unique<sql::Connection>(path, flags);
+    harden(*db);
 
     // SQLITE_OPEN_READWRITE silently falls back to read-only on a write-protected file.
     if (access != Access::read_only && sqlite3_db_readonly(db->get(), "main") == 1) {
@@ -107,29 +231,51 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
     sqlite3_busy_timeout(db->get(), options.busy_timeout_ms);
     db->exec("PRAGMA foreign_keys = ON", "turn on foreign keys");
 
-    // First read of the file: a non-database fails here, before anything is written.
+    // First read of the file: a non-database fails here, before anything is
+    // written. One read transaction, so that a file another process is creating
+    // at this moment is seen whole (stamped, with its tables) or not at all.
     std::int64_t app_id = 0;
     int version = 0;
+    std::int64_t objects = 0;
+    bool study_tables = false;
     try {
+        sql::Transaction look(*db, sql::Transaction::Kind::read, "read the file header");
         app_id = db->query_int("PRAGMA application_id", "read the file header");
         version = static_cast<int>(db->query_int("PRAGMA user_version", "read the schema version"));
+        objects = db->query_int("SELECT count(*) FROM sqlite_schema", "list the file's tables");
+        study_tables = db->query_int(
+                           "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN "
+                           "('schema_history', 'sessions', 'trials')",
+                           "look for the study's tables") == 3;
+        look.commit();
     } catch (const StoreError& e) {
-        if (e.kind() != StoreErrc::not_a_database) throw;
-        fail(StoreErrc::not_a_database, path,
-             fmt::format("{} is not an SQLite database, so not an atonlab study file (SQLite: {}); it was not changed",
-                         str(path), sqlite3_errmsg(db->get())));
+        if (e.kind() == StoreErrc::not_a_database) {
+            fail(StoreErrc::not_a_database, path,
+                 fmt::format("{} is not an SQLite database, so not an atonlab study file (SQLite: {}); it was not "
+                             "changed",
+                             str(path), sqlite3_errstr(e.sqlite_code())));
+        }
+        // A lock, the OS or permissions failing is not damage; SQLite's
+        // "malformed" or "unsupported file format" is.
+        if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other) throw;
+        fail(StoreErrc::corrupt, path,
+             fmt::format("{} is damaged: SQLite cannot read its header or schema ({}, {}); it was not changed "
+                         "(restore it from a backup, or read what is left with atonlab analyze --salvage)",
+                         str(path), sqlite3_errstr(e.sqlite_code()), sql::code_name(e.sqlite_code())));
     }
     const int latest = steps.empty() ? 0 : steps.back().to_version;
+    const bool empty = app_id == 0 && version == 0 && objects == 0;
     if (app_id != application_id) {
-        const std::int64_t objects = db->query_int("SELECT count(*) FROM sqlite_schema", "list the file's tables");
-        const bool empty = app_id == 0 && version == 0 && objects == 0;
-        if (!empty) {
+        // A study written before application_id was stamped would carry no id but
+        // the study's own tables and a schema version: still a study.
+        const bool unstamped_study = app_id == 0 && version >= 1 && study_tables;
+        if (!empty && !unstamped_study) {
             fail(StoreErrc::not_a_study, path,
                  fmt::format("{} is an SQLite database but not an atonlab study file (application_id {}, "
                              "{} schema objects); it was not changed",
                              str(path), app_id, objects));
         }
-        if (access == Access::read_only) {
+        if (empty && access == Access::read_only) {
             fail(StoreErrc::not_a_study, path,
                  fmt::format("{} is an empty database, not yet an atonlab study file", str(path)));
         }
@@ -140,6 +286,8 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
                          "it was not changed, open it with a newer atonlab",
                          str(path), version, latest));
     }
+
+    if (!empty && options.verify) verify(*db);
 
     if (access == Access::read_only) {
         if (version < latest) {
@@ -155,7 +303,7 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
     // A committed trial must survive a killed process and a power cut: WAL with
     // synchronous=FULL fsyncs the WAL on every commit (NORMAL would only survive
     // the former). Costs one fsync per trial, far below one trial's duration.
-    const std::string mode = db->query_text("PRAGMA journal_mode = WAL", "switch to the WAL journal");
+    const std::string mode = switch_to_wal(*db, options.busy_timeout_ms);
     if (mode != "wal") {
         fail(StoreErrc::other, path,
              fmt::format("{}: cannot switch to the WAL journal (SQLite kept \"{}\"; WAL needs a local file "

@@ -24,6 +24,15 @@ constexpr const char* select_one_session =
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
     "WHERE s.id = ?1";
 
+// An observer code, not a name: short, and no spaces, so "Jane Doe" is refused.
+bool valid_observer_code(std::string_view code) {
+    return !code.empty() && code.size() <= 32 && std::all_of(code.begin(), code.end(), [](char c) {
+        return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    });
+}
+
+}  // namespace
+
 SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::path& path) {
     SessionRecord r;
     r.id = SessionId{s.int64(0)};
@@ -47,15 +56,6 @@ SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::p
     r.trial_count = s.int64(12);
     return r;
 }
-
-// An observer code, not a name: short, and no spaces, so "Jane Doe" is refused.
-bool valid_observer_code(std::string_view code) {
-    return !code.empty() && code.size() <= 32 && std::all_of(code.begin(), code.end(), [](char c) {
-        return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-    });
-}
-
-}  // namespace
 
 SessionStatus Store::Impl::status_of(SessionId session, std::string_view doing) {
     sql::Use s(db->cached("SELECT status FROM sessions WHERE id = ?1"));

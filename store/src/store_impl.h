@@ -36,6 +36,16 @@ struct Store::Impl {
     ResumePoint read_resume_point(SessionId session, std::string_view doing);
 };
 
+/// A sessions row as selected by sessions.cpp (id, observer code, protocol id,
+/// name and hash, software version, seed, calibration, started, ended, status,
+/// resume count, trial count).
+SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::path& path);
+/// A trials row from column `first` on: trial_index, block, condition_id,
+/// procedure_id, level, test_on_left, stimulus_json, response, response_value,
+/// response_time_s, onset_time_s, dropped_frames, missed_deadline,
+/// procedure_state_json, recorded_at.
+TrialRecord trial_from_row(const sql::Statement& s, int first);
+
 /// True when `text` is valid JSON by SQLite's own json_valid(), the CHECK the schema uses.
 bool json_valid(sql::Connection& db, std::string_view text, std::string_view doing);
 

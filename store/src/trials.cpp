@@ -102,26 +102,28 @@ std::vector<TrialRecord> Store::Impl::read_trials(SessionId session, std::string
         "response_value, response_time_s, onset_time_s, dropped_frames, missed_deadline, procedure_state_json, "
         "recorded_at FROM trials WHERE session_id = ?1 ORDER BY trial_index"));
     s->bind(1, session.value);
-    while (s->step(doing)) {
-        TrialRecord t;
-        t.trial_index = s->int64(0);
-        t.block = s->int32(1);
-        t.condition_id = s->text(2);
-        t.procedure_id = s->text(3);
-        t.level = s->real(4);
-        if (!s->is_null(5)) t.test_on_left = s->int64(5) != 0;
-        t.stimulus_json = s->text(6);
-        t.response = s->text(7);
-        if (!s->is_null(8)) t.response_value = s->real(8);
-        t.response_time_s = s->real(9);
-        t.onset_time_s = s->real(10);
-        t.dropped_frames = s->int32(11);
-        t.missed_deadline = s->int64(12) != 0;
-        t.procedure_state_json = s->text(13);
-        t.recorded_at = s->text(14);
-        out.push_back(std::move(t));
-    }
+    while (s->step(doing)) out.push_back(trial_from_row(*s, 0));
     return out;
+}
+
+TrialRecord trial_from_row(const sql::Statement& s, int c) {
+    TrialRecord t;
+    t.trial_index = s.int64(c);
+    t.block = s.int32(c + 1);
+    t.condition_id = s.text(c + 2);
+    t.procedure_id = s.text(c + 3);
+    t.level = s.real(c + 4);
+    if (!s.is_null(c + 5)) t.test_on_left = s.int64(c + 5) != 0;
+    t.stimulus_json = s.text(c + 6);
+    t.response = s.text(c + 7);
+    if (!s.is_null(c + 8)) t.response_value = s.real(c + 8);
+    t.response_time_s = s.real(c + 9);
+    t.onset_time_s = s.real(c + 10);
+    t.dropped_frames = s.int32(c + 11);
+    t.missed_deadline = s.int64(c + 12) != 0;
+    t.procedure_state_json = s.text(c + 13);
+    t.recorded_at = s.text(c + 14);
+    return t;
 }
 
 std::vector<TrialRecord> Store::trials(SessionId session) const {

@@ -13,7 +13,9 @@
 //    --resume-last completes it (with a pause and "go on" on the way) with the
 //    trial sequence the uninterrupted schedule gives.
 //  - Timing: the refresh period is measured at start; a display whose rate is
-//    not the protocol's refuses with exit status 5; an injected stall of 6 refreshes marks
+//    not the protocol's refuses with exit status 5, and one of another size
+//    than the protocol's with 2, both before the study file is created (an
+//    existing one is left byte for byte); an injected stall of 6 refreshes marks
 //    its trial (missed_deadline, dropped_frames >= 5) and, with repeat_missed,
 //    the trial is shown again and the procedure sees one answer.
 //  - The screen (Xvfb's framebuffer, read from its -fbdir file) shows, code for
@@ -407,7 +409,38 @@ TEST_F(runner, ADisplayAtAnotherRateThanTheProtocolsRefusesToStart) {
     const std::string line = err.substr(at, err.find('\n', at) - at);
     EXPECT_NE(line.find("written for 60 Hz"), std::string::npos) << line;
     EXPECT_NE(line.find("not started"), std::string::npos) << line;
-    EXPECT_TRUE(Store::open_read_only(db()).sessions().empty()) << "no session is begun";
+    EXPECT_FALSE(fs::exists(db())) << "the screen is refused before the study file is created";
+
+    // An existing study file: refused the same way, and left byte for byte as it was.
+    {
+        Store s = Store::create_or_open(db());
+        store::SessionStart start;
+        start.observer_code = "P01";
+        start.protocol_name = "other.toml";
+        start.protocol_text = "[protocol]\n";
+        s.begin_session(start);
+    }
+    const std::string before = file_bytes(db());
+    const Child again = spawn(args, dir_.path() / "r2.out", dir_.path() / "r2.err");
+    ASSERT_EQ(finish(again), 5) << file_bytes(again.err);
+    EXPECT_EQ(file_bytes(db()), before);
+}
+
+TEST_F(runner, AScreenOfAnotherSizeThanTheProtocolsLeavesNoStudyFile) {
+    // small_2afc.toml is written for 320 x 180 px; the Xvfb screen is 640 x 360.
+    std::vector<std::string> args{ATONLAB_BINARY,
+                                  "run",
+                                  (fs::path(ATONLAB_SOURCE_DIR) / "tests/data/run/small_2afc.toml").string(),
+                                  "--db",
+                                  db().string(),
+                                  "--model-observer",
+                                  "--software-vsync",
+                                  "60",
+                                  "--skip-sync-test"};
+    const Child c = spawn(args, dir_.path() / "r.out", dir_.path() / "r.err");
+    ASSERT_EQ(finish(c), 2) << file_bytes(c.out) << file_bytes(c.err);
+    EXPECT_NE(file_bytes(c.err).find("320×180"), std::string::npos) << file_bytes(c.err);
+    EXPECT_FALSE(fs::exists(db())) << "the screen is refused before the study file is created";
 }
 
 // --- The screen's pixels ----------------------------------------------------------

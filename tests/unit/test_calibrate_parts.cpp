@@ -304,7 +304,7 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
     TempDir dir;
     store::Store db = store::Store::create_or_open(dir / "study.db");
     // No name in the protocol.
-    SessionCalibration s = session_calibration(db, protocol_display(""), std::nullopt, "2024-06-01", "study.db");
+    SessionCalibration s = session_calibration(&db, protocol_display(""), std::nullopt, "2024-06-01", "study.db");
     EXPECT_FALSE(s.calibration.has_value());
     EXPECT_TRUE(s.warnings.empty());
     EXPECT_TRUE(any_contains(s.notes, "names no display"));
@@ -320,7 +320,7 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
     nominal.source = "scene";
     nominal.measured_at = "2024-05-30";
     db.put_calibration(nominal);
-    s = session_calibration(db, protocol_display("lab"), std::nullopt, "2024-06-01", "study.db");
+    s = session_calibration(&db, protocol_display("lab"), std::nullopt, "2024-06-01", "study.db");
     EXPECT_FALSE(s.calibration.has_value());
     EXPECT_FALSE(s.display.has_value());
     EXPECT_TRUE(any_contains(s.warnings, "display \"lab\" has no calibration in study.db"));
@@ -333,13 +333,13 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
     measured.source = "measured";
     measured.measured_at = "2024-04-22T09:00:00Z";
     const store::CalibrationId id = db.put_calibration(measured);
-    s = session_calibration(db, protocol_display("lab"), std::nullopt, "2024-06-01", "study.db");
+    s = session_calibration(&db, protocol_display("lab"), std::nullopt, "2024-06-01", "study.db");
     ASSERT_TRUE(s.calibration.has_value());
     EXPECT_EQ(*s.calibration, id);
     ASSERT_TRUE(s.display.has_value());
     EXPECT_EQ(s.display->peak_cd_m2, model.peak_cd_m2);
     EXPECT_TRUE(any_contains(s.warnings, "is 40 days old, older than max_calibration_age_days = 30 (the default)"));
-    s = session_calibration(db, protocol_display("lab", 60.0), std::nullopt, "2024-06-01", "study.db");
+    s = session_calibration(&db, protocol_display("lab", 60.0), std::nullopt, "2024-06-01", "study.db");
     EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
 
     // Its latest check failed.
@@ -351,13 +351,13 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
         R"({"failed":["peak_percent"],"values":{"peak_percent":10.2},"tolerances":{"peak_percent":5}})";
     check.source = "measured";
     db.put_calibration_check(check);
-    s = session_calibration(db, protocol_display("lab", 60.0), std::nullopt, "2024-06-01", "study.db");
+    s = session_calibration(&db, protocol_display("lab", 60.0), std::nullopt, "2024-06-01", "study.db");
     EXPECT_TRUE(any_contains(s.warnings, "failed on 2024-05-20 (peak_percent 10.2 > 5)"));
 
     // Another geometry in the protocol.
     protocols::Display other = protocol_display("lab", 60.0);
     other.width_px = 1280;
-    s = session_calibration(db, other, std::nullopt, "2024-06-01", "study.db");
+    s = session_calibration(&db, other, std::nullopt, "2024-06-01", "study.db");
     EXPECT_TRUE(any_contains(s.warnings, "the protocol's [display] says 1280 x 1080 px"));
 
     // A resumed session keeps what it began with: the nominal row stays nominal.
@@ -365,7 +365,7 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
     for (const auto& row : db.calibrations("lab"))
         if (row.source == "scene") nominal_id = row.id;
     ASSERT_TRUE(nominal_id.has_value());
-    s = session_calibration(db, protocol_display("lab"), nominal_id, "2024-06-01", "study.db");
+    s = session_calibration(&db, protocol_display("lab"), nominal_id, "2024-06-01", "study.db");
     EXPECT_FALSE(s.calibration.has_value());
     EXPECT_TRUE(s.warnings.empty());
 

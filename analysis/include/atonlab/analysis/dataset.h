@@ -153,6 +153,17 @@ struct SnapshotRef {
     std::string read_from;
 };
 
+/// A study file that was damaged and was read with salvage (read_study):
+/// what is wrong with it and how much could still be read.
+struct DamagedInput {
+    std::string file;
+    std::string problem;  ///< the store's sentence saying what is wrong
+    std::size_t sessions_read = 0;
+    std::size_t trials_read = 0;
+    std::int64_t sessions_unreadable = 0;  ///< session rows that could not be read
+    std::int64_t trials_unreadable = 0;    ///< trial rows that could not be read
+};
+
 /// Everything read, from every input.
 struct Dataset {
     std::vector<std::string> sources;  ///< the inputs, in the order given
@@ -161,15 +172,20 @@ struct Dataset {
     std::vector<CalibrationInfo> calibrations;
     std::vector<SnapshotRef> snapshots;  ///< one per (session, condition) that has one
     std::vector<std::string> notes;      ///< what the reader could not do (a protocol it could not replay, ...)
+    std::vector<DamagedInput> damaged;   ///< inputs found damaged and salvaged (read_study with salvage)
     /// Owns temporary files the dataset refers to (migrated copies of older
     /// study files, see SnapshotRef::read_from); removed with the last copy.
     std::vector<std::shared_ptr<void>> temporaries;
 };
 
 /// Reads a study file read-only (Store::open_read_only: readable while a
-/// session runs). Throws store::StoreError for a file the store refuses (not
-/// SQLite, not a study, a newer schema, ...), InputError for nothing else.
-Dataset read_study(const std::filesystem::path& study_file);
+/// session runs), checked by SQLite's integrity_check first. Throws
+/// store::StoreError for a file the store refuses (not SQLite, not a study, a
+/// newer schema, damaged: StoreErrc::corrupt, ...), InputError for nothing
+/// else. With `salvage`, a damaged file is read row by row instead
+/// (Store::salvage()): what SQLite can still read, with a DamagedInput saying
+/// what is wrong and how many rows were read.
+Dataset read_study(const std::filesystem::path& study_file, bool salvage = false);
 
 /// The CSV's required columns ("observer", "condition", "level", "response").
 const std::vector<std::string>& required_csv_columns();

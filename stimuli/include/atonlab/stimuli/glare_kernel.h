@@ -51,6 +51,11 @@ inline constexpr int kMaxGlareKernelPx = 4097;
 /// pixels_per_degree: 2⌈R · ppd⌉ + 1 (any size; may exceed kMaxGlareKernelPx,
 /// +∞ for a non-finite product).
 double glare_kernel_width_px(double pixels_per_degree, double radius_deg);
+/// The kernel's width, 2⌈R·ppd⌉ + 1 pixels, for a billboard of radius_deg at
+/// pixels_per_degree. Throws InputError (key "radius_deg") for a radius ≤ 0 or
+/// a kernel wider than 4097 px, and (key "pixels_per_degree") for a
+/// non-positive pixel density: the checks every kernel builder makes.
+int glare_kernel_size_px(double pixels_per_degree, double radius_deg);
 
 /// Resamples an RGB PSF to display pixels by exact box overlap (each pixel
 /// receives the PSF energy of the angles it covers), windows it at radius_deg

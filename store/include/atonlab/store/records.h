@@ -159,4 +159,19 @@ struct Snapshot {
     std::string recorded_at;  ///< filled by the store
 };
 
+/// A trial that Store::salvage() could read, with the session it belongs to.
+struct SalvagedTrial {
+    SessionId session{};
+    TrialRecord trial;
+};
+
+/// What Store::salvage() could read of a damaged study file.
+struct Salvage {
+    std::vector<SessionRecord> sessions;   ///< readable sessions; trial_count = the trials read for each
+    std::vector<SalvagedTrial> trials;     ///< readable trials, by session, then trial_index
+    std::int64_t unreadable_sessions = 0;  ///< session row ids up to the largest that could not be read
+    std::int64_t unreadable_trials = 0;    ///< trial row ids up to the largest that could not be read
+    std::vector<std::string> problems;     ///< one sentence for each part that could not be read at all
+};
+
 }  // namespace atonlab::store

@@ -29,14 +29,23 @@ struct StoreOptions {
     /// StoreErrc::disk_full exactly as a full disk would. Lets a lab cap a study's
     /// size, and lets tests exercise the disk-full path.
     std::int64_t max_size_bytes = 0;
+    /// Check an existing file with SQLite's PRAGMA integrity_check before it is
+    /// used (docs/store.md, "Opening"): a damaged file is refused with
+    /// StoreErrc::corrupt and left unchanged. false only for salvage: reading
+    /// what is left of a file known to be damaged (read-only opens).
+    bool verify = true;
 };
 
 class Store {
 public:
     /// Opens `path` for reading and writing, creating it (and its schema) if it
-    /// does not exist, migrating an older schema in one transaction. Throws
-    /// StoreError: cannot_open (missing directory, ...), not_a_database,
-    /// not_a_study, newer_schema (file untouched), read_only, io_error, busy.
+    /// does not exist, migrating an older schema in one transaction. An existing
+    /// file is checked before anything is written to it: an SQLite file (not a
+    /// truncated or foreign one), an atonlab study, a schema no newer than this
+    /// code's, and (StoreOptions::verify) no damage by PRAGMA integrity_check.
+    /// Throws StoreError: cannot_open (missing directory, ...), not_a_database,
+    /// not_a_study, newer_schema, corrupt (all with the file untouched),
+    /// read_only, io_error, busy.
     static Store create_or_open(const std::filesystem::path& path, const StoreOptions& options = {});
     /// As create_or_open, but the file must already exist (a typo in a path does
     /// not silently start a new, empty study).
@@ -123,6 +132,11 @@ public:
     std::string integrity_check() const;
     /// The file's PRAGMA user_version.
     int file_schema_version() const;
+    /// For a damaged file (opened read-only with StoreOptions::verify false):
+    /// every session and trial row SQLite can still read, each looked up by its
+    /// row id (1 … the largest), so that a damaged page loses only the rows on
+    /// it. Never throws for damage; counts what it could not read.
+    Salvage salvage() const;
 
     struct Impl;
 

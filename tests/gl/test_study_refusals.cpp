@@ -1,0 +1,349 @@
+// The binary refuses what it must not write to, and writes nothing when it
+// refuses (docs/running.md "Before the session", docs/store.md "Opening"):
+//
+//  - damaged or foreign study files (garbage, cut to 1 byte and to half,
+//    another application's SQLite file, a newer schema, bytes overwritten in
+//    the header and in the trials table's pages): `run` and `calibrate import`
+//    exit 4 with one sentence naming the file and leave it byte for byte as it
+//    was; `analyze` refuses a damaged one (exit 4) and a foreign one (exit 2,
+//    docs/analysis.md), and with --salvage reads what is left and says so in
+//    the first lines of report.html and summary.json;
+//  - each headless refusal path of `run` (exit 2: a billboard too wide for the
+//    display, a session to resume in a file that does not exist or does not
+//    hold it; exit 3: no GL) leaves no study file behind and an existing one
+//    byte-identical (the on-screen refusals, exit 2 and 5, are in
+//    runner_xvfb.cpp);
+//  - two `run`s started together on a study file that does not exist yet both
+//    complete, 20 times out of 20.
+// Skips where the binary finds no GL 4.5 context (exit status 3).
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "../store/store_test_support.h"
+#include "../support/child_process.h"
+#include "atonlab/store/store.h"
+
+#ifndef ATONLAB_BINARY
+#error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
+#endif
+
+namespace atonlab {
+namespace {
+
+namespace fs = std::filesystem;
+using store::Store;
+using store::test_support::file_bytes;
+using store::test_support::RawDb;
+using store::test_support::TempDir;
+
+const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data";
+const fs::path kTiny = kData / "run/tiny_2afc.toml";
+
+struct Result {
+    int code = -1;
+    std::string out, err;
+};
+
+Result atonlab(std::vector<std::string> args, const fs::path& dir, const std::string& tag = "r") {
+    args.insert(args.begin(), ATONLAB_BINARY);
+    const fs::path out = dir / (tag + ".out"), err = dir / (tag + ".err");
+    Result r;
+    r.code = test::wait_for(test::spawn_to_files(std::move(args), out, err, false, false));
+    r.out = file_bytes(out);
+    r.err = file_bytes(err);
+    return r;
+}
+
+Result run_tiny(const fs::path& db, const fs::path& dir, const std::string& tag = "r",
+                const fs::path& protocol = kTiny) {
+    return atonlab({"run", protocol.string(), "--db", db.string(), "--headless", "--model-observer", "--quiet"}, dir,
+                   tag);
+}
+
+bool contains(const std::string& s, const std::string& part) {
+    return s.find(part) != std::string::npos;
+}
+
+/// One line on stderr that names the file.
+void expect_one_sentence_naming(const Result& r, const fs::path& file) {
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(contains(r.err, file.string())) << r.err;
+}
+
+void overwrite(const fs::path& path, std::int64_t offset, const std::string& bytes) {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(offset);
+    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+class StudyRefusals : public ::testing::Test {
+protected:
+    /// A study file with one completed session, made once by the binary.
+    static void SetUpTestSuite() {
+        dir_ = new TempDir;
+        const Result r = run_tiny(good(), dir_->path(), "setup");
+        if (r.code == 3) {
+            skip_ = "no GL 4.5 context: " + r.err;
+            return;
+        }
+        setup_code_ = r.code;
+        setup_err_ = r.err;
+    }
+    static void TearDownTestSuite() {
+        delete dir_;
+        dir_ = nullptr;
+    }
+    void SetUp() override {
+        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        ASSERT_EQ(setup_code_, 0) << setup_err_;
+    }
+    static fs::path good() { return dir_->path() / "good.db"; }
+    fs::path copy_of_good(const char* name) const {
+        const fs::path p = tmp_.path() / name;
+        fs::copy_file(good(), p);
+        return p;
+    }
+
+    TempDir tmp_;
+    static inline TempDir* dir_ = nullptr;
+    static inline std::string skip_;
+    static inline int setup_code_ = -1;
+    static inline std::string setup_err_;
+};
+
+// --- Damaged and foreign files ---------------------------------------------------
+
+struct Damaged {
+    std::string name;
+    fs::path path;
+    bool damaged;  ///< damaged (analyze: exit 4, salvageable) rather than not a study (analyze: exit 2)
+};
+
+TEST_F(StudyRefusals, DamagedAndForeignFilesAreRefusedByEveryCommandAndLeftUnchanged) {
+    std::vector<Damaged> files;
+    {
+        const fs::path p = tmp_.path() / "garbage.db";
+        std::ofstream(p, std::ios::binary) << std::string(5000, 'g');
+        files.push_back({"garbage", p, false});
+    }
+    {
+        const fs::path p = copy_of_good("one-byte.db");
+        fs::resize_file(p, 1);
+        files.push_back({"cut to 1 byte", p, false});
+    }
+    {
+        const fs::path p = copy_of_good("half.db");
+        fs::resize_file(p, fs::file_size(p) / 2);
+        files.push_back({"cut to half", p, true});
+    }
+    {
+        const fs::path p = tmp_.path() / "other.db";
+        RawDb raw(p, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+        ASSERT_EQ(raw.exec("CREATE TABLE recipes (name TEXT); INSERT INTO recipes VALUES ('bread');"), "");
+        files.push_back({"another application's SQLite file", p, false});
+    }
+    {
+        const fs::path p = copy_of_good("newer.db");
+        RawDb raw(p);
+        ASSERT_EQ(raw.exec("PRAGMA user_version = 99"), "");
+        files.push_back({"a newer schema", p, false});
+    }
+    {
+        const fs::path p = copy_of_good("header.db");
+        overwrite(p, 16, std::string("\x12\x34", 2));  // the page size: not a power of two
+        files.push_back({"header overwritten", p, true});
+    }
+    std::int64_t trials_root = 0, page = 0;
+    {
+        RawDb raw(good(), SQLITE_OPEN_READONLY);
+        trials_root = raw.integer("SELECT rootpage FROM sqlite_schema WHERE name = 'trials'");
+        page = raw.integer("PRAGMA page_size");
+        const fs::path p = copy_of_good("trials-page.db");
+        overwrite(p, (trials_root - 1) * page, std::string(12, '\xee'));  // the b-tree page's header
+        files.push_back({"trials page overwritten", p, true});
+    }
+
+    for (const Damaged& f : files) {
+        SCOPED_TRACE(f.name);
+        const std::string before = file_bytes(f.path);
+
+        const Result run = run_tiny(f.path, tmp_.path(), "run");
+        EXPECT_EQ(run.code, 4) << run.err;
+        expect_one_sentence_naming(run, f.path);
+        EXPECT_EQ(file_bytes(f.path), before) << "run changed the refused file";
+
+        const Result cal = atonlab({"calibrate", "import", (kData / "calibration/display.ti3").string(), "--display",
+                                    "lcd", "--db", f.path.string(), "--width-px", "320", "--height-px", "180",
+                                    "--width-m", "0.1", "--viewing-distance-m", "0.9", "--date", "2024-03-12"},
+                                   tmp_.path(), "cal");
+        EXPECT_EQ(cal.code, 4) << cal.err;
+        expect_one_sentence_naming(cal, f.path);
+        EXPECT_EQ(file_bytes(f.path), before) << "calibrate changed the refused file";
+
+        const fs::path out = tmp_.path() / "report";
+        const Result an = atonlab({"analyze", f.path.string(), "--out", out.string(), "--quiet"}, tmp_.path(), "an");
+        EXPECT_EQ(an.code, f.damaged ? 4 : 2) << an.err;
+        expect_one_sentence_naming(an, f.path);
+        EXPECT_FALSE(fs::exists(out / "report.html")) << "nothing is written for a refused input";
+        EXPECT_EQ(file_bytes(f.path), before) << "analyze changed the refused file";
+        if (f.damaged) {
+            EXPECT_TRUE(contains(run.err, "is damaged")) << run.err;
+        }
+    }
+}
+
+TEST_F(StudyRefusals, SalvageReadsWhatIsLeftAndTheReportSaysSoFirst) {
+    // Trials on several pages, so that one page can be lost and the rest read:
+    // three sessions of the tiny protocol.
+    const fs::path study = tmp_.path() / "study.db";
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(run_tiny(study, tmp_.path()).code, 0);
+    std::int64_t leaf = 0, page = 0, trials = 0, leaves = 0;
+    {
+        RawDb raw(study, SQLITE_OPEN_READONLY);
+        page = raw.integer("PRAGMA page_size");
+        trials = raw.integer("SELECT count(*) FROM trials");
+        try {
+            leaves = raw.integer("SELECT count(*) FROM dbstat WHERE name = 'trials' AND pagetype = 'leaf'");
+            leaf = raw.integer("SELECT min(pageno) FROM dbstat WHERE name = 'trials' AND pagetype = 'leaf'");
+        } catch (const std::exception&) {
+            GTEST_SKIP() << "no dbstat in this SQLite build: the trials table's leaves cannot be found";
+        }
+    }
+    ASSERT_EQ(trials, 9);
+    ASSERT_GE(leaves, 2) << "the trials should span several pages";
+    overwrite(study, (leaf - 1) * page, std::string(12, '\xee'));  // one leaf's b-tree page header
+    const std::string before = file_bytes(study);
+
+    const fs::path out = tmp_.path() / "report";
+    const Result refused = atonlab({"analyze", study.string(), "--out", out.string(), "--quiet"}, tmp_.path());
+    ASSERT_EQ(refused.code, 4) << refused.err;
+    EXPECT_TRUE(contains(refused.err, "--salvage")) << refused.err;
+
+    const Result r = atonlab(
+        {"analyze", study.string(), "--out", out.string(), "--quiet", "--salvage", "--bootstrap", "0"}, tmp_.path());
+    ASSERT_TRUE(r.code == 0 || r.code == 5) << r.err;  // 5: figures missing without gnuplot
+    EXPECT_EQ(file_bytes(study), before) << "salvage changed the damaged file";
+    EXPECT_TRUE(contains(r.err, "is damaged")) << r.err;
+
+    // summary.json: the damaged input before anything else.
+    const std::string summary = file_bytes(out / "summary.json");
+    const auto damaged_at = summary.find("\"damaged_inputs\"");
+    ASSERT_NE(damaged_at, std::string::npos) << summary.substr(0, 400);
+    EXPECT_LT(damaged_at, summary.find("\"software_version\""));
+    const auto first = summary.substr(damaged_at, summary.find(']', damaged_at) - damaged_at);
+    EXPECT_TRUE(contains(first, study.string())) << first;
+    // The trials on the lost leaf are counted unreadable, the others read:
+    // together the 9 that were stored.
+    const auto number_after = [&](const std::string& key) {
+        const auto at = first.find("\"" + key + "\":");
+        return at == std::string::npos ? -1 : std::stol(first.substr(at + key.size() + 3));
+    };
+    const long read = number_after("trials_read"), unreadable = number_after("trials_unreadable");
+    EXPECT_GT(read, 0) << first;
+    EXPECT_GT(unreadable, 0) << first;
+    EXPECT_EQ(read + unreadable, 9) << first;
+    EXPECT_EQ(number_after("sessions_read"), 3) << first;
+
+    // report.html: the first thing after the title.
+    const std::string html = file_bytes(out / "report.html");
+    const auto h1 = html.find("</h1>");
+    const auto warn = html.find("Damaged input");
+    ASSERT_NE(warn, std::string::npos);
+    EXPECT_LT(warn - h1, 60u) << html.substr(h1, 300);
+    EXPECT_TRUE(contains(html.substr(warn, 600), fmt::format("3 session(s) and {} trial(s) were read", read)))
+        << html.substr(warn, 600);
+}
+
+// --- Refusals of `run` leave nothing behind --------------------------------------
+
+TEST_F(StudyRefusals, EveryHeadlessRefusalOfRunLeavesNoFileAndChangesNone) {
+    const fs::path absent = tmp_.path() / "absent.db";
+    const fs::path existing = copy_of_good("existing.db");
+    const std::string before = file_bytes(existing);
+    const fs::path wide = kData / "run/billboard_too_wide.toml";
+
+    struct Case {
+        std::string name;
+        std::vector<std::string> extra;
+        fs::path protocol;
+        int code;
+        bool on_existing_only = false;
+    };
+    const std::vector<Case> cases{
+        {"billboard too wide for the display", {}, wide, 2},
+        {"--resume in a file that does not exist", {"--resume", "1"}, kTiny, 2},
+        {"--resume-last in a file that does not exist", {"--resume-last"}, kTiny, 2},
+        {"--resume of a session the file does not hold", {"--resume", "7"}, kTiny, 2, true},
+        {"--resume of a completed session", {"--resume", "1"}, kTiny, 2, true},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        for (const fs::path& db : {absent, existing}) {
+            if (c.on_existing_only && db == absent) continue;
+            std::vector<std::string> args{"run",       c.protocol.string(), "--db",
+                                          db.string(), "--headless",        "--model-observer"};
+            args.insert(args.end(), c.extra.begin(), c.extra.end());
+            const Result r = atonlab(args, tmp_.path());
+            EXPECT_EQ(r.code, c.code) << r.err;
+            EXPECT_FALSE(fs::exists(absent)) << "a refused session created " << absent;
+            EXPECT_FALSE(fs::exists(absent.string() + "-wal"));
+            EXPECT_EQ(file_bytes(existing), before) << "a refused session changed " << existing;
+        }
+    }
+
+    // Exit 3, no GL: EGL finds no driver (glvnd's vendor list points nowhere).
+    for (const fs::path& db : {absent, existing}) {
+        const fs::path out = tmp_.path() / "nogl.out", err = tmp_.path() / "nogl.err";
+        const pid_t pid = fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/egl_vendor.json", 1);
+            setenv("__EGL_VENDOR_LIBRARY_DIRS", "/nonexistent", 1);
+            setenv("EGL_PLATFORM", "surfaceless", 1);
+            const std::vector<std::string> a{ATONLAB_BINARY, "run",        kTiny.string(),    "--db",
+                                             db.string(),    "--headless", "--model-observer"};
+            _exit(test::wait_for(test::spawn_to_files(a, out, err, false, false)));
+        }
+        int status = 0;
+        ASSERT_EQ(waitpid(pid, &status, 0), pid);
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        if (code != 3) {
+            std::printf("[ skip ] the EGL vendor override did not take GL away (exit %d): %s\n", code,
+                        file_bytes(err).c_str());
+            if (db == absent && fs::exists(absent)) fs::remove(absent);
+            continue;
+        }
+        EXPECT_FALSE(fs::exists(absent)) << "a session without GL created " << absent;
+        EXPECT_EQ(file_bytes(existing), before) << "a session without GL changed " << existing;
+    }
+}
+
+// --- Two writers on one new file --------------------------------------------------
+
+TEST_F(StudyRefusals, TwoRunsStartedTogetherOnANewFileBothComplete) {
+    for (int round = 0; round < 20; ++round) {
+        SCOPED_TRACE("round " + std::to_string(round));
+        TempDir dir;
+        const fs::path db = dir.path() / "new.db";
+        const std::vector<std::string> args{ATONLAB_BINARY, "run",        kTiny.string(),     "--db",
+                                            db.string(),    "--headless", "--model-observer", "--quiet"};
+        const pid_t a = test::spawn_to_files(args, dir.path() / "a.out", dir.path() / "a.err", false, false);
+        const pid_t b = test::spawn_to_files(args, dir.path() / "b.out", dir.path() / "b.err", false, false);
+        EXPECT_EQ(test::wait_for(a), 0) << file_bytes(dir.path() / "a.err");
+        EXPECT_EQ(test::wait_for(b), 0) << file_bytes(dir.path() / "b.err");
+        RawDb raw(db, SQLITE_OPEN_READONLY);
+        EXPECT_EQ(raw.integer("SELECT count(*) FROM sessions WHERE status = 'completed'"), 2);
+        EXPECT_EQ(raw.integer("SELECT count(*) FROM trials"), 6);
+        EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
+    }
+}
+
+}  // namespace
+}  // namespace atonlab
