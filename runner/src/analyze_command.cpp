@@ -253,12 +253,12 @@ std::string command_line_text(const AnalyzeOptions& o) {
     return s;
 }
 
-/// A study-file error that is the input's fault (exit status 2) rather than
-/// the file system's (4).
+/// A study-file error that is the command line's fault (exit status 2: no such
+/// file, an argument out of range) rather than the file's (4: not a study
+/// file, a newer schema, damaged — refused as `run` and `calibrate` refuse it).
 bool is_bad_input(store::StoreErrc k) {
     using store::StoreErrc;
-    return k == StoreErrc::cannot_open || k == StoreErrc::not_a_database || k == StoreErrc::not_a_study ||
-           k == StoreErrc::newer_schema || k == StoreErrc::not_found || k == StoreErrc::invalid_argument;
+    return k == StoreErrc::cannot_open || k == StoreErrc::not_found || k == StoreErrc::invalid_argument;
 }
 
 }  // namespace

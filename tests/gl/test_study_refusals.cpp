@@ -123,7 +123,7 @@ protected:
 struct Damaged {
     std::string name;
     fs::path path;
-    bool damaged;  ///< damaged (analyze: exit 4, salvageable) rather than not a study (analyze: exit 2)
+    bool damaged;  ///< damaged (salvageable) rather than not a study file at all (both: exit 4)
 };
 
 TEST_F(StudyRefusals, DamagedAndForeignFilesAreRefusedByEveryCommandAndLeftUnchanged) {
@@ -189,7 +189,7 @@ TEST_F(StudyRefusals, DamagedAndForeignFilesAreRefusedByEveryCommandAndLeftUncha
 
         const fs::path out = tmp_.path() / "report";
         const Result an = atonlab({"analyze", f.path.string(), "--out", out.string(), "--quiet"}, tmp_.path(), "an");
-        EXPECT_EQ(an.code, f.damaged ? 4 : 2) << an.err;
+        EXPECT_EQ(an.code, 4) << an.err;
         expect_one_sentence_naming(an, f.path);
         EXPECT_FALSE(fs::exists(out / "report.html")) << "nothing is written for a refused input";
         EXPECT_EQ(file_bytes(f.path), before) << "analyze changed the refused file";
