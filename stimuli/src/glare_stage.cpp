@@ -177,10 +177,8 @@ struct GlareStage::Impl {
                 // pupil_mm already holds the hippus of time_s (prepare()); applied once.
                 eye.hippus.enabled = false;
                 eye.validate(gs.psf_size);
-                const double dpt = psf_degrees_per_texel(eye);
-                const auto field = pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
                 GpuPsfGenerator& gen = generator_for(gs.psf_size);
-                gen.generate(field, dpt, samples);
+                gen.generate(eye, samples, time_s);
                 g.psf = gen.read_rgb();
                 break;
             }
@@ -314,8 +312,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     for (const Particles* p : {&e.lens_particles, &e.vitreous_particles})
         add(p->enabled, p->count, p->diameter_um, p->diameter_spread, p->opacity, p->spread_radius_mm);
     add(e.eyelashes.enabled, e.eyelashes.count, e.eyelashes.width_um, e.eyelashes.reach_mm, e.eyelashes.max_tilt_deg);
-    add(e.eyelid.enabled, e.eyelid.edge_mm, e.fresnel_distance_mm, e.plane_width_mm, e.halo_radius_deg.value_or(-1),
-        e.seed, e.supersampling);
+    add(e.eyelid.enabled, e.eyelid.edge_mm, e.defocus_diopters, static_cast<int>(e.scale), e.plane_width_mm,
+        e.halo_radius_deg.value_or(-1), e.seed, e.supersampling);
 
     // The largest projected radius each group needs (lights in front whose glare can reach the image).
     std::vector<double> need(m.order.size(), 0.0);

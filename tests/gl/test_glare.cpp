@@ -37,7 +37,7 @@ EyeModel small_eye() {
     e.pupil_diameter_mm = 6.0;
     e.gratings.enabled = false;
     e.halo_radius_deg.reset();
-    e.fresnel_distance_mm = 2000.0;
+    e.defocus_diopters = 0.5;
     return e;
 }
 
@@ -65,27 +65,26 @@ TEST_F(GlarePsf, GpuMonoAndRgbMatchTheirCpuReferences) {
 }
 
 TEST_F(GlarePsf, DefaultEyeAtN512MatchesCpuAndIsBitIdenticalForASeed) {
-    EyeModel eye;  // the default eye: gratings, particles, E; halo at 4°
+    EyeModel eye;  // the default eye: two scales, gratings, particles, in focus; halo at 4°
     eye.pupil_diameter_mm = 6.0;
     const int n = 512;
     const SpectralSamples samples = spectral_samples(d65_spectrum(), 30);
     GpuPsfGenerator gen(n);
-    const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
-    gen.generate(field, psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     const RgbPsf first = gen.read_rgb();
-    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     const RgbPsf second = gen.read_rgb();
     ASSERT_EQ(first.rgb.size(), second.rgb.size());
     EXPECT_TRUE(first.rgb == second.rgb) << "same seed, same machine: the PSF must be bit-identical";
     const RgbPsf cpu = spectral_psf_resampled(mono_psf_reference(eye, n, kReferenceWavelengthNm), samples);
     EXPECT_LT(stimuli::relative_l2(first, cpu), 1e-4);
-    // The scale puts the lenticular halo's outer edge at 4°: dpt = 4° / (count/(2π r0) · W).
-    EXPECT_NEAR(first.degrees_per_texel,
-                4.0 / (eye.gratings.count / (2 * std::numbers::pi * eye.gratings.inner_radius_mm) * eye.plane_width_mm),
+    // The scale puts the ring diffracted by the gratings at the pupil's edge
+    // (r = 3 mm) at 4°: dpt = 4° / (count/(2π r) · W).
+    EXPECT_NEAR(first.degrees_per_texel, 4.0 / (eye.gratings.count / (2 * std::numbers::pi * 3.0) * eye.plane_width_mm),
                 1e-9);
     // A different seed draws a different eye.
     eye.seed = 2;
-    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     EXPECT_FALSE(gen.read_rgb().rgb == first.rgb);
 }
 

@@ -468,7 +468,10 @@ TEST(SceneFileGlare, BadGlareInputNamesTheKey) {
     expect_error_at(glare + "spencer_vision = \"owl\"\n", 7, "glare.spencer_vision", "unknown vision");
     expect_error_at(glare + "aperture_image = \"no-such-lashes.png\"\n", 7, "glare.aperture_image", "does not exist");
     expect_error_at(glare + "grating_count = -1\n", 7, "glare.grating_count", "between");
-    expect_error_at(glare + "fresnel_distance_mm = 24\n", 6, "glare", "fresnel_distance_mm");
+    // The old key names the new one; a defocus the grid cannot sample says why, at its line.
+    expect_error_at(glare + "fresnel_distance_mm = 24\n", 7, "glare.fresnel_distance_mm", "defocus_diopters");
+    expect_error_at(glare + "defocus_diopters = -30\n", 7, "glare.defocus_diopters", "more than π between texels");
+    expect_error_at(glare + "eye_preset = \"k2013\"\n", 7, "glare.eye_preset", "unknown eye preset");
     expect_error_at(glare + "sparkle = 1\n", 7, "glare.sparkle", "unknown key");
 }
 
