@@ -223,7 +223,11 @@ void GpuPsfGenerator::generate(const EyeModel& eye, const SpectralSamples& sampl
                  psf_degrees_per_texel(eye), samples);
         return;
     }
-    generate(mono_psf_reference(eye, impl_->n, kReferenceWavelengthNm, time_s), samples);
+    const auto t0 = std::chrono::steady_clock::now();
+    const MonoPsf mono = mono_psf_reference(eye, impl_->n, kReferenceWavelengthNm, time_s);
+    const double cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    generate(mono, samples);
+    impl_->last.fft_ms = cpu_ms;  // the CPU's pupil planes, FFTs and binning
 }
 
 MonoPsf GpuPsfGenerator::read_mono() const {

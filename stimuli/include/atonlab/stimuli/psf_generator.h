@@ -13,7 +13,8 @@
 namespace atonlab::stimuli {
 
 /// GPU time of the last generate() per stage (ms), from timer queries (fft_ms:
-/// the CPU's steady clock when the FFT ran on the CPU).
+/// the CPU's steady clock when the FFT ran on the CPU; for a two-scale eye, the
+/// CPU's whole mono PSF: pupil planes, FFTs and binning).
 struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
 };
