@@ -647,7 +647,9 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
 }
 
 /// The [glare] table: the glare stage's settings and the eye model (docs/scene-file.md).
-void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
+/// pupil_mm: the pupil the scene's frames will use (fixed adaptation), or the
+/// darkest eq 3.15 gives (dynamic), for the checks that depend on it.
+void read_glare(const Document& doc, const Section& root, GlareSettings& g, double pupil_mm) {
     const toml::table* t = sub_table(root, "glare", "[glare]");
     if (t == nullptr) return;
     Section s(doc, *t, "glare", "the [glare] table");
@@ -736,10 +738,13 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
     e.eyelashes.width_um = s.number_or("eyelash_width_um", e.eyelashes.width_um);
     e.eyelid.enabled = s.boolean("eyelid").value_or(e.eyelid.enabled);
     e.eyelid.edge_mm = s.number_or("eyelid_edge_mm", e.eyelid.edge_mm);
-    // The eye model's own checks (the pupil is checked per frame, where it is known).
+    // The eye model's own checks (the pupil itself is checked per frame, where
+    // hippus has moved it): with the scene's pupil within half the plane, so
+    // that a defocus the frames' grid cannot sample is refused here, at its line.
     try {
         EyeModel probe = e;
-        probe.pupil_diameter_mm = std::min(probe.pupil_diameter_mm, 0.25 * probe.plane_width_mm);
+        probe.pupil_diameter_mm = std::min(pupil_mm, 0.5 * probe.plane_width_mm);
+        probe.hippus.enabled = false;
         probe.validate(g.psf_size);
     } catch (const InputError& err) {
         const std::string key = err.where() ? err.where()->key : std::string();
@@ -1014,7 +1019,14 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     scene.environment = read_environment(doc, root);
     scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation);
     scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
-    read_glare(doc, root, scene.glare);
+    // The pupil the glare stage will use (glare_stage.h glare_pupil_mm): given,
+    // or eq 3.15 from the fixed adaptation, or the dark-adapted 7.9 mm when the
+    // adaptation follows the frame.
+    const double pupil_mm = scene.glare.pupil_mm ? *scene.glare.pupil_mm
+                            : scene.output.adaptation.mode == AdaptationMode::dynamic
+                                ? pupil_diameter_mm_from_adaptation(0.0)
+                                : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
+    read_glare(doc, root, scene.glare, pupil_mm);
     read_output(doc, root, scene.output);
     const Profiles profiles = read_profiles(doc, root);
 
