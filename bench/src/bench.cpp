@@ -6,8 +6,10 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
+#include <stdexcept>
 
 #include "atonlab/stimuli/error.h"
 #include "bench_common.h"
@@ -34,6 +36,7 @@ const Entry kBenches[] = {
     {"tonemap", bench_tonemap},
     {"display_skips", bench_display_skips},
     {"lights", bench_lights},
+    {"eye_validation", bench_eye_validation},
 };
 
 }  // namespace
@@ -63,7 +66,7 @@ BenchSummary run_bench(const BenchOptions& options, const gl::ContextInfo& conte
     // Described before the run: the date and the load average are the start's.
     const Machine m = describe_machine(options.device_label, context.vendor, context.renderer, context.version,
                                        context.platform, context.software, options.quick);
-    Bench b{options, {}, {}, {}};
+    Bench b{options, {}, {}, {}, {}};
     const auto started = std::chrono::steady_clock::now();
     for (const Entry& e : kBenches) {
         if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), e.name) == options.only.end())
@@ -91,6 +94,11 @@ BenchSummary run_bench(const BenchOptions& options, const gl::ContextInfo& conte
         "The whole bench took {:.0f} s.",
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     write_markdown(path("bench.md"), m, b.rows, b.points, b.scaling_notes);
+    for (const auto& [name, text] : b.documents) {
+        std::ofstream f(path(name.c_str()));
+        f << text;
+        if (!f) throw std::runtime_error(fmt::format("cannot write {}.", summary.files.back()));
+    }
     if (options.plots) {
         summary.plotted = write_plots(options.out_dir, b.rows, b.points);
         if (summary.plotted) {

@@ -3,6 +3,7 @@
 // and the error metrics.
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atonlab/bench/bench.h"
@@ -17,6 +18,8 @@ struct Bench {
     std::vector<Row> rows;
     std::vector<ScalePoint> points;
     std::vector<std::string> scaling_notes;
+    /// Further files a bench writes into the output directory: (name, Markdown).
+    std::vector<std::pair<std::string, std::string>> documents;
 
     bool quick() const { return options.quick; }
     /// Repeats: two in the quick form.
@@ -73,5 +76,6 @@ void bench_adaptation_stride(Bench& b);
 void bench_tonemap(Bench& b);
 void bench_display_skips(Bench& b);
 void bench_lights(Bench& b);
+void bench_eye_validation(Bench& b);
 
 }  // namespace atonlab::bench

@@ -27,8 +27,8 @@ namespace {
 constexpr int kDefaultN = 512;       // GlareSettings::psf_size
 constexpr int kDefaultSamples = 30;  // GlareSettings::spectral_samples
 
-/// The eye the PSF benches use: the default eye (gratings, particles, E, halo
-/// at 4°) with a night pupil.
+/// The eye the PSF benches use: the default eye (two scales, in focus,
+/// gratings, particles, halo at 4°) with a night pupil.
 EyeModel bench_eye() {
     EyeModel e;
     e.pupil_diameter_mm = 6.0;
@@ -81,8 +81,7 @@ void bench_psf_size(Bench& b) {
         const TimeSpec spec = n >= 2048 ? TimeSpec{1, 3, false} : b.spec(5, false);
         const Timing t = measure(
             [&] {
-                const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
-                gen.generate(field, dpt, samples);
+                gen.generate(eye, samples);
                 kernel = glare_kernel_from_psf(gen.read_rgb(), ppd, radius, GlareWindow::silverman);
                 const PsfGpuTimings g = gen.timings();
                 return g.upload_ms + g.fft_ms + g.mono_ms + g.spectral_ms;
@@ -141,10 +140,9 @@ void spectral_path_for(Bench& b, const EyeModel& eye, const std::string& bench, 
     b.add(a);
 
     GpuPsfGenerator gen(n);
-    const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
     const Timing fast = measure(
         [&] {
-            gen.generate(field, psf_degrees_per_texel(eye), samples);
+            gen.generate(eye, samples);
             return -1.0;
         },
         b.spec(5, false));
@@ -180,14 +178,12 @@ void bench_spectral_samples(Bench& b) {
     const EyeModel eye = bench_eye();
     const MonoPsf mono = mono_psf_reference(eye, n, kReferenceWavelengthNm);
     const RgbPsf ref = spectral_psf_resampled(mono, spectral_samples(d65_spectrum(), k_ref));
-    const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
-    const double dpt = psf_degrees_per_texel(eye);
     GpuPsfGenerator gen(n);
     for (int k : counts) {
         const SpectralSamples samples = spectral_samples(d65_spectrum(), k);
         const Timing t = measure(
             [&] {
-                gen.generate(field, dpt, samples);
+                gen.generate(mono, samples);
                 return gen.timings().spectral_ms;
             },
             b.spec(7, false));
@@ -206,11 +202,11 @@ void bench_spectral_samples(Bench& b) {
     }
     // The fast path itself against the exact per-wavelength path.
     spectral_path_for(b, eye, "spectral_path", "");
-    // The Fresnel term E (eq 4.6) depends on the wavelength, which eq 4.9's
-    // rescaling cannot follow; without it only the resampling is left.
-    EyeModel no_e = bench_eye();
-    no_e.fresnel_distance_mm = 0.0;
-    spectral_path_for(b, no_e, "spectral_path_no_E", "; E off");
+    // The k2012 preset's Fresnel term E (eq 4.6) depends on the wavelength,
+    // which eq 4.9's rescaling cannot follow; the default eye is in focus.
+    EyeModel k2012 = EyeModel::k2012();
+    k2012.pupil_diameter_mm = bench_eye().pupil_diameter_mm;
+    spectral_path_for(b, k2012, "spectral_path_k2012", "; k2012 preset (E on)");
 }
 
 void bench_fft(Bench& b) {
@@ -346,8 +342,7 @@ void bench_area_layers(Bench& b) {
     const double ppd = default_display().pixels_per_degree_at_centre();
     const double dpt = psf_degrees_per_texel(eye);
     GpuPsfGenerator gen(n);
-    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), dpt,
-                 spectral_samples(d65_spectrum(), kDefaultSamples));
+    gen.generate(eye, spectral_samples(d65_spectrum(), kDefaultSamples));
     const GlareKernel kernel =
         glare_kernel_from_psf(gen.read_rgb(), ppd, glare_radius_deg(n, dpt), GlareWindow::silverman);
     // Radii between the layers: the exact disc convolution at r is the second

@@ -27,6 +27,7 @@ struct PsfOptions {
     std::optional<double> pupil_mm;
     std::optional<double> adaptation_cd_m2;
     std::string scene;
+    std::optional<std::string> eye_preset;
     bool clear = false;
     std::string spd = "d65";
     int size = 512;

@@ -30,7 +30,10 @@ void add_psf_command(CLI::App& app, PsfOptions& o) {
                                   "Adaptation luminance (cd/m²) giving the pupil by K2012 eq 3.15 (default 0.001)");
     pupil->excludes(adapt);
     cmd->add_option("--scene", o.scene, "Take the eye model from this scene's [glare] table");
-    cmd->add_flag("--clear", o.clear, "A clear circular pupil: no obstacles, no Fresnel term, physical scale");
+    cmd->add_option("--eye-preset", o.eye_preset,
+                    "Eye preset: focused (default: two angular scales, in focus) or k2012 (the thesis's single scale "
+                    "and Fresnel term); replaces the scene's eye");
+    cmd->add_flag("--clear", o.clear, "A clear circular pupil: no obstacles, in focus, physical scale");
     cmd->add_option("--spd", o.spd, "Spectrum to integrate the PSF with (default d65; see docs/scene-file.md)");
     cmd->add_option("--size", o.size, "PSF size N (a power of two, 16 .. 2048; default 512)");
     cmd->add_option("--samples", o.samples, "Spectral samples (1 .. 128; default 30)");
@@ -75,6 +78,16 @@ int run_psf(const PsfOptions& o) {
     // Validate everything before touching the GPU or the output paths.
     stimuli::EyeModel eye;
     if (!o.scene.empty()) eye = stimuli::load_scene(o.scene, {}).glare.eye;
+    if (o.eye_preset) {
+        const std::optional<stimuli::EyeModel> named = stimuli::eye_preset(*o.eye_preset);
+        if (!named) {
+            std::string names;
+            for (const auto& n : stimuli::eye_preset_names()) names += (names.empty() ? "" : ", ") + n;
+            throw InputError(SourceLocation{"--eye-preset", 0, 0, ""},
+                             fmt::format("unknown eye preset \"{}\"; presets are {}.", *o.eye_preset, names));
+        }
+        eye = *named;
+    }
     if (o.seed) eye.seed = *o.seed;
     double pupil = 0;
     if (o.pupil_mm) {
@@ -126,8 +139,7 @@ int run_psf(const PsfOptions& o) {
     auto context = gl::create_headless_context();
     stimuli::GpuPsfGenerator gen(o.size);
     const double dpt = stimuli::psf_degrees_per_texel(eye);
-    gen.generate(stimuli::pupil_plane(eye, o.size, stimuli::kReferenceWavelengthNm, eye.plane_width_mm, o.time_s), dpt,
-                 samples);
+    gen.generate(eye, samples, o.time_s);
     const stimuli::MonoPsf mono = gen.read_mono();
     // The RGB PSF by the default spectral path (docs/glare.md "The spectral path").
     const int anchors = stimuli::GlareSettings{}.spectral_anchors;
@@ -143,7 +155,9 @@ int run_psf(const PsfOptions& o) {
     meta.strings["software"] = "atonlab " ATONLAB_VERSION;
     meta.strings["pupil_mm"] = fmt::format("{}", pupil);
     meta.strings["seed"] = fmt::format("{}", eye.seed);
-    meta.strings["eye"] = o.clear ? "clear pupil" : (o.scene.empty() ? "default" : o.scene);
+    meta.strings["eye"] = o.clear        ? "clear pupil"
+                          : o.eye_preset ? *o.eye_preset
+                                         : (o.scene.empty() ? "default" : o.scene);
     meta.strings["normalisation"] = "each PSF sums to 1 (RGB: its luminance 0.2126 R + 0.7152 G + 0.0722 B)";
     stimuli::ExrMetadata rgb_meta = meta;
     rgb_meta.strings["spd"] = o.spd;

@@ -1,7 +1,8 @@
 // The eye model of the wave-optics glare (K2012 §4.2.1): pupil size from
 // adaptation (eq 3.15), pupillary hippus (eq 4.7), the seeded obstacle geometry,
-// its area-sampled pupil-plane image times the Fresnel term E (eq 4.6), and
-// Spencer et al.'s analytic PSF for comparison.
+// its area-sampled pupil-plane image times the defocus phase (eq 4.6's E), its
+// split into core and scatter (docs/glare.md), and Spencer et al.'s analytic
+// PSF for comparison.
 //
 // Determinism: every random number comes from SplitMix64 (Steele, Lea & Flood
 // 2014) with our own conversion to doubles, never from <random>'s
@@ -17,6 +18,7 @@
 #include <cstddef>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #include "atonlab/stimuli/error.h"
 
@@ -236,9 +238,29 @@ EyeModel EyeModel::clear_pupil(double diameter_mm) {
     e.vitreous_particles.enabled = false;
     e.eyelashes.enabled = false;
     e.eyelid.enabled = false;
-    e.fresnel_distance_mm = 0.0;
+    e.defocus_diopters = 0.0;
     e.halo_radius_deg = std::nullopt;
     return e;
+}
+
+EyeModel EyeModel::k2012() {
+    EyeModel e;
+    e.scale = EyeScale::k2012_single;
+    // The Fresnel distance this code used before the split, d = 5000 mm (K2012
+    // §5.2 leaves d open; Trester's λd = N texel² gives ~1100 mm at N = 512,
+    // which blurs the stretched core to ~1.8°): ΔD = 1/d.
+    e.defocus_diopters = 1.0 / 5.0;
+    return e;
+}
+
+std::optional<EyeModel> eye_preset(std::string_view name) {
+    if (name == "focused") return EyeModel{};
+    if (name == "k2012") return EyeModel::k2012();
+    return std::nullopt;
+}
+
+std::vector<std::string> eye_preset_names() {
+    return {"focused", "k2012"};
 }
 
 void EyeModel::validate(int n) const {
@@ -271,10 +293,20 @@ void EyeModel::validate(int n) const {
     if (!std::isfinite(eyelid.edge_mm))
         refuse("eyelid.edge_mm", fmt::format("eyelid.edge_mm must be a finite number of mm, got {}.", eyelid.edge_mm));
 
-    require_non_negative("fresnel_distance_mm", fresnel_distance_mm, " mm (0 turns E off)");
+    if (!std::isfinite(defocus_diopters))
+        refuse("defocus_diopters",
+               fmt::format("defocus_diopters must be a finite number of diopters, got {}.", defocus_diopters));
     require_positive("plane_width_mm", plane_width_mm, " mm");
     if (halo_radius_deg && (!(*halo_radius_deg > 0) || !(*halo_radius_deg < 90)))
         refuse("halo_radius_deg", fmt::format("halo_radius_deg must be in (0°, 90°), got {}°.", *halo_radius_deg));
+    // The two-scale eye only widens the scatter: its grid must be at least as
+    // coarse as the core's, or the core would not fit onto it.
+    if (scale == EyeScale::two_scales && angular_scale(*this) < 1.0)
+        refuse("halo_radius_deg",
+               fmt::format("halo_radius_deg = {}° lies inside the ring the gratings diffract to at their physical "
+                           "scale ({:.3g}°); the two-scale eye can only widen the scatter, so give at least that, "
+                           "or 0 for the physical scale.",
+                           *halo_radius_deg, *halo_radius_deg / angular_scale(*this)));
     if (supersampling < 1)
         refuse("supersampling",
                fmt::format("supersampling must be at least 1 sample per texel per axis, got {}.", supersampling));
@@ -289,17 +321,16 @@ void EyeModel::validate(int n) const {
                            "widen plane_width_mm or shrink the pupil.",
                            largest, hippus.enabled ? " at its hippus maximum" : "", plane_width_mm));
 
-    // E's phase π r²/(λ d) grows by 2π r h/(λ d) per texel at radius r; past π
-    // between neighbouring texels at the pupil edge, E is undersampled.
-    if (fresnel_distance_mm > 0) {
-        const double step =
-            2 * pi * (0.5 * largest) * (plane_width_mm / n) / (reference_wavelength_mm * fresnel_distance_mm);
-        if (step > pi)
-            refuse("fresnel_distance_mm",
-                   fmt::format("at {} mm the Fresnel phase changes by {:.3g} rad between texels at the pupil edge "
-                               "(more than π) at size {}; use a longer distance, a larger size, or 0 to turn E off.",
-                               fresnel_distance_mm, step, n));
-    }
+    // The defocus phase π ΔD r²/λ grows by 2π ΔD r h/λ per texel at radius r;
+    // past π between neighbouring texels at the pupil's edge it is undersampled.
+    const double limit = max_defocus_diopters(*this, n);
+    if (std::abs(defocus_diopters) > limit)
+        refuse("defocus_diopters",
+               fmt::format("{} D of defocus cannot be sampled at size {} for a {} mm pupil: its phase would change by "
+                           "more than π between texels at the pupil's edge (and its blur disc, p·ΔD/2 = {:.3g}°, "
+                           "would overflow the grid); at most ±{:.3g} D here, or raise the size.",
+                           defocus_diopters, n, largest, 0.5 * largest * 1e-3 * std::abs(defocus_diopters) * 180 / pi,
+                           limit));
 }
 
 double pupil_diameter_mm_at(const EyeModel& eye, double time_s) {
@@ -320,13 +351,37 @@ double pupil_diameter_mm_at(const EyeModel& eye, double time_s) {
 double angular_scale(const EyeModel& eye) {
     const LensGratings& g = eye.gratings;
     if (!g.enabled || !eye.halo_radius_deg || g.count <= 0 || !(g.inner_radius_mm > 0)) return 1.0;
-    // The grating's outer halo edge λ0·count/(2π r_inner) (rad) is moved to halo_radius_deg.
-    const double edge_rad = reference_wavelength_mm * g.count / (2 * pi * g.inner_radius_mm);
-    return (*eye.halo_radius_deg * pi / 180.0) / edge_rad;
+    // A radial grating of `count` lines has spacing 2πr/count at radius r and
+    // diffracts λ0 to λ0·count/(2πr) rad. k2012_single moves its outer edge
+    // (r = inner_radius_mm) to halo_radius_deg, as K2012 §4.2 does.
+    // two_scales moves the ring from the pupil's edge instead: the per-steradian
+    // intensity there is highest (the annulus at r holds energy ∝ r dr and
+    // spreads it over a solid angle ∝ dr/r³), so that ring is the halo's radius
+    // (docs/glare.md). Without gratings inside the pupil, the inner radius again.
+    double r_mm = g.inner_radius_mm;
+    if (eye.scale == EyeScale::two_scales) r_mm = std::max(r_mm, 0.5 * eye.pupil_diameter_mm);
+    const double ring_rad = reference_wavelength_mm * g.count / (2 * pi * r_mm);
+    return (*eye.halo_radius_deg * pi / 180.0) / ring_rad;
 }
 
 double psf_degrees_per_texel(const EyeModel& eye) {
     return angular_scale(eye) * reference_wavelength_mm / eye.plane_width_mm * 180.0 / pi;
+}
+
+bool has_two_scales(const EyeModel& eye) {
+    return eye.scale == EyeScale::two_scales && angular_scale(eye) != 1.0;
+}
+
+double core_degrees_per_texel(const EyeModel& eye) {
+    if (!has_two_scales(eye)) return psf_degrees_per_texel(eye);
+    return reference_wavelength_mm / eye.plane_width_mm * 180.0 / pi;
+}
+
+double max_defocus_diopters(const EyeModel& eye, int n) {
+    // 2π |ΔD| (p/2) h / λ ≤ π with h = W/n (all in metres): |ΔD| ≤ λ n / (p W).
+    // The exact path's plane W·λ/λ0 gives the same bound at every λ.
+    const double p_m = largest_pupil_mm(eye) * 1e-3;
+    return kReferenceWavelengthNm * 1e-9 * n / (p_m * eye.plane_width_mm * 1e-3);
 }
 
 EyeGeometry eye_geometry(const EyeModel& eye) {
@@ -453,9 +508,9 @@ ComplexImage<double> pupil_plane(const EyeModel& eye, int n, double wavelength_n
                     grid.capsules[grid.index(tx, ty)].push_back(id);
     }
 
-    // ---- E = exp(iπ r²/(λ d)), K2012 eq 4.6 ----
-    const double d = eye.fresnel_distance_mm;
-    const double phase_per_mm2 = d > 0 ? pi / (wavelength_nm * mm_per_nm * d) : 0.0;
+    // ---- defocus exp(iπ ΔD r²/λ): K2012 eq 4.6's E = exp(iπ r²/(λ d)) with d = 1/ΔD ----
+    // ΔD in 1/m = 1e-3/mm, r in mm, λ in mm.
+    const double phase_per_mm2 = pi * eye.defocus_diopters * 1e-3 / (wavelength_nm * mm_per_nm);
     const std::optional<double> lid = geo.eyelid_edge_mm;
 
     for (int j = first; j <= last; ++j) {
@@ -503,6 +558,37 @@ ComplexImage<double> pupil_plane(const EyeModel& eye, int n, double wavelength_n
         }
     }
     return image;
+}
+
+PupilParts pupil_parts(const EyeModel& eye, int n, double wavelength_nm, double plane_width_mm, double time_s) {
+    // P in focus: the obstacles' transmittance over the aperture.
+    EyeModel focused = eye;
+    focused.defocus_diopters = 0.0;
+    ComplexImage<double> p = pupil_plane(focused, n, wavelength_nm, plane_width_mm, time_s);
+    // A·E: the aperture alone (the pupil disc with hippus, and the eyelid, which
+    // shapes the aperture rather than scattering), with the defocus.
+    EyeModel aperture = eye;
+    aperture.gratings.enabled = false;
+    aperture.lens_particles.enabled = false;
+    aperture.vitreous_particles.enabled = false;
+    aperture.eyelashes.enabled = false;
+    PupilParts parts{pupil_plane(aperture, n, wavelength_nm, plane_width_mm, time_s), std::move(p), 1.0};
+
+    // t = Σ P·A / Σ A²: the projection of P on A (A = |A·E|, P real), which
+    // makes P − t·A orthogonal to A and hence to A·E's energy.
+    double pa = 0, aa = 0;
+    for (std::size_t i = 0; i < parts.core.data.size(); ++i) {
+        const double a = std::abs(parts.core.data[i]);
+        pa += parts.scatter.data[i].real() * a;
+        aa += a * a;
+    }
+    const double t = aa > 0 ? pa / aa : 0.0;
+    parts.mean_transmittance = t;
+    for (std::size_t i = 0; i < parts.core.data.size(); ++i) {
+        parts.scatter.data[i] -= t * std::abs(parts.core.data[i]);
+        parts.core.data[i] *= t;
+    }
+    return parts;
 }
 
 double spencer_psf(double theta_deg, double wavelength_nm, SpencerVision vision) {

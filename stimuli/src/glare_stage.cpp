@@ -230,17 +230,15 @@ struct GlareStage::Impl {
                 eye.hippus.enabled = false;
                 eye.validate(gs.psf_size);
                 switch (gs.spectral_path) {
-                    case SpectralPath::anchored:  // docs/glare.md "The spectral path": FFTW double on the CPU
+                    case SpectralPath::anchored:  // docs/glare.md "The spectral path": FFTW on the CPU
                         g.psf = spectral_psf_anchored(eye, gs.psf_size, samples, gs.spectral_anchors, time_s);
                         break;
                     case SpectralPath::exact:
                         g.psf = spectral_psf_exact(eye, gs.psf_size, samples, time_s);
                         break;
-                    case SpectralPath::rescaled: {  // K2012 eq 4.9 on the GPU
-                        const auto field =
-                            pupil_plane(eye, gs.psf_size, kReferenceWavelengthNm, eye.plane_width_mm, time_s);
+                    case SpectralPath::rescaled: {  // K2012 eq 4.9 (on the GPU for a single-scale eye)
                         GpuPsfGenerator& gen = generator_for(gs.psf_size);
-                        gen.generate(field, psf_degrees_per_texel(eye), samples);
+                        gen.generate(eye, samples, time_s);
                         g.psf = gen.read_rgb();
                         break;
                     }
@@ -379,8 +377,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     for (const Particles* p : {&e.lens_particles, &e.vitreous_particles})
         add(p->enabled, p->count, p->diameter_um, p->diameter_spread, p->opacity, p->spread_radius_mm);
     add(e.eyelashes.enabled, e.eyelashes.count, e.eyelashes.width_um, e.eyelashes.reach_mm, e.eyelashes.max_tilt_deg);
-    add(e.eyelid.enabled, e.eyelid.edge_mm, e.fresnel_distance_mm, e.plane_width_mm, e.halo_radius_deg.value_or(-1),
-        e.seed, e.supersampling);
+    add(e.eyelid.enabled, e.eyelid.edge_mm, e.defocus_diopters, static_cast<int>(e.scale), e.plane_width_mm,
+        e.halo_radius_deg.value_or(-1), e.seed, e.supersampling);
 
     // The largest projected radius each group needs (lights in front whose glare can reach the image).
     std::vector<double> need(m.order.size(), 0.0);

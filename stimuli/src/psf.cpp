@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "atonlab/stimuli/error.h"
 
@@ -60,9 +61,100 @@ MonoPsf mono_psf_from_spectrum(const ComplexImage<double>& F, double degrees_per
     return p;
 }
 
-MonoPsf mono_psf_reference(const EyeModel& eye, int n, double wavelength_nm, double time_s) {
+namespace {
+
+// |F|², centred (eq 4.8), unnormalised.
+std::vector<double> centred_power(const ComplexImage<double>& F) {
+    const int n = F.n, h = n / 2;
+    std::vector<double> out(F.data.size());
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            out[static_cast<std::size_t>((y + h) % n) * n + (x + h) % n] = std::norm(F.at(x, y));
+    return out;
+}
+
+double sum_of(const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return s;
+}
+
+// The coarse texels (index, share of the fine texel) that fine texel k
+// overlaps on one axis: its square [u - r/2, u + r/2] in coarse units, u its
+// centre, against coarse texel m's [m - 1/2, m + 1/2].
+struct AxisShare {
+    int first = 0;
+    std::vector<double> share;
+};
+std::vector<AxisShare> axis_shares(int n_fine, int n_coarse, double ratio) {
+    std::vector<AxisShare> out(static_cast<std::size_t>(n_fine));
+    for (int k = 0; k < n_fine; ++k) {
+        const double u = n_coarse / 2 + (k - n_fine / 2) * ratio;
+        const double lo = u - 0.5 * ratio, hi = u + 0.5 * ratio;
+        AxisShare& a = out[static_cast<std::size_t>(k)];
+        a.first = static_cast<int>(std::floor(lo + 0.5));
+        for (int m = a.first; m - 0.5 < hi; ++m) {
+            const double overlap = std::min(hi, m + 0.5) - std::max(lo, m - 0.5);
+            a.share.push_back(std::max(overlap, 0.0) / ratio);
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+void bin_into(const MonoPsf& fine, double weight, MonoPsf& coarse) {
+    const double ratio = fine.degrees_per_texel / coarse.degrees_per_texel;
+    const std::vector<AxisShare> shares = axis_shares(fine.n, coarse.n, ratio);
+    for (int y = 0; y < fine.n; ++y) {
+        const AxisShare& sy = shares[static_cast<std::size_t>(y)];
+        for (int x = 0; x < fine.n; ++x) {
+            const double v = weight * fine.at(x, y);
+            if (v == 0) continue;
+            const AxisShare& sx = shares[static_cast<std::size_t>(x)];
+            for (std::size_t b = 0; b < sy.share.size(); ++b) {
+                const int cy = sy.first + static_cast<int>(b);
+                if (cy < 0 || cy >= coarse.n) continue;  // beyond the coarse grid: cannot happen for ratio ≤ 1
+                for (std::size_t a = 0; a < sx.share.size(); ++a) {
+                    const int cx = sx.first + static_cast<int>(a);
+                    if (cx < 0 || cx >= coarse.n) continue;
+                    coarse.value[static_cast<std::size_t>(cy) * coarse.n + cx] += v * sy.share[b] * sx.share[a];
+                }
+            }
+        }
+    }
+}
+
+MonoPsfParts mono_psf_parts(const EyeModel& eye, int n, double wavelength_nm, double time_s) {
     // The plane scales with λ so that λ/W_λ = λ0/W: every wavelength's FFT
     // lands on λ0's angular grid (the exact path of §4.2.4's approximation).
+    const double w = eye.plane_width_mm * wavelength_nm / kReferenceWavelengthNm;
+    PupilParts fields = pupil_parts(eye, n, wavelength_nm, w, time_s);
+    fftw_forward(fields.core);
+    fftw_forward(fields.scatter);
+    MonoPsfParts out;
+    out.core = {n, core_degrees_per_texel(eye), wavelength_nm, centred_power(fields.core)};
+    out.scatter = {n, psf_degrees_per_texel(eye), wavelength_nm, centred_power(fields.scatter)};
+    // Parseval: Σ|F|² = n² Σ|field|² for both, so their raw sums are in the
+    // proportion of the pupil-plane energies; one factor keeps it.
+    const double core_sum = sum_of(out.core.value), scatter_sum = sum_of(out.scatter.value);
+    const double total = core_sum + scatter_sum;
+    if (total > 0) {
+        out.core_fraction = core_sum / total;
+        for (double& v : out.scatter.value) v /= total;
+        if (core_sum > 0)
+            for (double& v : out.core.value) v /= core_sum;
+    }
+    return out;
+}
+
+MonoPsf mono_psf_reference(const EyeModel& eye, int n, double wavelength_nm, double time_s) {
+    if (has_two_scales(eye)) {
+        MonoPsfParts parts = mono_psf_parts(eye, n, wavelength_nm, time_s);
+        MonoPsf out = std::move(parts.scatter);
+        bin_into(parts.core, parts.core_fraction, out);
+        return out;
+    }
     const double w = eye.plane_width_mm * wavelength_nm / kReferenceWavelengthNm;
     ComplexImage<double> field = pupil_plane(eye, n, wavelength_nm, w, time_s);
     fftw_forward(field);

@@ -72,7 +72,50 @@ struct GpuPsfGenerator::Impl {
         sums.bind_storage(4);
     }
     static void barrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT); }
+
+    void check_samples(const SpectralSamples& samples) const {
+        const auto count = samples.wavelength_nm.size();
+        if (count < 1 || count > kMaxSpectralSamples)
+            throw InputError(SourceLocation{"", 0, 0, "spectral_samples"},
+                             fmt::format("the GPU spectral integration takes 1 to {} wavelength samples, not {}.",
+                                         kMaxSpectralSamples, count));
+    }
+    void downsample_mono() {
+        downsample.set("n", static_cast<unsigned>(n) / 2);
+        downsample.use();
+        glDispatchCompute(groups_for(static_cast<std::size_t>(n) * static_cast<std::size_t>(n) / 4), 1, 1);
+        barrier();
+    }
+    void spectral_stage(const SpectralSamples& samples);
 };
+
+// Spectral integration (eq 4.9-4.10), then unit luminance.
+void GpuPsfGenerator::Impl::spectral_stage(const SpectralSamples& samples) {
+    const auto texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+    const auto count = static_cast<int>(samples.wavelength_nm.size());
+    spectral.set("n", static_cast<unsigned>(n));
+    spectral.set("sample_count", count);
+    for (int s = 0; s < count; ++s) {
+        const double ratio = kReferenceWavelengthNm / samples.wavelength_nm[static_cast<std::size_t>(s)];
+        const glm::dvec3 w = samples.xyz_weight[static_cast<std::size_t>(s)] * ratio * ratio;
+        spectral.set(fmt::format("ratio[{}]", s), static_cast<float>(ratio));
+        spectral.set(fmt::format("weight[{}]", s), static_cast<float>(w.x), static_cast<float>(w.y),
+                     static_cast<float>(w.z));
+    }
+    const glm::mat3 xyz_to_rgb(rec709_xyz_to_rgb());
+    spectral.set_mat3("xyz_to_rgb", &xyz_to_rgb[0][0]);
+    spectral.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    barrier();
+    reduce_rgb.set("count", static_cast<unsigned>(texels));
+    reduce_rgb.use();
+    glDispatchCompute(1, 1, 1);
+    barrier();
+    scale_rgb.set("n", static_cast<unsigned>(n));
+    scale_rgb.use();
+    glDispatchCompute(groups_for(texels), 1, 1);
+    barrier();
+}
 
 GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles, PsfFftPlacement fft)
     : impl_(std::make_unique<Impl>(n, twiddles, fft)) {}
@@ -97,11 +140,7 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
         throw InputError(
             SourceLocation{"", 0, 0, "size"},
             fmt::format("the pupil plane is {0}×{0} but the PSF generator was made for {1}×{1}.", pupil.n, m.n));
-    const auto count = static_cast<int>(samples.wavelength_nm.size());
-    if (count < 1 || count > kMaxSpectralSamples)
-        throw InputError(SourceLocation{"", 0, 0, "spectral_samples"},
-                         fmt::format("the GPU spectral integration takes 1 to {} wavelength samples, not {}.",
-                                     kMaxSpectralSamples, count));
+    m.check_samples(samples);
     m.degrees_per_texel = degrees_per_texel;
     const auto texels = static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n);
     const auto n = static_cast<unsigned>(m.n);
@@ -144,42 +183,51 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
     m.scale_mono.use();
     glDispatchCompute(groups_for(texels), 1, 1);
     Impl::barrier();
-    m.downsample.set("n", n / 2);
-    m.downsample.use();
-    glDispatchCompute(groups_for(texels / 4), 1, 1);
-    Impl::barrier();
+    m.downsample_mono();
     m.timers[2].end();
 
-    // Spectral integration, then unit luminance.
     m.timers[3].begin();
-    m.spectral.set("n", n);
-    m.spectral.set("sample_count", count);
-    for (int s = 0; s < count; ++s) {
-        const double ratio = kReferenceWavelengthNm / samples.wavelength_nm[static_cast<std::size_t>(s)];
-        const glm::dvec3 w = samples.xyz_weight[static_cast<std::size_t>(s)] * ratio * ratio;
-        m.spectral.set(fmt::format("ratio[{}]", s), static_cast<float>(ratio));
-        m.spectral.set(fmt::format("weight[{}]", s), static_cast<float>(w.x), static_cast<float>(w.y),
-                       static_cast<float>(w.z));
-    }
-    const glm::mat3 xyz_to_rgb(rec709_xyz_to_rgb());
-    m.spectral.set_mat3("xyz_to_rgb", &xyz_to_rgb[0][0]);
-    m.spectral.use();
-    glDispatchCompute(groups_for(texels), 1, 1);
-    Impl::barrier();
-    m.reduce_rgb.set("count", static_cast<unsigned>(texels));
-    m.reduce_rgb.use();
-    glDispatchCompute(1, 1, 1);
-    Impl::barrier();
-    m.scale_rgb.set("n", n);
-    m.scale_rgb.use();
-    glDispatchCompute(groups_for(texels), 1, 1);
-    Impl::barrier();
+    m.spectral_stage(samples);
     m.timers[3].end();
 
     m.last.upload_ms = m.timers[0].elapsed_ms().value_or(0);
     m.last.fft_ms = cpu_fft ? cpu_fft_ms : m.timers[1].elapsed_ms().value_or(0);
     m.last.mono_ms = m.timers[2].elapsed_ms().value_or(0);
     m.last.spectral_ms = m.timers[3].elapsed_ms().value_or(0);
+}
+
+void GpuPsfGenerator::generate(const MonoPsf& psf, const SpectralSamples& samples) {
+    Impl& m = *impl_;
+    if (psf.n != m.n || psf.value.size() != static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n))
+        throw InputError(SourceLocation{"", 0, 0, "size"},
+                         fmt::format("the PSF is {0}×{0} but the PSF generator was made for {1}×{1}.", psf.n, m.n));
+    m.check_samples(samples);
+    m.degrees_per_texel = psf.degrees_per_texel;
+    m.timers[0].begin();
+    const std::vector<float> packed(psf.value.begin(), psf.value.end());
+    m.mono.upload(0, packed.size() * sizeof(float), packed.data());
+    m.bind_all();
+    m.downsample_mono();
+    m.timers[0].end();
+    m.timers[3].begin();
+    m.spectral_stage(samples);
+    m.timers[3].end();
+    m.last = {};
+    m.last.upload_ms = m.timers[0].elapsed_ms().value_or(0);
+    m.last.spectral_ms = m.timers[3].elapsed_ms().value_or(0);
+}
+
+void GpuPsfGenerator::generate(const EyeModel& eye, const SpectralSamples& samples, double time_s) {
+    if (!has_two_scales(eye)) {
+        generate(pupil_plane(eye, impl_->n, kReferenceWavelengthNm, eye.plane_width_mm, time_s),
+                 psf_degrees_per_texel(eye), samples);
+        return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const MonoPsf mono = mono_psf_reference(eye, impl_->n, kReferenceWavelengthNm, time_s);
+    const double cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    generate(mono, samples);
+    impl_->last.fft_ms = cpu_ms;  // the CPU's pupil planes, FFTs and binning
 }
 
 MonoPsf GpuPsfGenerator::read_mono() const {

@@ -66,12 +66,13 @@ constexpr std::string_view kTonemapKeys[] = {
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
     "ldr_glare"};
 constexpr std::string_view kGlareKeys[] = {
-    "psf_size", "spectral_samples", "spectral_path", "spectral_anchors", "window", "radius_deg", "area_layers", "bloom_sigma_deg", "spencer_vision",
-    "aperture_image", "aperture_width_mm", "aperture_with_pupil", "seed", "halo_radius_deg", "plane_width_mm",
-    "fresnel_distance_mm", "supersampling", "clear_pupil", "hippus", "hippus_amplitude", "gratings", "grating_count",
-    "grating_inner_radius_mm", "grating_width_um", "grating_opacity", "lens_particles", "lens_particle_count",
-    "lens_particle_diameter_um", "vitreous_particles", "vitreous_particle_count", "vitreous_particle_diameter_um",
-    "eyelashes", "eyelash_count", "eyelash_width_um", "eyelid", "eyelid_edge_mm"};
+    "psf_size", "spectral_samples", "spectral_path", "spectral_anchors", "window", "radius_deg", "area_layers",
+    "bloom_sigma_deg", "spencer_vision", "aperture_image", "aperture_width_mm", "aperture_with_pupil", "eye_preset",
+    "seed", "halo_radius_deg", "plane_width_mm", "defocus_diopters", "supersampling", "clear_pupil", "hippus",
+    "hippus_amplitude", "gratings", "grating_count", "grating_inner_radius_mm", "grating_width_um", "grating_opacity",
+    "lens_particles", "lens_particle_count", "lens_particle_diameter_um", "vitreous_particles",
+    "vitreous_particle_count", "vitreous_particle_diameter_um", "eyelashes", "eyelash_count", "eyelash_width_um",
+    "eyelid", "eyelid_edge_mm"};
 constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
 constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
 constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};
@@ -687,12 +688,28 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
 }
 
 /// The [glare] table: the glare stage's settings and the eye model (docs/scene-file.md).
-void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
+/// pupil_mm: the pupil the scene's frames will use (fixed adaptation), or the
+/// darkest eq 3.15 gives (dynamic), for the checks that depend on it.
+void read_glare(const Document& doc, const Section& root, GlareSettings& g, double pupil_mm) {
     const toml::table* t = sub_table(root, "glare", "[glare]");
     if (t == nullptr) return;
     Section s(doc, *t, "glare", "the [glare] table");
+    // The key the two-scale eye replaced (docs/glare.md): its distance was a
+    // defocus of 1/d diopters, now said as such.
+    if (s.has("fresnel_distance_mm"))
+        s.fail(s.get("fresnel_distance_mm"), "fresnel_distance_mm",
+               "fresnel_distance_mm is no longer read: the eye's defocus is now 'defocus_diopters' (0 = in focus, "
+               "the default; a distance d in mm is 1000/d diopters), and eye_preset = \"k2012\" draws the thesis's "
+               "single-scale eye with its Fresnel term (d = 5000 mm).");
     s.allow(kGlareKeys);
     EyeModel& e = g.eye;
+    if (auto preset = s.string("eye_preset")) {
+        const std::optional<EyeModel> named = eye_preset(*preset);
+        if (!named)
+            s.fail(s.get("eye_preset"), "eye_preset",
+                   fmt::format("unknown eye preset \"{}\"; presets are {}.", *preset, join(eye_preset_names())));
+        e = *named;
+    }
     if (s.boolean("clear_pupil").value_or(false)) e = EyeModel::clear_pupil(e.pupil_diameter_mm);
     g.psf_size = s.integer("psf_size", 16, 2048).value_or(g.psf_size);
     if (!is_power_of_two(g.psf_size))
@@ -751,7 +768,7 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
         e.halo_radius_deg = *h > 0 ? std::optional<double>(*h) : std::nullopt;  // 0: physical scale
     }
     e.plane_width_mm = s.number_or("plane_width_mm", e.plane_width_mm);
-    e.fresnel_distance_mm = s.number_or("fresnel_distance_mm", e.fresnel_distance_mm);
+    e.defocus_diopters = s.number_or("defocus_diopters", e.defocus_diopters);
     e.supersampling = s.integer("supersampling", 1, 16).value_or(e.supersampling);
     e.hippus.enabled = s.boolean("hippus").value_or(e.hippus.enabled);
     e.hippus.amplitude = s.number_or("hippus_amplitude", e.hippus.amplitude);
@@ -771,13 +788,18 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g) {
     e.eyelashes.width_um = s.number_or("eyelash_width_um", e.eyelashes.width_um);
     e.eyelid.enabled = s.boolean("eyelid").value_or(e.eyelid.enabled);
     e.eyelid.edge_mm = s.number_or("eyelid_edge_mm", e.eyelid.edge_mm);
-    // The eye model's own checks (the pupil is checked per frame, where it is known).
+    // The eye model's own checks (the pupil itself is checked per frame, where
+    // hippus has moved it): with the scene's pupil within half the plane, so
+    // that a defocus the frames' grid cannot sample is refused here, at its line.
     try {
         EyeModel probe = e;
-        probe.pupil_diameter_mm = std::min(probe.pupil_diameter_mm, 0.25 * probe.plane_width_mm);
+        probe.pupil_diameter_mm = std::min(pupil_mm, 0.5 * probe.plane_width_mm);
+        probe.hippus.enabled = false;
         probe.validate(g.psf_size);
     } catch (const InputError& err) {
         const std::string key = err.where() ? err.where()->key : std::string();
+        // Keys spelt the same in the file and the model are refused at their own line.
+        if (!key.empty() && s.has(key)) s.fail(s.get(key), key, err.message());
         s.fail_table(fmt::format("the eye model is invalid ({}): {}", key, err.message()));
     }
 }
@@ -1106,7 +1128,14 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     scene.environment = read_environment(doc, root);
     scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation);
     scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
-    read_glare(doc, root, scene.glare);
+    // The pupil the glare stage will use (glare_stage.h glare_pupil_mm): given,
+    // or eq 3.15 from the fixed adaptation, or the dark-adapted 7.9 mm when the
+    // adaptation follows the frame.
+    const double pupil_mm = scene.glare.pupil_mm ? *scene.glare.pupil_mm
+                            : scene.output.adaptation.mode == AdaptationMode::dynamic
+                                ? pupil_diameter_mm_from_adaptation(0.0)
+                                : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
+    read_glare(doc, root, scene.glare, pupil_mm);
     read_output(doc, root, scene.output);
     check_billboard(doc, root, scene);
     const Profiles profiles = read_profiles(doc, root);

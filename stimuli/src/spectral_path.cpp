@@ -144,6 +144,9 @@ void add_rescaled(XyzPlanes& xyz, int n, double ratio, const glm::dvec3& weight,
 /// it (the plane over W·λ/λ0) but transformed by FFTW in fp32: the anchors
 /// are rescaled and summed in fp32 anyway (≈ 10% faster than double here).
 MonoPsf anchor_psf(const EyeModel& eye, int n, double wavelength_nm, double time_s) {
+    // The two-scale eye (eye_model.h): core and scatter at their own angular
+    // scales, binned onto one grid, as the exact reference builds each wavelength.
+    if (has_two_scales(eye)) return mono_psf_reference(eye, n, wavelength_nm, time_s);
     const double w = eye.plane_width_mm * wavelength_nm / kReferenceWavelengthNm;
     const ComplexImage<double> field = pupil_plane(eye, n, wavelength_nm, w, time_s);
     ComplexImage<float> f(n);

@@ -132,6 +132,8 @@ TEST_F(bench, quick) {
     }
     EXPECT_TRUE(fs::file_size(dir / "bench.md") > 0);
     EXPECT_TRUE(fs::file_size(dir / "machine.txt") > 0);
+    EXPECT_TRUE(benches.count("eye_validation"));
+    EXPECT_TRUE(fs::file_size(dir / "eye_validation.md") > 0);
     if (o.plots && summary.plotted) {
         EXPECT_TRUE(fs::exists(dir / "pareto.png"));
     }

@@ -37,7 +37,7 @@ EyeModel small_eye() {
     e.pupil_diameter_mm = 6.0;
     e.gratings.enabled = false;
     e.halo_radius_deg.reset();
-    e.fresnel_distance_mm = 2000.0;
+    e.defocus_diopters = 0.5;
     return e;
 }
 
@@ -65,27 +65,26 @@ TEST_F(GlarePsf, GpuMonoAndRgbMatchTheirCpuReferences) {
 }
 
 TEST_F(GlarePsf, DefaultEyeAtN512MatchesCpuAndIsBitIdenticalForASeed) {
-    EyeModel eye;  // the default eye: gratings, particles, E; halo at 4°
+    EyeModel eye;  // the default eye: two scales, gratings, particles, in focus; halo at 4°
     eye.pupil_diameter_mm = 6.0;
     const int n = 512;
     const SpectralSamples samples = spectral_samples(d65_spectrum(), 30);
     GpuPsfGenerator gen(n);
-    const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
-    gen.generate(field, psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     const RgbPsf first = gen.read_rgb();
-    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     const RgbPsf second = gen.read_rgb();
     ASSERT_EQ(first.rgb.size(), second.rgb.size());
     EXPECT_TRUE(first.rgb == second.rgb) << "same seed, same machine: the PSF must be bit-identical";
     const RgbPsf cpu = spectral_psf_resampled(mono_psf_reference(eye, n, kReferenceWavelengthNm), samples);
     EXPECT_LT(stimuli::relative_l2(first, cpu), 1e-4);
-    // The scale puts the lenticular halo's outer edge at 4°: dpt = 4° / (count/(2π r0) · W).
-    EXPECT_NEAR(first.degrees_per_texel,
-                4.0 / (eye.gratings.count / (2 * std::numbers::pi * eye.gratings.inner_radius_mm) * eye.plane_width_mm),
+    // The scale puts the ring diffracted by the gratings at the pupil's edge
+    // (r = 3 mm) at 4°: dpt = 4° / (count/(2π r) · W).
+    EXPECT_NEAR(first.degrees_per_texel, 4.0 / (eye.gratings.count / (2 * std::numbers::pi * 3.0) * eye.plane_width_mm),
                 1e-9);
     // A different seed draws a different eye.
     eye.seed = 2;
-    gen.generate(pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm), psf_degrees_per_texel(eye), samples);
+    gen.generate(eye, samples);
     EXPECT_FALSE(gen.read_rgb().rgb == first.rgb);
 }
 
@@ -216,6 +215,53 @@ TEST_F(GlareFrames, CieVeilOfOneLightIsTheCie146EquationAndKeepsItsEnergy) {
     EXPECT_NEAR(kept, 1.0 - v.outside_frame.g, 1e-3);
     EXPECT_GT(v.outside_frame.g, 0.05);  // the veil reaches far beyond ±5°
     EXPECT_LT(v.outside_frame.g, 0.5);
+}
+
+TEST_F(GlareFrames, FocusedEyePeaksAtTheLightAndBothEyesKeepItsEnergy) {
+    // One 100 cd light at 1 km, the 6.89 mm pupil of 0.001 cd/m² (eq 3.15).
+    // The default two-scale eye draws its core where the light is: the
+    // frame's brightest pixel is the light's own (the no-glare frame's). The
+    // k2012 preset's core, two waves out of focus (0.2 D) and stretched with
+    // the halo (blur radius 6.89 mm · 0.2 D / 2 × 10.2 = 0.40°, ~20 px), is a
+    // ring around a dark centre (at an odd number of half waves, 6 mm, the
+    // centre would be bright again). Both frames hold the light's illuminance
+    // within 1% (the window's cut is renormalised).
+    Scene scene = black_scene(GlareModel::none);
+    scene.glare.pupil_mm = pupil_diameter_mm_from_adaptation(0.001);
+    scene.lights = {light_at(glm::dvec3(0.013, -0.007, -1.0) * 1000.0)};
+    const double direct = energy(scene);
+    const ImageRGBA32F no_glare = renderer->read_hdr();
+    auto brightest = [](const ImageRGBA32F& img) {
+        std::pair<int, int> best{0, 0};
+        float v = -1;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x)
+                if (img.pixel(x, y)[1] > v) {
+                    v = img.pixel(x, y)[1];
+                    best = {x, y};
+                }
+        return best;
+    };
+    const auto light_pixel = brightest(no_glare);
+    scene.glare.model = GlareModel::wave_optics;
+    for (const EyeModel& eye : {EyeModel{}, EyeModel::k2012()}) {
+        scene.glare.eye = eye;
+        const double with_glare = energy(scene);
+        const ImageRGBA32F img = renderer->read_hdr();
+        const auto peak = brightest(img);
+        const float centre = img.pixel(light_pixel.first, light_pixel.second)[1];
+        const float top = img.pixel(peak.first, peak.second)[1];
+        const bool focused = eye.scale == EyeScale::two_scales;
+        std::printf("%s eye: energy ratio %.5f, brightest pixel (%d, %d), light's pixel (%d, %d), centre / max %.3f\n",
+                    focused ? "focused" : "k2012", with_glare / direct, peak.first, peak.second, light_pixel.first,
+                    light_pixel.second, centre / top);
+        EXPECT_NEAR(with_glare / direct, 1.0, 0.01);
+        if (focused) {
+            EXPECT_EQ(peak, light_pixel);
+        } else {
+            EXPECT_LT(centre / top, 0.5);
+        }
+    }
 }
 
 TEST_F(GlareFrames, HiddenLightsEmitNothing) {

@@ -52,7 +52,7 @@ Scene grid_scene(GlareModel model) {
     s.glare.pupil_mm = 5.0;
     s.glare.eye.gratings.enabled = false;
     s.glare.eye.halo_radius_deg.reset();
-    s.glare.eye.fresnel_distance_mm = 0.0;
+    s.glare.eye.defocus_diopters = 0.0;
     s.glare.spectral_samples = 8;
     // Intensities log-spaced over 10 decades at 100 m: the dim end cannot move a
     // code, the bright end lights hundreds of pixels.

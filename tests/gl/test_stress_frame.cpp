@@ -242,7 +242,7 @@ TEST_F(StressGlare, ExtremeLightsWithEveryCheapModelAndPupil) {
             scene.glare.psf_size = 128;
             scene.glare.eye.gratings.enabled = false;
             scene.glare.eye.halo_radius_deg.reset();
-            scene.glare.eye.fresnel_distance_mm = 2000.0;
+            scene.glare.eye.defocus_diopters = 0.5;
             scene.glare.radius_deg = 0.5;
             scene.glare.bloom_sigma_deg = 0.1;
             const glm::dvec3 c = scene.camera.position_m;

@@ -108,9 +108,10 @@ TEST(PupilPlane, ClearPupilIsOneInsideAndZeroOutside) {
     EXPECT_GT(outside, 50000);
 }
 
-TEST(PupilPlane, FresnelPhaseIsPiRSquaredOverLambdaD) {
+TEST(PupilPlane, DefocusPhaseIsPiDeltaDRSquaredOverLambda) {
+    // ΔD = 1/1.1 m: the same phase as K2012 eq 4.6's E at d = 1100 mm.
     EyeModel eye = EyeModel::clear_pupil(4.0);
-    eye.fresnel_distance_mm = 1100.0;
+    eye.defocus_diopters = 1.0 / 1.1;
     const int n = 256;
     for (double lambda_nm : {575.0, 450.0}) {
         const double w = 18.0 * lambda_nm / kReferenceWavelengthNm;
@@ -127,7 +128,7 @@ TEST(PupilPlane, FresnelPhaseIsPiRSquaredOverLambdaD) {
     }
 }
 
-TEST(PupilPlane, NoFresnelTermWhenDistanceIsZero) {
+TEST(PupilPlane, NoPhaseWhenInFocus) {
     const auto p = pupil_plane(EyeModel::clear_pupil(4.0), 128, 500.0, 18.0);
     for (const auto& v : p.data) EXPECT_EQ(v.imag(), 0.0);
 }
@@ -354,13 +355,20 @@ TEST(PupilPlane, EyelashesHangFromTheTopDownToTheirReach) {
 
 // ---- scale and validation ------------------------------------------------------------
 
-TEST(AngularScale, DefaultsPutTheHaloEdgeAtFourDegrees) {
+TEST(AngularScale, DefaultsPutTheHalosBrightestRingAtFourDegrees) {
+    // two_scales: the ring the gratings at the pupil's edge (r = p/2 = 2 mm)
+    // diffract λ0 to, λ0 count / (2π r), moves to 4°.
     const EyeModel eye;
-    // s = 4° (in rad) / (λ0 count / (2π r_inner)), λ0 = 575e-6 mm.
-    const double s = (4.0 * pi / 180.0) / (575e-6 * 120.0 / (2 * pi * 1.6));
+    const double s = (4.0 * pi / 180.0) / (575e-6 * 120.0 / (2 * pi * 2.0));
     EXPECT_NEAR(angular_scale(eye), s, 1e-12 * s);
-    EXPECT_NEAR(angular_scale(eye), 10.171, 0.001);  // by hand: 0.0698132 / 0.0068638
+    EXPECT_NEAR(angular_scale(eye), 12.714, 0.001);  // by hand: 0.0698132 / 0.0054910
     EXPECT_NEAR(psf_degrees_per_texel(eye), s * 575e-6 / 18.0 * 180.0 / pi, 1e-15);
+    // The core stays physical.
+    EXPECT_NEAR(core_degrees_per_texel(eye), 575e-6 / 18.0 * 180.0 / pi, 1e-15);
+    // A pupil that does not reach the gratings: their inner radius sets the ring.
+    EyeModel small = eye;
+    small.pupil_diameter_mm = 3.0;
+    EXPECT_NEAR(angular_scale(small), (4.0 * pi / 180.0) / (575e-6 * 120.0 / (2 * pi * 1.6)), 1e-9);
 
     EyeModel off = eye;
     off.gratings.enabled = false;
@@ -369,6 +377,20 @@ TEST(AngularScale, DefaultsPutTheHaloEdgeAtFourDegrees) {
     off.halo_radius_deg = std::nullopt;
     EXPECT_EQ(angular_scale(off), 1.0);
     EXPECT_NEAR(psf_degrees_per_texel(off), 575e-6 / 18.0 * 180.0 / pi, 1e-15);
+}
+
+TEST(AngularScale, K2012PresetPutsTheHaloEdgeAtFourDegreesAndStretchesTheCore) {
+    const EyeModel eye = EyeModel::k2012();
+    EXPECT_EQ(eye.scale, EyeScale::k2012_single);
+    EXPECT_DOUBLE_EQ(eye.defocus_diopters, 0.2);  // K2012 eq 4.6's E at d = 5000 mm
+    // s = 4° (in rad) / (λ0 count / (2π r_inner)), λ0 = 575e-6 mm.
+    const double s = (4.0 * pi / 180.0) / (575e-6 * 120.0 / (2 * pi * 1.6));
+    EXPECT_NEAR(angular_scale(eye), s, 1e-12 * s);
+    EXPECT_NEAR(angular_scale(eye), 10.171, 0.001);  // by hand: 0.0698132 / 0.0068638
+    EXPECT_NEAR(core_degrees_per_texel(eye), psf_degrees_per_texel(eye), 1e-15);
+    EXPECT_TRUE(eye_preset("k2012").has_value());
+    EXPECT_EQ(eye_preset("focused")->scale, EyeScale::two_scales);
+    EXPECT_FALSE(eye_preset("k2013").has_value());
 }
 
 TEST(Validate, DefaultsAreValidAtTheSizesWeUse) {
@@ -401,12 +423,14 @@ TEST(Validate, ErrorsNameTheKey) {
     EXPECT_KEY(error_after([](EyeModel& e) { e.eyelashes.count = -1; }), "eyelashes.count");
     EXPECT_KEY(error_after([](EyeModel& e) { e.plane_width_mm = 0; }), "plane_width_mm");
     EXPECT_KEY(error_after([](EyeModel& e) { e.supersampling = 0; }), "supersampling");
-    EXPECT_KEY(error_after([](EyeModel& e) { e.fresnel_distance_mm = -1; }), "fresnel_distance_mm");
+    EXPECT_KEY(error_after([](EyeModel& e) { e.defocus_diopters = std::nan(""); }), "defocus_diopters");
     EXPECT_KEY(error_after([](EyeModel& e) { e.halo_radius_deg = -4.0; }), "halo_radius_deg");
     EXPECT_KEY(error_after([](EyeModel&) {}, 300), "size");
     EXPECT_KEY(error_after([](EyeModel&) {}, 0), "size");
-    // The anatomical 24 mm cannot be sampled (the header says so).
-    EXPECT_KEY(error_after([](EyeModel& e) { e.fresnel_distance_mm = 24; }), "fresnel_distance_mm");
+    // The gratings' physical ring is 0.31° for the default 4 mm pupil: the two-scale eye cannot shrink it.
+    EXPECT_KEY(error_after([](EyeModel& e) { e.halo_radius_deg = 0.2; }), "halo_radius_deg");
+    // 1000/24 mm = 41.7 D (the anatomical eye's Fresnel distance) cannot be sampled.
+    EXPECT_KEY(error_after([](EyeModel& e) { e.defocus_diopters = -1000.0 / 24; }), "defocus_diopters");
 }
 
 TEST(Validate, PupilMayFillHalfThePlane) {
@@ -426,16 +450,22 @@ TEST(Validate, HippusMaximumCountsAgainstThePlane) {
     EXPECT_NO_THROW(eye.validate(512));
 }
 
-TEST(Validate, FresnelStepLimitIsPiAtThePupilEdge) {
-    // step = 2π (p/2)(W/n) / (λ0 d) ≤ π  <=>  d ≥ p W / (n λ0)
-    // = 4 × 18 / (512 × 575e-6) = 244.565 mm for the default 4 mm pupil.
+TEST(Validate, DefocusStepLimitIsPiAtThePupilEdge) {
+    // step = 2π |ΔD| (p/2)(W/n) / λ0 ≤ π  <=>  |ΔD| ≤ n λ0 / (p W)
+    // = 512 × 575e-9 / (4e-3 × 18e-3) = 4.0889 D for the default 4 mm pupil, either sign.
     EyeModel eye;
-    eye.fresnel_distance_mm = 246.0;
-    EXPECT_NO_THROW(eye.validate(512));
-    eye.fresnel_distance_mm = 243.0;
-    EXPECT_KEY(input_error_of([&] { eye.validate(512); }), "fresnel_distance_mm");
-    EXPECT_NO_THROW(eye.validate(1024));  // half the texel: the limit halves
-    eye.fresnel_distance_mm = 0;          // E off: no limit
+    EXPECT_NEAR(max_defocus_diopters(eye, 512), 4.0889, 1e-4);
+    for (double sign : {1.0, -1.0}) {
+        eye.defocus_diopters = sign * 4.08;
+        EXPECT_NO_THROW(eye.validate(512));
+        eye.defocus_diopters = sign * 4.10;
+        const std::string what = input_error_of([&] { eye.validate(512); });
+        EXPECT_KEY(what, "defocus_diopters");
+        // The sentence says why: the phase step, and the blur disc against the grid.
+        EXPECT_NE(what.find("more than π between texels"), std::string::npos) << what;
+        EXPECT_NO_THROW(eye.validate(1024));  // half the texel: the limit doubles
+    }
+    eye.defocus_diopters = 0;  // in focus: no limit
     EXPECT_NO_THROW(eye.validate(16));
 }
 

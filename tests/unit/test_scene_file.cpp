@@ -508,7 +508,21 @@ TEST(SceneFileGlare, BadGlareInputNamesTheKey) {
     expect_error_at(glare + "spencer_vision = \"owl\"\n", 7, "glare.spencer_vision", "unknown vision");
     expect_error_at(glare + "aperture_image = \"no-such-lashes.png\"\n", 7, "glare.aperture_image", "does not exist");
     expect_error_at(glare + "grating_count = -1\n", 7, "glare.grating_count", "between");
-    expect_error_at(glare + "fresnel_distance_mm = 24\n", 6, "glare", "fresnel_distance_mm");
+    // The old key names the new one; a defocus the grid cannot sample says why, at its line.
+    expect_error_at(glare + "fresnel_distance_mm = 24\n", 7, "glare.fresnel_distance_mm", "defocus_diopters");
+    expect_error_at(glare + "defocus_diopters = -30\n", 7, "glare.defocus_diopters", "more than π between texels");
+    expect_error_at(glare + "eye_preset = \"k2013\"\n", 7, "glare.eye_preset", "unknown eye preset");
+    // The limit is the scene's pupil's: λ0 N / (p W) = 2.04 D at 8 mm and N = 512, 4.09 D at 4 mm.
+    const std::string three_d = "[glare]\ndefocus_diopters = 3\n";
+    expect_error_at(std::string(kMinimal) + "[eye]\npupil_mm = 8\n" + three_d, 9, "glare.defocus_diopters",
+                    "at most ±2.04 D");
+    EXPECT_DOUBLE_EQ(parse_scene(std::string(kMinimal) + "[eye]\npupil_mm = 4\n" + three_d, kFile)
+                         .glare.eye.defocus_diopters,
+                     3.0);
+    const Scene k2012 = parse_scene(glare + "eye_preset = \"k2012\"\nseed = 7\n", kFile);
+    EXPECT_EQ(k2012.glare.eye.scale, EyeScale::k2012_single);
+    EXPECT_DOUBLE_EQ(k2012.glare.eye.defocus_diopters, 0.2);
+    EXPECT_EQ(k2012.glare.eye.seed, 7u);  // the preset first, then the keys
     expect_error_at(glare + "sparkle = 1\n", 7, "glare.sparkle", "unknown key");
 }
 

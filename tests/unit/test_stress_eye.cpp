@@ -151,7 +151,7 @@ TEST(StressPsf, DefaultEyeAtTheSmallestAndLargestPupilsWithHippus) {
             eye.hippus.enabled = true;
             eye.gratings.enabled = false;  // resolved only at N >= 512 (test_glare.cpp runs them)
             eye.halo_radius_deg.reset();
-            eye.fresnel_distance_mm = 5000.0;  // 2000 mm is refused at N = 128 for 9 mm
+            eye.defocus_diopters = 0.2;  // 0.5 D is refused at N = 128 for 9 mm (limit 0.454 D)
             eye.supersampling = 2;
             const MonoPsf mono = mono_psf_reference(eye, 128, kReferenceWavelengthNm, t);
             const PsfStats s = stats_of(mono);

@@ -2,16 +2,18 @@
 // The eye model that the wave-optics glare is computed from (K2012 §4.2.1,
 // after Ritschel et al. 2009 and Kakimoto et al. 2005): a pupil-plane image of
 // the aperture and the obstacles in and in front of the eye, each switchable,
-// with parameters in physical units, multiplied by the Fresnel term E of
-// K2012 eq 4.6. Deterministic for a seed: the obstacle geometry is drawn in
-// millimetres from the seed alone, so every image size and wavelength sees the
-// same eye.
+// with parameters in physical units, multiplied by the defocus phase (K2012
+// eq 4.6's Fresnel term E with d = 1/ΔD). Deterministic for a seed: the
+// obstacle geometry is drawn in millimetres from the seed alone, so every image
+// size and wavelength sees the same eye.
 //
 // Pupil-plane coordinates: millimetres, origin at the pupil centre, +x right,
 // +y up (as the observer's eye sees the world), image row 0 at the bottom
 // (y = -W/2), texel (i, j) centred at ((i + 0.5 - n/2) W/n, (j + 0.5 - n/2) W/n).
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -79,6 +81,18 @@ struct Eyelid {
     double edge_mm = 2.5;
 };
 
+/// How the eye's PSF is put together (docs/glare.md).
+enum class EyeScale {
+    /// Two angular scales, one PSF: the core (the aperture's diffraction with
+    /// its defocus) at its physical scale λ/W rad per texel, the scatter of the
+    /// obstacles (gratings, particles, eyelashes) at the scale that puts the
+    /// halo at halo_radius_deg; their energies as the pupil function shares them.
+    two_scales,
+    /// K2012 §4.2 as the thesis draws it: one FFT of P·E, the whole PSF (core
+    /// included) stretched so the gratings' outer halo edge lies at halo_radius_deg.
+    k2012_single,
+};
+
 struct EyeModel {
     double pupil_diameter_mm = 4.0;  ///< mean diameter p (eq 3.15 gives it from adaptation)
     Hippus hippus;
@@ -87,45 +101,73 @@ struct EyeModel {
     Particles vitreous_particles{true, 40, 150.0, 0.5, 0.6, 0.0};   ///< few large, partly transparent discs
     Eyelashes eyelashes;
     Eyelid eyelid;
-    /// d of eq 4.6 in mm; 0 turns E off (E = 1: the focused eye's Fraunhofer limit).
-    /// E is a quadratic phase, i.e. defocus: its geometric blur radius is about
-    /// (p/2)/d rad before the angular scale. Trester's λd = N texel² (K2012 §5.2)
-    /// is d ≈ 1100 mm at N = 512 here, which blurs the core to ~1.8° under the
-    /// 4° halo scale; the default 5000 mm keeps the core within ~0.4°, closer to
-    /// K2012's figures. The anatomical 24 mm cannot be sampled (the phase step
-    /// between texels at the pupil edge would exceed π) and is refused by validate().
-    double fresnel_distance_mm = 5000.0;
+    /// Defocus ΔD in diopters (1/m; + or −, 0 = in focus): the pupil phase
+    /// 2π W(r)/λ with the wavefront error W(r) = ΔD r²/2 (paraxial defocus), i.e.
+    /// exp(iπ ΔD r²/λ) at each wavelength. K2012 eq 4.6's Fresnel term E with
+    /// distance d is the same phase with ΔD = 1/d. Geometric blur disc radius
+    /// p·ΔD/2 rad. Sampling limit: |ΔD| ≤ λ0·n/(p·W) (validate()).
+    double defocus_diopters = 0.0;
     /// Side W of the square pupil plane (mm). The PSF's physical angular texel
     /// is λ/W rad; W ≥ 2 × the largest pupil keeps |F|² unaliased.
     double plane_width_mm = 18.0;
-    /// Angular scale (K2012 §4.2, "a user parameter that adjusts the size of the
-    /// glare"): with gratings on, the PSF is scaled so the halo's outer edge lies
-    /// at this visual angle (Simpson 1953: about 4°). nullopt, or gratings off:
-    /// physical Fraunhofer scale (λ/W rad per texel).
+    /// How the PSF's parts are placed in angle (docs/glare.md).
+    EyeScale scale = EyeScale::two_scales;
+    /// The scatter's angular scale (Simpson 1953: the lenticular halo at about
+    /// 4°). two_scales: the ring the gratings at the pupil's edge diffract λ0
+    /// into (the halo's brightest ring) lands at this visual angle. k2012_single
+    /// (K2012 §4.2, "a user parameter that adjusts the size of the glare"): the
+    /// whole PSF is scaled so the gratings' outer halo edge lands here. nullopt,
+    /// or gratings off: physical Fraunhofer scale (λ/W rad per texel) for everything.
     std::optional<double> halo_radius_deg = 4.0;
     std::uint64_t seed = 1;
     int supersampling = 4;  ///< samples per texel per axis when rasterising
 
-    /// A clear circular pupil of the given diameter: every obstacle, hippus and
-    /// E off, physical scale. For tests and for studies.
+    /// A clear circular pupil of the given diameter: every obstacle and hippus
+    /// off, in focus, physical scale. For tests and for studies.
     static EyeModel clear_pupil(double diameter_mm);
+    /// The `k2012` preset: the default obstacles with K2012's single angular
+    /// scale and its Fresnel term at d = 5000 mm (ΔD = 0.2 D), the look of the
+    /// thesis's figures (before this eye was split into two scales).
+    static EyeModel k2012();
 
     /// Throws InputError (key names the field, e.g. "pupil_diameter_mm") for a
     /// pupil ≤ 0 or larger than the plane allows, negative counts or sizes, a
-    /// Fresnel distance too short to sample at `n` texels, supersampling < 1.
+    /// defocus the grid of `n` texels cannot sample, supersampling < 1.
     void validate(int n) const;
 };
+
+/// A named eye: "focused" (the default EyeModel: two scales, in focus) or
+/// "k2012" (EyeModel::k2012()); nullopt for any other name.
+std::optional<EyeModel> eye_preset(std::string_view name);
+/// The names eye_preset() knows, for messages.
+std::vector<std::string> eye_preset_names();
 
 /// Pupil diameter (mm) at time t with hippus applied (eq 4.7); the mean
 /// diameter when hippus is off. Always within (0, max(p, p_max)].
 double pupil_diameter_mm_at(const EyeModel& eye, double time_s);
 
-/// Angular scale factor s: the PSF's angular texel is s · λ0 / W rad.
-/// 1 when the scale is physical (see EyeModel::halo_radius_deg).
+/// Angular scale factor s of the scatter (two_scales) or of the whole PSF
+/// (k2012_single): its angular texel is s · λ0 / W rad. 1 when the scale is
+/// physical (see EyeModel::halo_radius_deg).
 double angular_scale(const EyeModel& eye);
 
-/// Degrees per PSF texel at λ0 for this eye: s · λ0 / W, in degrees.
+/// Degrees per texel of the eye's PSF grid at λ0: s · λ0 / W, in degrees.
 double psf_degrees_per_texel(const EyeModel& eye);
+
+/// True when the eye's PSF is put together from two parts at different scales
+/// (EyeScale::two_scales with angular_scale ≠ 1). Otherwise one coherent FFT of
+/// P·E is exact wave optics and is what every path computes.
+bool has_two_scales(const EyeModel& eye);
+
+/// Degrees per texel of the core's own grid at λ0: λ0 / W (two_scales), or
+/// psf_degrees_per_texel (k2012_single, where the core is stretched too).
+double core_degrees_per_texel(const EyeModel& eye);
+
+/// The largest defocus (diopters, either sign) an n-texel plane can sample for
+/// this eye's largest pupil: λ0·n/(p·W). Beyond it the defocus phase changes by
+/// more than π between neighbouring texels at the pupil's edge, and (the same
+/// condition) the geometric blur disc p·ΔD/2 rad overflows the core's grid.
+double max_defocus_diopters(const EyeModel& eye, int n);
 
 /// The obstacle geometry drawn from the seed, in pupil-plane millimetres.
 struct EyeGeometry {
@@ -150,10 +192,24 @@ EyeGeometry eye_geometry(const EyeModel& eye);
 /// passes W·λ/λ0 so every wavelength's FFT lands on λ0's angular grid).
 /// P is the transmittance (pupil disc of diameter pupil_diameter_mm_at(eye, t),
 /// times Π(1 - opacity · coverage) of each obstacle, times the eyelid), area-
-/// sampled with eye.supersampling² samples per texel. E uses the physical
-/// coordinates and the wavelength: exp(iπ r²/(λ d)).
+/// sampled with eye.supersampling² samples per texel. E is the defocus phase
+/// exp(iπ ΔD r²/λ) in physical coordinates at this wavelength (eq 4.6 with d = 1/ΔD).
 ComplexImage<double> pupil_plane(const EyeModel& eye, int n, double wavelength_nm, double plane_width_mm,
                                  double time_s = 0.0);
+
+/// The pupil plane split into the two fields of EyeScale::two_scales
+/// (docs/glare.md): with P the transmittance of pupil_plane() in focus and A the
+/// aperture alone (pupil disc and eyelid, no obstacles), t = Σ P·A / Σ A² is the
+/// obstacles' mean transmittance, core = t·A·exp(iπ ΔD r²/λ) and scatter =
+/// P − t·A. The two are orthogonal (Σ core*·scatter = 0 in focus), so their
+/// energies Σ|core|² + Σ|scatter|² equal Σ P²: the obstacles take from the
+/// core exactly what they scatter or absorb.
+struct PupilParts {
+    ComplexImage<double> core;
+    ComplexImage<double> scatter;
+    double mean_transmittance = 1.0;  ///< t
+};
+PupilParts pupil_parts(const EyeModel& eye, int n, double wavelength_nm, double plane_width_mm, double time_s = 0.0);
 
 /// Spencer et al. 1995, "Physically-based glare effects for digital images",
 /// eq 1-4 (the analytic PSF per unit solid angle, θ in degrees, λ in nm).

@@ -57,8 +57,28 @@ struct RgbPsf {
 MonoPsf mono_psf_from_spectrum(const ComplexImage<double>& fft_of_pupil, double degrees_per_texel,
                                double wavelength_nm);
 
+/// The two parts of an EyeScale::two_scales PSF at one wavelength (docs/glare.md),
+/// each |F|² of its pupil_parts() field, centred (eq 4.8), scaled by the same
+/// factor so that core_fraction + scatter sum = 1: the core on its own grid
+/// (core_degrees_per_texel, physical), the scatter on the eye's PSF grid
+/// (psf_degrees_per_texel).
+struct MonoPsfParts {
+    MonoPsf core;     ///< unit sum; carries core_fraction of the energy
+    MonoPsf scatter;  ///< sums to 1 - core_fraction
+    double core_fraction = 1.0;
+};
+MonoPsfParts mono_psf_parts(const EyeModel& eye, int n, double wavelength_nm, double time_s = 0.0);
+
+/// Adds `fine` (a centred PSF on a grid of fine.degrees_per_texel) into `coarse`
+/// (centred, coarse.degrees_per_texel ≥ fine's) times `weight`: each fine texel's
+/// energy is shared among the coarse texels its square overlaps, by area, so the
+/// sum is kept exactly and the centre texel maps onto the centre texel.
+void bin_into(const MonoPsf& fine, double weight, MonoPsf& coarse);
+
 /// The monochromatic PSF of an eye at one wavelength, exactly (FFTW double):
 /// the pupil plane is drawn over W·λ/λ0 so the result lands on λ0's grid.
+/// has_two_scales: the core binned onto the scatter's grid plus the scatter
+/// (mono_psf_parts); otherwise one FFT of P·E at psf_degrees_per_texel.
 MonoPsf mono_psf_reference(const EyeModel& eye, int n, double wavelength_nm, double time_s = 0.0);
 
 /// The fast spectral integration of §4.2.4 in double (the CPU twin of

@@ -13,7 +13,8 @@
 namespace atonlab::stimuli {
 
 /// GPU time of the last generate() per stage (ms), from timer queries (fft_ms:
-/// the CPU's steady clock when the FFT ran on the CPU).
+/// the CPU's steady clock when the FFT ran on the CPU; for a two-scale eye, the
+/// CPU's whole mono PSF: pupil planes, FFTs and binning).
 struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
 };
@@ -42,6 +43,15 @@ public:
     /// The pupil-plane field at λ0 (n×n), the PSF's angular texel (degrees) and
     /// the spectral samples (at most 128; InputError, key "spectral_samples").
     void generate(const ComplexImage<double>& pupil_field, double degrees_per_texel, const SpectralSamples& samples);
+    /// The same from a monochromatic PSF at λ0 already made (unit sum, n×n):
+    /// upload, then the mip level and the spectral integration.
+    void generate(const MonoPsf& psf_at_reference_wavelength, const SpectralSamples& samples);
+    /// An eye's PSF at time_s: a one-scale eye (k2012_single, or no stretched
+    /// scatter) transforms its pupil plane here (one FFT, on the GPU or the CPU
+    /// as placed); a two-scale eye builds its parts on the CPU in double
+    /// (mono_psf_reference: two FFTW transforms and the core's binning) and
+    /// uploads the result.
+    void generate(const EyeModel& eye, const SpectralSamples& samples, double time_s = 0.0);
     MonoPsf read_mono() const;
     RgbPsf read_rgb() const;
     PsfGpuTimings timings() const;
