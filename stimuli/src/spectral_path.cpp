@@ -38,11 +38,6 @@ struct Taps {
     std::vector<int> first;
     std::vector<double> weight;  // kTaps per output index
 };
-double sinc(double x) {
-    if (std::abs(x) < 1e-12) return 1.0;
-    const double px = std::numbers::pi * x;
-    return std::sin(px) / px;
-}
 Taps taps(int n, double ratio) {
     Taps t;
     t.first.resize(static_cast<std::size_t>(n));
@@ -54,9 +49,24 @@ Taps taps(int n, double ratio) {
         t.first[static_cast<std::size_t>(i)] = first;
         double sum = 0;
         double* w = &t.weight[static_cast<std::size_t>(i) * kTaps];
+        // The taps' distances d0 − k share their sines: sin π(d0 − k) =
+        // (−1)^k sin πd0, and sin π(d0 − k)/3 by the angle difference.
+        const double d0 = s - first;
+        const double sin_d0 = std::sin(std::numbers::pi * d0);
+        const double sin_w = std::sin(std::numbers::pi * d0 / kLobes), cos_w = std::cos(std::numbers::pi * d0 / kLobes);
         for (int k = 0; k < kTaps; ++k) {
-            const double d = s - (first + k);
-            w[k] = std::abs(d) < kLobes ? sinc(d) * sinc(d / kLobes) : 0.0;
+            const double d = d0 - k;
+            if (std::abs(d) >= kLobes) {
+                w[k] = 0.0;
+            } else if (std::abs(d) < 1e-12) {
+                w[k] = 1.0;
+            } else {
+                const double a = std::numbers::pi * k / kLobes;
+                const double sin_pd = (k % 2 == 0 ? 1.0 : -1.0) * sin_d0;
+                const double sin_pd3 = sin_w * std::cos(a) - cos_w * std::sin(a);
+                const double pd = std::numbers::pi * d;
+                w[k] = sin_pd / pd * (sin_pd3 / (pd / kLobes));
+            }
             sum += w[k];
         }
         for (int k = 0; k < kTaps; ++k) w[k] /= sum;
@@ -327,13 +337,25 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
             for (const Term& t : s.terms) add_term_band(ws, n, y0, y1, t, ws.source[t.anchor]);
             const float* a = ws.acc.data();
             std::size_t i = 0;
-            for (; i + kLanes <= texels; i += kLanes)  // blocks of texels, as in add_term_band
+            for (; i + kLanes <= texels; i += kLanes) {  // blocks of texels, as in add_term_band
+                float v[kLanes], b[3][kLanes];
                 for (std::size_t j = 0; j < kLanes; ++j) {
-                    const float v = a[i + j];
-                    bx[i + j] += s.xyz.x * v;
-                    by[i + j] += s.xyz.y * v;
-                    bz[i + j] += s.xyz.z * v;
+                    v[j] = a[i + j];
+                    b[0][j] = bx[i + j];
+                    b[1][j] = by[i + j];
+                    b[2][j] = bz[i + j];
                 }
+                for (std::size_t j = 0; j < kLanes; ++j) {
+                    b[0][j] += s.xyz.x * v[j];
+                    b[1][j] += s.xyz.y * v[j];
+                    b[2][j] += s.xyz.z * v[j];
+                }
+                for (std::size_t j = 0; j < kLanes; ++j) {
+                    bx[i + j] = b[0][j];
+                    by[i + j] = b[1][j];
+                    bz[i + j] = b[2][j];
+                }
+            }
             for (; i < texels; ++i) {
                 bx[i] += s.xyz.x * a[i];
                 by[i] += s.xyz.y * a[i];
