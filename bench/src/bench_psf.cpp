@@ -133,7 +133,7 @@ void spectral_path_for(Bench& b, const EyeModel& eye, const std::string& bench, 
     a.error = relative_l2(anchored, ref);
     a.metric = metric;
     a.note = fmt::format(
-        "CPU: FFTW fp32 at the anchors, cubic in 1/λ, Lanczos-3 rescaling; {:.4f} from the exact path at {} samples, "
+        "CPU: FFTW fp32 at the anchors, cubic in 1/λ (linear for weak samples), Lanczos-3 rescaling; {:.4f} from the exact path at {} samples, "
         "in {:.2f} of its time{}",
         relative_l2(anchored, exact), kDefaultSamples, t_anchored.primary().median / t_exact.primary().median,
         eye_note);

@@ -17,7 +17,8 @@
 //
 // each term eq 4.9 from λk by separable Lanczos-3; beyond the outer anchors the
 // two nearest extrapolate linearly (the nearest alone for a sample under 1% of
-// the brightest's weight). Anchors sit at quantiles of the samples' weight
+// the brightest's weight), and between them a sample under a quarter of the
+// brightest's weight is linear in its two nearest. Anchors sit at quantiles of the samples' weight
 // (x̄ + ȳ + z̄ of CMF × SPD), so they are dense where the light is.
 // docs/glare.md "The spectral path" gives the measured errors and times.
 #include <vector>
