@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# Build tools, libraries (DESIGN.md "Dependencies"), and the Mesa EGL/llvmpipe
+# Build tools, libraries (docs/architecture.md "Dependencies"), and the Mesa EGL/llvmpipe
 # driver that the headless GL tests run on.
 packages=(
   build-essential cmake ninja-build pkg-config

@@ -4,7 +4,7 @@
 // (dataset.h Trial::outcome), and, for adaptive tracks, the staircase
 // reversals and QUEST's posterior after every trial, found by replaying the
 // logged answers through a fresh copy of the track's procedure (protocols/;
-// DESIGN.md: procedures are pure state machines).
+// docs/architecture.md: procedures are pure state machines).
 #include <map>
 #include <optional>
 #include <string>

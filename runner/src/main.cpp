@@ -1,4 +1,4 @@
-// atonlab: one binary, subcommands (DESIGN.md "Command line").
+// atonlab: one binary, subcommands (docs/architecture.md "The libraries").
 // Bad input: one sentence on stderr naming file, line and key; exit status 2.
 // No usable GL: one sentence saying why; exit status 3.
 // `atonlab run`: the study file failed (StoreError): exit status 4 (run_command.cpp); on screen,

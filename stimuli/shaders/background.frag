@@ -1,4 +1,4 @@
-// The background (DESIGN.md pipeline step 1): a uniform field, or a sky of
+// The background (docs/architecture.md "The pipeline, one frame", step 1): a uniform field, or a sky of
 // uniform luminance over a flat sea that mirrors it with Schlick's Fresnel
 // factor (K2012 eq 3.17, §3.6.1). D65 white, absolute cd/m².
 // Also writes the linear view depth (m along the view axis; +inf for sky) that

@@ -1,4 +1,4 @@
-// Tone mapping and display encoding of one frame (DESIGN.md pipeline steps 5-6):
+// Tone mapping and display encoding of one frame (docs/architecture.md "The pipeline, one frame", steps 5-6):
 // every pixel of the HDR frame (cd/m²) is tone-mapped at the adapted luminance
 // that adaptation.comp left in the State buffer, then encoded to the display's
 // code values with dithering. With LDR_PATH (K2012 §6.2.2, "adding glare to an

@@ -72,7 +72,7 @@ constexpr std::array<NarrowBandLed, 4> kNarrowBandLeds = {{
 // matrix reproduces every printed digit for red (4.7021 = 1/0.2126729), blue (13.8552 = 1/0.0721750),
 // green and red-optimum except its G (0.0058 vs 0.0059), and its inverse rounded to 4 decimals is exactly
 // K2012 eq 3.12. Eq 3.11, by contrast, is the matrix derived from the specified white (0.3127, 0.3290).
-// We derive both matrices from the specified white (Rec.709, DESIGN.md), which moves the table's values
+// We derive both matrices from the specified white (Rec.709, docs/architecture.md), which moves the table's values
 // by at most 2.4e-4 relative (red 4.7028, blue 13.8519): inside the 1e-3 the tests hold it to.
 struct IalaColour {
     const char* name;

@@ -325,7 +325,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         };
         begin(2);
         if (glare && !ldr && !veil) {
-            // The glare billboard replaces the direct image (DESIGN.md: energy-matched).
+            // The glare billboard replaces the direct image (docs/architecture.md: energy-matched).
             m.glare.draw(m.light_count, P, m.pre_exposure);
         } else if (!veil || ldr) {
             draw_direct(pre);

@@ -1,7 +1,6 @@
 // Images in and out (image_io.h): OpenEXR for scene-referred data, PNG for
 // display-encoded frames. Every writer goes through AtomicFile so that a
-// failure never leaves a partial file at the destination (DESIGN.md "Nothing
-// already stored is ever lost because of bad input").
+// failure never leaves a partial file at the destination (docs/architecture.md "Errors and what is kept").
 #include "atonlab/stimuli/image_io.h"
 
 #include <Imath/half.h>
@@ -39,7 +38,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Header attribute names (DESIGN.md "File formats").
+// Header attribute names (docs/architecture.md "Units and colour").
 constexpr const char* kUnits = "units";
 constexpr const char* kDegreesPerPixel = "degreesPerPixel";
 constexpr const char* kAdaptation = "adaptationLuminance";

@@ -114,7 +114,7 @@ CREATE TRIGGER trials_append_only_delete BEFORE DELETE ON trials
 BEGIN SELECT RAISE(ABORT, 'trials are append-only: a recorded trial cannot be deleted'); END;
 
 -- The stimulus as rendered, one per session and condition: an OpenEXR file's
--- bytes (scene-referred cd/m2, DESIGN.md "File formats"), so a study is one file.
+-- bytes (scene-referred cd/m2, docs/architecture.md "Units and colour"), so a study is one file.
 CREATE TABLE snapshots (
     session_id   INTEGER NOT NULL REFERENCES sessions(id),
     condition_id TEXT NOT NULL,

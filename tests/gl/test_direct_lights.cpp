@@ -1,4 +1,4 @@
-// The direct-light stage on the GPU, held to DESIGN.md's invariants:
+// The direct-light stage on the GPU, held to docs/architecture.md's "Physical invariants":
 // energy (Σ L·Ω = I·T·P·B/d²), no flicker, and CPU/GPU agreement of the light model.
 #include <gtest/gtest.h>
 

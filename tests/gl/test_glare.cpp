@@ -1,5 +1,5 @@
 // The glare stage on the GPU: the PSF pipeline against its double-precision
-// CPU references, and the billboards against DESIGN.md's energy rule (glare
+// CPU references, and the billboards against docs/architecture.md's "Physical invariants" (glare
 // redistributes a light's energy; it neither creates nor loses it).
 #include <gtest/gtest.h>
 

@@ -135,7 +135,7 @@ TEST(Bouguer, KoschmiederExtinctionGivesFivePercentAtTheVisibility) {
 }
 
 TEST(Bouguer, AllardIsInverseSquareTimesBouguer) {
-    // The illuminance at the eye, I * T(d) / d^2 (DESIGN.md step 2), of a light of
+    // The illuminance at the eye, I * T(d) / d^2 (docs/architecture.md "The pipeline, one frame", step 2), of a light of
     // Allard intensity equals the threshold E_t up to 3.43e6 / 1852^2 = 1.0000280:
     // the constant is 1852^2 rounded to three digits.
     for (const double d_nmi : {0.5, 2.0, 6.0, 15.0}) {

@@ -1,5 +1,5 @@
 // Tone mapping and adaptation (K2012 §4.4): every equation against values computed by hand
-// from the papers, the thesis's typos pinned, and DESIGN.md's invariant "every operator is
+// from the papers, the thesis's typos pinned, and the invariant of docs/architecture.md ("Physical invariants") "every operator is
 // finite and monotonic in luminance over 0 … 1e9 cd/m², including exact zero and pure
 // primaries" swept over adaptation, hue preservation and blueshift.
 #include <gtest/gtest.h>
@@ -437,7 +437,7 @@ TEST(Blueshift, DarkAdaptationTurnsEveryColourTowardsTheBlueshiftHue) {
 }
 
 TEST(ToneMapInvariant, EveryOperatorFiniteAndMonotonicFromZeroToOneE9) {
-    // DESIGN.md: every operator finite and monotonic in luminance over 0 … 1e9 cd/m², exact
+    // docs/architecture.md: every operator finite and monotonic in luminance over 0 … 1e9 cd/m², exact
     // zero and pure primaries included, at adaptation 1e-6 … 1e6 cd/m² (25 levels), for
     // blueshift on/off and each hue mode. Monotonic: the output luminance never decreases as
     // the input luminance grows at fixed chromaticity (a relative 1e-12 allowance for

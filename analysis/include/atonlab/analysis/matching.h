@@ -36,7 +36,7 @@ AdjustmentSummary summarize_log_ratios(std::span<const double> log10_ratios, con
 /// intensity / glare test intensity). The PSE is the log10 intensity of the
 /// no-glare reference that looks as bright as the glare test shown at
 /// test_log10; > 0 means the glare version looks brighter than its
-/// energy-matched no-glare twin (DESIGN.md "Glare and no-glare are energy-matched").
+/// energy-matched no-glare twin (docs/architecture.md "Physical invariants").
 struct Enhancement {
     std::optional<double> log10_enhancement;  ///< pse_log10 - test_log10
     std::optional<double> ratio;              ///< 10^log10_enhancement

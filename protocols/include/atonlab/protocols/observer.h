@@ -1,5 +1,5 @@
 #pragma once
-// Observers: whoever answers a trial (DESIGN.md "Experiments"). A person at the
+// Observers: whoever answers a trial (docs/architecture.md "One trial, from protocol to store"). A person at the
 // runner's keyboard is one; here are the two that run headless:
 //
 //  - ModelObserver: a deterministic brightness model with Gaussian decision

@@ -1,5 +1,5 @@
 #pragma once
-// The common shape of every adaptive procedure (DESIGN.md "Experiments"): a pure
+// The common shape of every adaptive procedure (docs/architecture.md "One trial, from protocol to store"): a pure
 // state machine. Given the responses recorded so far it proposes the next
 // stimulus; replaying the logged responses into a freshly constructed procedure
 // (same parameters, same seed) reconstructs its state exactly, bit for bit. That

@@ -1,5 +1,5 @@
 #pragma once
-// A protocol: what a study asks (DESIGN.md "Experiments"; every key of the file
+// A protocol: what a study asks (docs/architecture.md "One trial, from protocol to store"; every key of the file
 // in docs/protocol-file.md). The display, the scene template, blocks of
 // conditions that override scene keys, and for each condition the task, the
 // procedure, what the procedure's level controls and how the stimulus is

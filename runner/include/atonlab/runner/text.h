@@ -1,5 +1,5 @@
 #pragma once
-// Text on the participant screen (DESIGN.md: stb_truetype with a Debian font):
+// Text on the participant screen (docs/architecture.md: stb_truetype with a Debian font):
 // a TrueType font rasterised on the CPU into a coverage bitmap, laid out in
 // word-wrapped lines, and blended into display code values. Text is drawn
 // after display encoding, at a code value the session chooses (the luminance

@@ -1,6 +1,6 @@
 #pragma once
 // The display model and the display encoder: the last stage of the pipeline
-// (DESIGN "The pipeline" step 6). Input is display-referred *linear* Rec.709 RGB
+// (docs/architecture.md "The pipeline, one frame" step 6). Input is display-referred *linear* Rec.709 RGB
 // relative to the display's white (1 = the channel's full-drive luminance; the
 // tone mapper produces it); output is the integer code values that make a
 // calibrated display emit the intended luminance, dithered to the frame

@@ -1,6 +1,6 @@
 #pragma once
 // Adaptation, tone mapping and display encoding of HDR frames on the GPU
-// (DESIGN.md pipeline steps 4-6; K2012 §4.4): the log-average luminance by a
+// (docs/architecture.md "The pipeline, one frame", steps 4-6; K2012 §4.4): the log-average luminance by a
 // double-precision GPU reduction (eq 4.15), temporal adaptation (eq 4.16-4.17)
 // driven by the real frame time, or a fixed level; tonemap.glsl; then
 // display_encode.glsl to the display's code values with dithering. The state

@@ -5,7 +5,7 @@
 // K2012 eq 4.5 attenuates a sub-pixel light's radiance by its projected area
 // in pixels so the energy reaching the image is continuous. We generalise it
 // so that Σ L·Ω over the image equals the illuminance at the eye exactly
-// (DESIGN.md energy rule), at any size and anywhere in the field:
+// (docs/architecture.md "Physical invariants"), at any size and anywhere in the field:
 //  - the footprint area A (px²) is the light's solid angle times f²/cos³α
 //    (the image-plane area of a small solid angle seen α off-axis);
 //  - A >= 1 px²: a disc of that area (the sphere's projection, K2012 §4.1.3);

@@ -1,5 +1,5 @@
 #pragma once
-// The glare stage of one frame (DESIGN.md pipeline step 3; K2012 §4.2-4.3,
+// The glare stage of one frame (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3,
 // §5.3): per SPD, the glare kernel of the scene's model, its area layers up to
 // the largest projected radius the scene needs, and the billboards that draw
 // each visible light's glare in place of its direct image. Caches everything

@@ -20,7 +20,7 @@ struct ImageRGBA32F {
     const float* pixel(int x, int y) const { return &rgba[(static_cast<std::size_t>(y) * width + x) * 4]; }
 };
 
-/// EXR header attributes atonlab writes and reads (DESIGN.md "File formats").
+/// EXR header attributes atonlab writes and reads (docs/architecture.md "Units and colour").
 struct ExrMetadata {
     std::string units = "cd/m2";           ///< "cd/m2" for scene-referred images, "relative" for PSFs
     double degrees_per_pixel = 0.0;        ///< visual angle of one pixel at the image centre

@@ -1,5 +1,5 @@
 #pragma once
-// What happens to an HDR frame after the lights and the glare (DESIGN.md
+// What happens to an HDR frame after the lights and the glare (docs/architecture.md
 // pipeline steps 4-6): adaptation, tone mapping, display model and encoding.
 // Plain settings (no GL), part of a Scene; DisplayPipeline carries them out.
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
 // The whole pipeline of one displayed frame, for a simulator that owns its
-// window and GL context (DESIGN.md "The pipeline"; issue: the simulator's
+// window and GL context (docs/architecture.md "The pipeline, one frame"; issue: the simulator's
 // pipeline, embeddable): lights → glare → adaptation → tone mapping → display
 // encoding, or the LDR path (glare tone-mapped on its own and added to a
 // display-referred scene). Call render() once per frame with the frame time;

@@ -1,5 +1,5 @@
 #pragma once
-// A scene: what the renderer draws in one frame (DESIGN.md "File formats").
+// A scene: what the renderer draws in one frame (docs/architecture.md "Units and colour").
 // World frame: metres, right-handed, x east, y up, -z north. Bearings and yaw
 // are clockwise from north, as on a chart.
 #include <cstdint>
@@ -82,7 +82,7 @@ struct Light {
     std::string spd;
 };
 
-/// The glare stage (DESIGN.md pipeline step 3; K2012 §4.2-4.3). Every model
+/// The glare stage (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3). Every model
 /// conserves each light's energy; all but `cie` go through the same billboards,
 /// `cie` convolves the whole frame (its veil reaches tens of degrees).
 enum class GlareModel : std::uint8_t {

@@ -1,5 +1,5 @@
 #pragma once
-// The scene file (TOML; DESIGN.md "File formats"; every key in docs/scene-file.md).
+// The scene file (TOML; docs/architecture.md "Units and colour"; every key in docs/scene-file.md).
 #include <filesystem>
 #include <string>
 #include <string_view>

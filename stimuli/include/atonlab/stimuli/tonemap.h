@@ -1,5 +1,5 @@
 #pragma once
-// Tone mapping and adaptation (K2012 §3.5, §4.4; DESIGN.md pipeline steps 4-5): the CPU
+// Tone mapping and adaptation (K2012 §3.5, §4.4; docs/architecture.md "The pipeline, one frame", steps 4-5): the CPU
 // double-precision reference of shaders/tonemap.glsl.
 //
 // Input: scene-referred linear Rec.709 RGB on an absolute scale (cd/m²: a pixel's
