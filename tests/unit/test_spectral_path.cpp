@@ -36,13 +36,13 @@ TEST(SpectralPath, AnchorsSitWhereTheLightIs) {
 
 TEST(SpectralPath, DefaultEyeAndClearPupilWithinOnePercentOfTheExactPath) {
     const SpectralSamples samples = spectral_samples(d65_spectrum(), kSamples);
-    EyeModel current;  // the default eye, night pupil (as bench/ measures it)
+    EyeModel current;  // the default eye (focused, two scales), night pupil (as bench/ measures it)
     current.pupil_diameter_mm = 6.0;
-    EyeModel focused = current;  // the same eye in focus (E off)
-    focused.fresnel_distance_mm = 0.0;
+    EyeModel k2012 = EyeModel::k2012();  // the thesis's single scale with its defocus
+    k2012.pupil_diameter_mm = 6.0;
     const EyeModel clear = EyeModel::clear_pupil(6.0);
     for (const auto& [name, eye] :
-         {std::pair{"default", current}, std::pair{"focused", focused}, std::pair{"clear pupil", clear}}) {
+         {std::pair{"default", current}, std::pair{"k2012", k2012}, std::pair{"clear pupil", clear}}) {
         const RgbPsf exact = spectral_psf_exact(eye, kN, samples);
         const RgbPsf anchored = spectral_psf_anchored(eye, kN, samples, 6);
         const RgbPsf rescaled = spectral_psf_resampled(mono_psf_reference(eye, kN, kReferenceWavelengthNm), samples);
