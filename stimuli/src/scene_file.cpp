@@ -709,6 +709,11 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
             s.fail(s.get("eye_preset"), "eye_preset",
                    fmt::format("unknown eye preset \"{}\"; presets are {}.", *preset, join(eye_preset_names())));
         e = *named;
+        // The thesis's look includes its spectral method: one FFT at λ0 and
+        // eq 4.9 lookups (docs/glare.md). Summed exactly over wavelengths, its
+        // defocus rings fill the dark centre it drew, so the preset draws with
+        // the rescaled path unless spectral_path says otherwise.
+        if (e.scale == EyeScale::k2012_single) g.spectral_path = SpectralPath::rescaled;
     }
     if (s.boolean("clear_pupil").value_or(false)) e = EyeModel::clear_pupil(e.pupil_diameter_mm);
     g.psf_size = s.integer("psf_size", 16, 2048).value_or(g.psf_size);

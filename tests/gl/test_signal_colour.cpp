@@ -5,9 +5,9 @@
 // with the blueshift off. Each light is judged alone: the frame is black
 // around the lights and the eye held at the adaptation level, so the core's
 // chromaticity is the light's own rendering, not its mixture with the sky
-// (which in daylight would be the sky's). Glare is off here so the core is the
-// light's direct image; GL.SignalColour.WithGlare* repeats the Δu′v′ part with
-// the wave-optics PSF. Passes at every adaptation level with the
+// (which in daylight would be the sky's). The full check runs on the lights'
+// direct images (glare off); GL.SignalColour.WithTheEyesGlare* repeats the
+// Δu′v′ part with the default eye's wave-optics PSF. Passes at every adaptation level with the
 // per-pixel blueshift; the adaptation reading fails in starlight, where it
 // turns the coloured lights white (the failure this check exists to catch).
 #include <gtest/gtest.h>
@@ -82,41 +82,38 @@ glm::ivec3 code_at(const EncodedImage& codes, int x, int y) {
     return {codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
 }
 
-/// XYZ of a light's displayed core: the 3 x 3 pixels around its brightest
-/// displayed pixel (searched within 4 px of its projected centre), as emitted
-/// (the display's black included: a dim light's weak channel may lie below
-/// the black a channel cannot go under, and the black is what shows there).
+/// XYZ of a light's displayed core: the pixel its projected centre falls in,
+/// as emitted (the display's black included: a dim light's weak channel may
+/// lie below the black a channel cannot go under, and the black is what shows
+/// there). Not the brightest displayed pixel: at night every pixel the glare
+/// touches saturates, and a blue-shifted glare pixel clipped at white shows
+/// more luminance than the light's own pure red one.
 glm::dvec3 core_xyz(const EncodedImage& codes, const DisplayModel& display, glm::dvec2 centre_px) {
-    const int cx = static_cast<int>(centre_px.x), cy = codes.height - 1 - static_cast<int>(centre_px.y);
-    int bx = cx, by = cy;
-    double best = -1.0;
-    for (int y = cy - 4; y <= cy + 4; ++y)
-        for (int x = cx - 4; x <= cx + 4; ++x) {
-            const double l = displayed_xyz(display, code_at(codes, x, y), codes.bits).y;
-            if (l > best) best = l, bx = x, by = y;
-        }
-    glm::dvec3 sum(0.0);
-    for (int y = by - 1; y <= by + 1; ++y)
-        for (int x = bx - 1; x <= bx + 1; ++x) sum += displayed_xyz(display, code_at(codes, x, y), codes.bits);
-    return sum;
+    const int x = static_cast<int>(centre_px.x), y = codes.height - 1 - static_cast<int>(centre_px.y);
+    return displayed_xyz(display, code_at(codes, x, y), codes.bits);
 }
 
 using SignalColour = GLTest;
 
-TEST_F(SignalColour, ColouredLightsKeepTheirColourAtEveryAdaptation) {
+/// Runs the check at every adaptation level and operator with the scene's
+/// glare set to `glare`; `area` also requires the core inside its colour's
+/// area. Returns how many coloured lights the adaptation reading turns in
+/// starlight (0.001 cd/m²).
+int check_every_level(const std::string& glare, bool area) {
     FrameRenderer frame;
     DisplayPipeline display;
-    int failures_adaptation_reading_starlight = 0;
+    int adaptation_reading_failures = 0;
     for (const double adaptation : {0.001, 0.03, 1.0, 24.0, 1570.0}) {
-        const std::string l = std::to_string(adaptation);
-        Scene scene = parse_scene(kScene, "signal-colour.toml", {SceneOverride::parse("eye.adaptation_cd_m2=" + l)});
+        Scene scene = parse_scene(kScene, "signal-colour.toml",
+                                  {SceneOverride::parse("eye.adaptation_cd_m2=" + std::to_string(adaptation)),
+                                   SceneOverride::parse("eye.glare=\"" + glare + "\"")});
         frame.render(scene, 0.0);
         const std::vector<LightDrawRecord> draws = frame.read_light_draws();
-        ASSERT_EQ(draws.size(), 4u);
+        EXPECT_EQ(draws.size(), 4u);
+        if (draws.size() != 4u) return -1;
         for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual}) {
             // The codes of one tone-mapping setting, dithered as the display
-            // shows them (the same pattern for every rendering: frame 0), so the
-            // 3 x 3 core averages the quantisation of a dim light out.
+            // shows them (the same pattern for every rendering: frame 0).
             auto codes_with = [&](bool blueshift, BlueshiftLuminance whose) {
                 OutputSettings out = scene.output;
                 out.tonemap.tone_operator = op;
@@ -135,23 +132,38 @@ TEST_F(SignalColour, ColouredLightsKeepTheirColourAtEveryAdaptation) {
                     check_signal_colour(kColours[i], core_xyz(per_pixel, dm, draws[i].centre_px), reference);
                 const SignalColourCheck a =
                     check_signal_colour(kColours[i], core_xyz(per_adaptation, dm, draws[i].centre_px), reference);
-                std::printf(
-                    "L_wa %-7g %-10s %-6s photopic u'v' (%.4f, %.4f): per pixel du'v' %.4f%s, "
-                    "adaptation du'v' %.4f%s\n",
-                    adaptation, std::string(tone_operator_name(op)).c_str(), kColours[i], c.photopic_uv.x,
-                    c.photopic_uv.y, c.delta_uv,
-                    c.area_meets_gamut ? (c.inside_area ? " (in area)" : " (OUT of area)") : "", a.delta_uv,
-                    a.passes() ? "" : " FAILS");
-                EXPECT_TRUE(c.passes()) << kColours[i] << " at " << adaptation << " cd/m2, " << tone_operator_name(op)
-                                        << ": du'v' " << c.delta_uv << ", in area " << c.inside_area;
-                if (adaptation == 0.001 && std::string(kColours[i]) != "white" && !a.passes())
-                    ++failures_adaptation_reading_starlight;
+                std::printf("glare %-11s L_wa %-7g %-10s %-6s photopic u'v' (%.4f, %.4f): per pixel du'v' %.4f%s, "
+                            "adaptation du'v' %.4f\n",
+                            glare.c_str(), adaptation, std::string(tone_operator_name(op)).c_str(), kColours[i],
+                            c.photopic_uv.x, c.photopic_uv.y, c.delta_uv,
+                            c.area_meets_gamut ? (c.inside_area ? " (in area)" : " (out of area)") : "", a.delta_uv);
+                const bool passes = area ? c.passes() : c.delta_uv <= 0.01;
+                EXPECT_TRUE(passes) << kColours[i] << " at " << adaptation << " cd/m2, " << tone_operator_name(op)
+                                    << ", glare " << glare << ": du'v' " << c.delta_uv << ", in area "
+                                    << c.inside_area;
+                if (adaptation == 0.001 && std::string(kColours[i]) != "white" && a.delta_uv > 0.01)
+                    ++adaptation_reading_failures;
             }
         }
     }
-    // The adaptation reading turns the three coloured lights white in
-    // starlight, under both operators: the check must see it.
-    EXPECT_EQ(failures_adaptation_reading_starlight, 6);
+    return adaptation_reading_failures;
+}
+
+// The full check on the lights' direct images: within 0.01 in u'v' of the
+// photopic rendering and inside the area, at every level; the adaptation
+// reading turns all three coloured lights in starlight, under both operators.
+TEST_F(SignalColour, ColouredLightsKeepTheirColourAtEveryAdaptation) {
+    EXPECT_EQ(check_every_level("none", true), 6);
+}
+
+// With the default (focused) eye's glare the blueshift still leaves each
+// core within 0.01 of its photopic rendering. The area is not required here:
+// the eye's diffraction core is narrower in blue than in red (1.22 λ/D), so
+// a white light's centre pixel is a little blue — u'v' (0.1948, 0.4677) at
+// 24 cd/m² — and D65 lies only 0.0027 inside the white area's blue edge
+// (x = 0.310). That is the optics, the same with the blueshift off.
+TEST_F(SignalColour, WithTheEyesGlareTheBlueshiftKeepsEachCoresColour) {
+    EXPECT_EQ(check_every_level("wave-optics", false), 6);
 }
 
 }  // namespace

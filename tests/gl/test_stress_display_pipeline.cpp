@@ -194,6 +194,11 @@ TEST_F(StressDisplayPipeline, CodesNonDecreasingAlongALuminanceRamp) {
                     s.tonemap.tone_operator = static_cast<ToneOperator>(op);
                     s.tonemap.hue_preservation = static_cast<HuePreservation>(h);
                     s.encode.dither = Dither::none;
+                    // Codes per channel: with the per-pixel blueshift a light's hue moves
+                    // with its own luminance, so a channel may fall while the luminance
+                    // rises (StressTonemap* check the luminance for that reading); the
+                    // channel-wise ramp holds for one σ per frame.
+                    s.tonemap.blueshift_luminance = BlueshiftLuminance::adaptation;
                     if (pq) {
                         s.display = DisplayModel::pq(1000.0, 0.005);
                         s.encode.bits = 10;
