@@ -10,7 +10,9 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/protocols/procedure.h"
 #include "csv.h"
 
@@ -271,12 +273,20 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
 
 }  // namespace
 
+/// Largest trials CSV read (bytes): 256 MiB, about two million trials.
+constexpr std::uintmax_t kMaxCsvBytes = 256u << 20;
+
 Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     const std::string file = csv_file.string();
     std::error_code ec;
     if (std::filesystem::is_directory(csv_file, ec)) throw InputError(file, 0, "", "is a directory, not a CSV file");
-    std::ifstream in(csv_file, std::ios::binary);
-    if (!in) throw InputError(file, 0, "", "cannot be opened for reading (does it exist?)");
+    // Read whole, up to a limit (docs/fuzzing.md "Limits on input"): a trials
+    // CSV of a large study is tens of MB; /dev/zero or a mistaken binary file
+    // would otherwise be read until the memory runs out.
+    const text::FileText read = text::read_text_file(csv_file, kMaxCsvBytes);
+    if (!read.opened) throw InputError(file, 0, "", "cannot be opened for reading (does it exist?)");
+    if (!read.ok()) throw InputError(file, 0, "", fmt::format("cannot be read: {}", read.error));
+    std::istringstream in(read.text);
     int line = 0;
     std::string error;
     auto header = detail::read_csv_record(in, line, error);
