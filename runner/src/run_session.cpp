@@ -479,10 +479,9 @@ s::Scene condition_scene(const std::string& scene_text, const std::filesystem::p
         std::vector<s::SceneOverride> parsed;
         for (const std::string& o : frame.overrides) parsed.push_back(parsed_override(protocol, o));
         s::Scene scene = s::parse_scene(scene_text, scene_file.string(), parsed);
+        // parse_scene has checked that the glare billboard fits the display
+        // (GL-free, naming the keys), so a session refuses it before it opens anything.
         s::validate_output_settings(scene.output);
-        // The billboard the glare stage will build for it fits the display (a
-        // GL-free check, so that a session refuses it before it opens anything).
-        s::check_glare_billboard(scene);
         return scene;
     } catch (const InputError& e) {
         const std::optional<SourceLocation>& w = e.where();

@@ -118,11 +118,6 @@ double glare_psf_degrees_per_texel(const GlareSettings& glare) {
     }
 }
 
-void check_glare_billboard(const Scene& scene) {
-    const double radius_deg = glare_billboard_radius_deg(scene.glare);
-    if (radius_deg == 0.0 || scene.lights.empty()) return;
-    glare_kernel_size_px(scene.display.pixels_per_degree_at_centre(), radius_deg);
-}
 
 namespace {
 

@@ -53,13 +53,6 @@ double glare_billboard_radius_deg(const GlareSettings& glare);
 /// the analytic ones, which have no PSF texture.
 double glare_psf_degrees_per_texel(const GlareSettings& glare);
 
-/// The checks the glare stage makes when it builds the scene's billboard
-/// kernel (glare_kernel_size_px: radius and width at the display's centre
-/// pixel density), made without GL so that a session can refuse a scene
-/// before it opens anything. Throws InputError; does nothing for a scene
-/// without lights or glare.
-void check_glare_billboard(const Scene& scene);
-
 /// Pupil diameter (mm) a scene's glare uses: the given one, or eq 3.15 from the adaptation.
 double glare_pupil_mm(const Scene& scene);
 
