@@ -26,7 +26,7 @@ void add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::App* cmd = app.add_subcommand("render", "Render one frame of a scene headless to an EXR (cd/m²) and a PNG");
     cmd->add_option("scene", o.scene, "Scene file (TOML; see docs/scene-file.md)")->required();
     cmd->add_option("-o,--output", o.exr, "Output EXR: linear Rec.709, absolute cd/m²")->required();
-    cmd->add_option("--png", o.png, "Also write a display-encoded PNG (plain exposure + sRGB curve)");
+    cmd->add_option("--png", o.png, "Also write the PNG the display would show (the scene's tone mapper and display encoding)");
     cmd->add_option("--time", o.time_s, "Time in seconds at which rhythms are sampled (default 0)");
     cmd->add_option("--set", o.overrides, "Override a scene key: section.key=value (TOML value; repeatable)");
     cmd->add_flag("--half", o.half, "Write the EXR as half floats instead of 32-bit floats");
