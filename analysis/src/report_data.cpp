@@ -6,6 +6,7 @@
 #include <map>
 
 #include "atonlab/analysis/report.h"
+#include "atonlab/common/atomic_file.h"
 #include "csv.h"
 #include "json_writer.h"
 
@@ -140,21 +141,6 @@ void write_group(JsonWriter& j, const GroupResult& g, const ConditionInfo& c) {
         j.null();
     }
     j.end_object();
-}
-
-/// Writes `text` to `file` through a temporary sibling renamed into place.
-void write_atomically(const std::filesystem::path& file, const std::string& text) {
-    const std::filesystem::path tmp = file.string() + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << text;
-        out.flush();
-        if (!out)
-            throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) throw std::runtime_error(fmt::format("{}: cannot be written: {}", file.string(), ec.message()));
 }
 
 std::string opt(const std::optional<double>& v) {
@@ -311,7 +297,7 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
     for (const std::string& w : ctx.problems) j.value(w);
     j.end_array();
     j.end_object();
-    write_atomically(file, j.text() + "\n");
+    files::write_file_atomically(file, j.text() + "\n");
 }
 
 void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
@@ -436,7 +422,7 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
                  {"method", csv_field(m.method)}});
         }
     }
-    write_atomically(file, out);
+    files::write_file_atomically(file, out);
 }
 
 std::vector<std::filesystem::path> write_report(const std::filesystem::path& out_dir, const ReportContext& ctx) {

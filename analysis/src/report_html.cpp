@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "atonlab/analysis/report.h"
+#include "atonlab/common/atomic_file.h"
 #include "csv.h"
 
 namespace atonlab::analysis {
@@ -369,17 +370,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
          "number here), and <code>figures/</code>. Their columns are described in docs/analysis.md.</p>\n";
     h += "</body>\n</html>\n";
 
-    const std::filesystem::path tmp = file.string() + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << h;
-        out.flush();
-        if (!out)
-            throw std::runtime_error(fmt::format("{}: cannot be written (disk full? permissions?)", file.string()));
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) throw std::runtime_error(fmt::format("{}: cannot be written: {}", file.string(), ec.message()));
+    files::write_file_atomically(file, h);
 }
 
 }  // namespace atonlab::analysis

@@ -12,13 +12,10 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <png.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <csetjmp>
@@ -26,11 +23,11 @@
 #include <cstring>
 #include <exception>
 #include <memory>
-#include <random>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
 
+#include "atonlab/common/atomic_file.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::stimuli {
@@ -52,80 +49,27 @@ std::string errno_text(int err) {
     return std::error_code(err, std::generic_category()).message();
 }
 
-/// A temporary file next to the destination, renamed over it by commit(). The
-/// destructor removes the temporary unless it was committed, so every early
-/// exit (exception or error return) cleans up.
+/// common's AtomicFile, whose failures become this library's InputError
+/// naming the file.
 class AtomicFile {
 public:
-    explicit AtomicFile(fs::path destination) : destination_(std::move(destination)) {
-        const fs::path dir = destination_.has_parent_path() ? destination_.parent_path() : fs::path(".");
-        // O_EXCL with a name nobody else picks; mode 0666 so the umask, not
-        // mkstemp's 0600, decides who can read the finished image.
-        static std::atomic<unsigned> counter{0};
-        std::random_device entropy;
-        int last_errno = 0;
-        for (int attempt = 0; attempt < 16; ++attempt) {
-            const auto name = fmt::format(".{}.{}-{}-{:08x}.tmp", destination_.filename().string(), ::getpid(),
-                                          counter.fetch_add(1), entropy());
-            fs::path candidate = dir / name;
-            const int fd = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-            if (fd >= 0) {
-                fd_ = fd;
-                temp_ = std::move(candidate);
-                return;
-            }
-            last_errno = errno;
-            if (last_errno != EEXIST) break;
-        }
-        fail(destination_, fmt::format("cannot create a temporary file in '{}' to write it: {}", dir.string(),
-                                       errno_text(last_errno)));
+    explicit AtomicFile(const fs::path& destination) try : file_(destination) {
+    } catch (const files::WriteError& e) {
+        fail(e.path(), e.reason());
     }
-
-    AtomicFile(const AtomicFile&) = delete;
-    AtomicFile& operator=(const AtomicFile&) = delete;
-
-    ~AtomicFile() {
-        close_fd();
-        if (!committed_) {
-            std::error_code ignored;
-            fs::remove(temp_, ignored);
-        }
-    }
-
-    const fs::path& temp_path() const { return temp_; }
-
-    /// Hands the descriptor to a FILE* (the caller then owns it) or closes it so
-    /// that a library can open temp_path() by name.
-    int release_fd() { return std::exchange(fd_, -1); }
-    void close_fd() {
-        if (fd_ >= 0) ::close(fd_);
-        fd_ = -1;
-    }
-
-    /// Flushes the finished temporary to disk and renames it over the destination.
+    const fs::path& temp_path() const { return file_.temp_path(); }
+    int release_fd() { return file_.release_fd(); }
+    void close_fd() { file_.close_fd(); }
     void commit() {
-        close_fd();
-        // fsync before rename: after a crash the destination holds either the old
-        // file or the complete new one.
-        const int fd = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
-        if (fd < 0 || ::fsync(fd) != 0) {
-            const int err = errno;
-            if (fd >= 0) ::close(fd);
-            fail(destination_,
-                 fmt::format("cannot flush the temporary file '{}': {}", temp_.string(), errno_text(err)));
+        try {
+            file_.commit();
+        } catch (const files::WriteError& e) {
+            fail(e.path(), e.reason());
         }
-        ::close(fd);
-        std::error_code ec;
-        fs::rename(temp_, destination_, ec);
-        if (ec) fail(destination_, fmt::format("cannot move the finished file into place: {}", ec.message()));
-        committed_ = true;
     }
 
 private:
-    fs::path destination_;
-    fs::path temp_;
-    int fd_ = -1;
-    bool committed_ = false;
+    files::AtomicFile file_;
 };
 
 bool is_reserved_exr_attribute(const std::string& name) {
