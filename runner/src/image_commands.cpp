@@ -189,7 +189,8 @@ int run_tonemap(const TonemapOptions& o) {
             const float* p = hdr.pixel(x, y);
             const glm::dvec3 rel = stimuli::tonemap_pixel({p[0], p[1], p[2]}, adaptation, tm);
             if (rel.r > 1 || rel.g > 1 || rel.b > 1) ++clipped;
-            const glm::ivec3 c = stimuli::encode_pixel(out.display, rel, {x, y}, 0, out.encode);
+            // The dither pattern's rows count from the bottom, as on the GPU (frame 0).
+            const glm::ivec3 c = stimuli::encode_pixel(out.display, rel, {x, hdr.height - 1 - y}, 0, out.encode);
             float* q = &codes[(static_cast<std::size_t>(y) * hdr.width + x) * 3];
             for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(c[k] / 255.0);
         }
