@@ -4,6 +4,7 @@
 // GL.ImageCommands.TonemapReinhardMatchesPfstmoReinhard02 matches them. Skipped
 // (no rows) when pfstools is not installed.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +12,6 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "atonlab/stimuli/display_model.h"
@@ -100,8 +100,8 @@ void bench_tonemap_pfstools(Bench& b) {
     auto pfstools = [&] { pfs_status = std::system(pfs_command.c_str()); };
     const std::vector<Timing> times = measure_interleaved({atonlab_tonemap, pfstools}, b.spec(5, false));
 
-    const std::vector<float> theirs = pfs_status == 0 ? read_pfm_top_down(pfm, frame.width, frame.height)
-                                                      : std::vector<float>{};
+    const std::vector<float> theirs =
+        pfs_status == 0 ? read_pfm_top_down(pfm, frame.width, frame.height) : std::vector<float>{};
     double sum = 0;
     int worst = 0;
     for (std::size_t i = 0; i < theirs.size(); ++i) {
@@ -122,9 +122,10 @@ void bench_tonemap_pfstools(Bench& b) {
     a.error = mean;
     a.codes = theirs.empty() ? kNaN : worst;
     a.metric = metric;
-    a.note = fmt::format("{}x{} px; in-process: EXR read, log-average, Reinhard 2002 global, sRGB encode, PNG write; "
-                         "one thread; max difference {} code",
-                         frame.width, frame.height, worst);
+    a.note = fmt::format(
+        "{}x{} px; in-process: EXR read, log-average, Reinhard 2002 global, sRGB encode, PNG write; "
+        "one thread; max difference {} code",
+        frame.width, frame.height, worst);
     b.add(a);
     Row p;
     p.bench = "tonemap_pfstools";

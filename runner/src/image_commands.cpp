@@ -29,7 +29,9 @@ namespace atonlab::runner {
 
 namespace {
 
-SourceLocation option(const char* name) { return SourceLocation{name, 0, 0, ""}; }
+SourceLocation option(const char* name) {
+    return SourceLocation{name, 0, 0, ""};
+}
 
 bool on_off(const std::optional<std::string>& v, const char* name, bool fallback) {
     if (!v) return fallback;
@@ -39,7 +41,8 @@ bool on_off(const std::optional<std::string>& v, const char* name, bool fallback
 }
 
 double positive(const std::optional<double>& v, const char* name, const char* what) {
-    if (!(*v > 0 && std::isfinite(*v))) throw InputError(option(name), fmt::format("{} must be a positive number", what));
+    if (!(*v > 0 && std::isfinite(*v)))
+        throw InputError(option(name), fmt::format("{} must be a positive number", what));
     return *v;
 }
 
@@ -66,7 +69,9 @@ std::string to_cd_m2(stimuli::ExrImage& in, const std::string& path, const std::
     return note;
 }
 
-double luminance_of(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+double luminance_of(const float* p) {
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
 
 }  // namespace
 
@@ -93,9 +98,10 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--blueshift", o.blueshift, "Scotopic blueshift (K2012 eq 4.27-4.29): on (default) or off");
     cmd->add_option("--hue-preservation", o.hue_preservation, "none, xyY (default) or rgb");
     cmd->add_option("--key", o.key, "reinhard: the key a (default 0.18)");
-    cmd->add_option("--reinhard-white", o.reinhard_white,
-                    "reinhard: L_white in scaled luminance, or 'max' (the image's brightest pixel, as pfstmo_reinhard02); "
-                    "default infinity");
+    cmd->add_option(
+        "--reinhard-white", o.reinhard_white,
+        "reinhard: L_white in scaled luminance, or 'max' (the image's brightest pixel, as pfstmo_reinhard02); "
+        "default infinity");
     cmd->add_option("--white-cd-m2", o.white_cd_m2, "linear and clamp: the luminance (cd/m²) shown as display white");
 }
 
@@ -199,15 +205,18 @@ int run_tonemap(const TonemapOptions& o) {
     std::printf("%s: %dx%d, %s, log-average %.6g cd/m2 -> %s\n", o.input.c_str(), hdr.width, hdr.height, units.c_str(),
                 log_average, o.png.c_str());
     std::printf("  adaptation_cd_m2=%.6g (%s) operator=%s%s hue_preservation=%s blueshift=%s\n", adaptation,
-                o.adaptation_cd_m2 ? "given" : scene_adaptation ? "the scene's fixed level" : "log-average, K2012 eq 4.15",
+                o.adaptation_cd_m2 ? "given"
+                : scene_adaptation ? "the scene's fixed level"
+                                   : "log-average, K2012 eq 4.15",
                 std::string(stimuli::tone_operator_name(tm.tone_operator)).c_str(),
                 tm.tone_operator == stimuli::ToneOperator::reinhard
                     ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative).c_str()
                     : "",
                 std::string(stimuli::hue_preservation_name(tm.hue_preservation)).c_str(), tm.blueshift ? "on" : "off");
-    std::printf("  display=%s peak_cd_m2=%g black_cd_m2=%g bits=8 dither=%s; %zu pixels above display white (clipped)\n",
-                out.display.name.c_str(), out.display.peak_cd_m2, out.display.black_cd_m2,
-                out.encode.dither == stimuli::Dither::none ? "off" : "on", clipped);
+    std::printf(
+        "  display=%s peak_cd_m2=%g black_cd_m2=%g bits=8 dither=%s; %zu pixels above display white (clipped)\n",
+        out.display.name.c_str(), out.display.peak_cd_m2, out.display.black_cd_m2,
+        out.encode.dither == stimuli::Dither::none ? "off" : "on", clipped);
     return 0;
 }
 
@@ -216,7 +225,8 @@ int run_tonemap(const TonemapOptions& o) {
 
 void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     CLI::App* cmd = app.add_subcommand(
-        "glare", "Add the eye's glare to a scene-referred EXR: convolve it with a glare model's PSF (energy-conserving)");
+        "glare",
+        "Add the eye's glare to a scene-referred EXR: convolve it with a glare model's PSF (energy-conserving)");
     cmd->add_option("input", o.input, "Scene-referred EXR (linear; cd/m² or any linear unit)")->required();
     cmd->add_option("-o,--output", o.output, "Output EXR (32-bit float, the input's header attributes kept)")
         ->required();
@@ -246,9 +256,9 @@ int run_glare(const GlareImageOptions& o) {
     if (o.model) {
         const auto m = stimuli::glare_model_from_name(*o.model);
         if (!m)
-            throw InputError(option("--model"),
-                             fmt::format("unknown glare model '{}'; one of wave-optics, gaussian-bloom, spencer, cie",
-                                         *o.model));
+            throw InputError(
+                option("--model"),
+                fmt::format("unknown glare model '{}'; one of wave-optics, gaussian-bloom, spencer, cie", *o.model));
         gs.model = *m;
     }
     if (gs.model == stimuli::GlareModel::none || gs.model == stimuli::GlareModel::aperture)
@@ -275,8 +285,9 @@ int run_glare(const GlareImageOptions& o) {
         throw InputError(option("--deg-per-px"),
                          fmt::format("{} has no degreesPerPixel attribute: give --deg-per-px", o.input));
     const double adaptation = o.adaptation_cd_m2 ? *o.adaptation_cd_m2
-                              : scene_adaptation ? *scene_adaptation
-                              : in.meta.adaptation_cd_m2.value_or(stimuli::log_average_luminance(in.image));
+                              : scene_adaptation
+                                  ? *scene_adaptation
+                                  : in.meta.adaptation_cd_m2.value_or(stimuli::log_average_luminance(in.image));
 
     stimuli::GlareKernel kernel;
     try {
@@ -284,12 +295,12 @@ int run_glare(const GlareImageOptions& o) {
     } catch (const InputError& e) {
         // The library names the scene key; on the command line it is an option.
         const std::string key = e.where() ? e.where()->key : std::string();
-        const char* name = key == "radius_deg"                                     ? "--radius-deg"
-                           : key == "bloom_sigma_deg"                              ? "--bloom-sigma-deg"
-                           : key == "size" || key == "psf_size"                    ? "--psf-size"
+        const char* name = key == "radius_deg"                                        ? "--radius-deg"
+                           : key == "bloom_sigma_deg"                                 ? "--bloom-sigma-deg"
+                           : key == "size" || key == "psf_size"                       ? "--psf-size"
                            : key == "pixels_per_degree" || key == "degrees_per_pixel" ? "--deg-per-px"
-                           : !o.scene.empty()                                      ? o.scene.c_str()
-                                                                                   : "--model";
+                           : !o.scene.empty()                                         ? o.scene.c_str()
+                                                                                      : "--model";
         throw InputError(option(name), e.message());
     }
     const stimuli::ImageGlareResult r = stimuli::convolve_image_glare(in.image, kernel);

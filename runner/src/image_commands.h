@@ -18,15 +18,15 @@ struct TonemapOptions {
     std::optional<double> adaptation_cd_m2;  ///< default: the log-average (K2012 eq 4.15)
     std::optional<double> epsilon_cd_m2;     ///< ε of eq 4.15
     std::optional<std::string> tone_operator;
-    std::optional<std::string> display;      ///< srgb or pq
+    std::optional<std::string> display;  ///< srgb or pq
     std::optional<double> peak_cd_m2;
     std::optional<double> black_cd_m2;
-    std::optional<std::string> dither;       ///< on or off
-    std::optional<std::string> blueshift;    ///< on or off
+    std::optional<std::string> dither;     ///< on or off
+    std::optional<std::string> blueshift;  ///< on or off
     std::optional<std::string> hue_preservation;
-    std::optional<double> key;                      ///< reinhard's key
-    std::optional<std::string> reinhard_white;      ///< a number or "max"
-    std::optional<double> white_cd_m2;              ///< linear, clamp
+    std::optional<double> key;                  ///< reinhard's key
+    std::optional<std::string> reinhard_white;  ///< a number or "max"
+    std::optional<double> white_cd_m2;          ///< linear, clamp
 };
 
 void add_tonemap_command(CLI::App& app, TonemapOptions& options);

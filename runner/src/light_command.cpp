@@ -18,7 +18,8 @@ namespace atonlab::runner {
 
 void add_light_command(CLI::App& app, LightOptions& o) {
     CLI::App* cmd = app.add_subcommand(
-        "light", "Allard's law for one light: range from intensity or intensity from range, and the IALA nominal range");
+        "light",
+        "Allard's law for one light: range from intensity or intensity from range, and the IALA nominal range");
     cmd->add_option("--intensity-cd", o.intensity_cd, "The light's luminous intensity (cd): print its range");
     cmd->add_option("--range-nmi", o.range_nmi, "The range wanted (nmi): print the intensity it needs");
     cmd->add_option("--colour", o.colour, "white, red, green, yellow or blue (printed; Allard's law is photometric)");
@@ -35,7 +36,9 @@ void add_light_command(CLI::App& app, LightOptions& o) {
 
 namespace {
 
-bool positive_finite(double v) { return v > 0 && std::isfinite(v); }
+bool positive_finite(double v) {
+    return v > 0 && std::isfinite(v);
+}
 
 }  // namespace
 
@@ -73,7 +76,8 @@ int run_light(const LightOptions& o) {
     else if (o.period == "day")
         threshold_lux = stimuli::allard_threshold_day_lux;
     else
-        throw InputError(SourceLocation{"--period", 0, 0, ""}, "the period must be night or day, not '" + o.period + "'");
+        throw InputError(SourceLocation{"--period", 0, 0, ""},
+                         "the period must be night or day, not '" + o.period + "'");
     double background_factor = 0;
     if (o.background == "none")
         background_factor = 1;
@@ -103,7 +107,8 @@ int run_light(const LightOptions& o) {
                 background_factor);
     std::printf("  visibility V: %.6g nmi (transmissivity T = 0.05^(1/V) = %.6f per nmi)\n", visibility_nmi,
                 stimuli::allard_transmissivity_per_nmi(visibility_nmi));
-    std::printf("  intensity I: %.6g cd%s\n", intensity_cd, o.intensity_cd ? " (given)" : " (Allard's law, K2012 eq 2.1)");
+    std::printf("  intensity I: %.6g cd%s\n", intensity_cd,
+                o.intensity_cd ? " (given)" : " (Allard's law, K2012 eq 2.1)");
     std::printf("  range d: %.6g nmi = %.6g km%s\n", range_nmi, range_nmi * km_per_nmi,
                 o.range_nmi ? " (given)" : " (Allard's law, K2012 eq 2.1)");
     // The charted figure: IALA E200-2's nominal conditions whatever was asked above.

@@ -65,8 +65,9 @@ GlareKernel image_glare_kernel(const GlareSettings& glare, double adaptation_cd_
             if (!(s > 0))
                 throw InputError(SourceLocation{"", 0, 0, "bloom_sigma_deg"},
                                  fmt::format("the bloom's standard deviation must be positive, not {} degrees.", s));
-            return glare_kernel_from_radial([s](double theta, double) { return std::exp(-0.5 * theta * theta / (s * s)); },
-                                            samples, ppd, default_glare_radius_deg(glare, 0.0), glare.window);
+            return glare_kernel_from_radial(
+                [s](double theta, double) { return std::exp(-0.5 * theta * theta / (s * s)); }, samples, ppd,
+                default_glare_radius_deg(glare, 0.0), glare.window);
         }
         case GlareModel::spencer: {
             const SpencerVision vision = spencer_vision_for(scene);
@@ -117,8 +118,7 @@ ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel
         // The kernel in image orientation (its row 0 is at the bottom, the image's at the top).
         std::fill(real.get(), real.get() + real_n, 0.0);
         for (int j = 0; j < m; ++j)
-            for (int i = 0; i < m; ++i)
-                real.get()[static_cast<std::size_t>(m - 1 - j) * pw + i] = kernel.at(i, j)[c];
+            for (int i = 0; i < m; ++i) real.get()[static_cast<std::size_t>(m - 1 - j) * pw + i] = kernel.at(i, j)[c];
         fftw_execute(forward_k);
         std::fill(real.get(), real.get() + real_n, 0.0);
         double in_sum = 0;

@@ -28,7 +28,8 @@ namespace fs = std::filesystem;
 using namespace atonlab::stimuli;
 
 fs::path scratch(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("atonlab-image-commands-" + name + "-" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("atonlab-image-commands-" + name + "-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -157,7 +158,8 @@ TEST(ImageCommands, GlareKeepsTheLightsEnergyMinusTheReportedEdgeCut) {
         ASSERT_DOUBLE_EQ(out.meta.degrees_per_pixel, in.meta.degrees_per_pixel);
         const std::string note = out.meta.strings.at("image_glare");
         std::smatch m;
-        ASSERT_TRUE(std::regex_search(note, m, std::regex(R"(edge_cut_rgb=\[([0-9.e+-]+), ([0-9.e+-]+), ([0-9.e+-]+)\])")))
+        ASSERT_TRUE(
+            std::regex_search(note, m, std::regex(R"(edge_cut_rgb=\[([0-9.e+-]+), ([0-9.e+-]+), ([0-9.e+-]+)\])")))
             << note;
         for (int c = 0; c < 3; ++c) {
             double sum_in = 0, sum_out = 0;  // Σ L·Ω, cd/m² · sr
@@ -184,7 +186,9 @@ TEST(ImageCommands, BadInputWritesNothing) {
     const fs::path dir = scratch("bad");
     const std::string bin = ATONLAB_BINARY;
     // No such file, an unknown operator, a glare model an image cannot take.
-    EXPECT_EQ(shell(bin + " tonemap " + (dir / "missing.exr").string() + " -o " + (dir / "a.png").string() + " 2>/dev/null"), 2);
+    EXPECT_EQ(
+        shell(bin + " tonemap " + (dir / "missing.exr").string() + " -o " + (dir / "a.png").string() + " 2>/dev/null"),
+        2);
     EXPECT_EQ(shell(bin + " tonemap x.exr -o " + (dir / "b.png").string() + " --operator drago 2>/dev/null"), 2);
     EXPECT_EQ(shell(bin + " glare x.exr -o " + (dir / "c.exr").string() + " --model aperture 2>/dev/null"), 2);
     EXPECT_TRUE(fs::is_empty(dir));
