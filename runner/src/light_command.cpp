@@ -114,7 +114,7 @@ int run_light(const LightOptions& o) {
     // The charted figure: IALA E200-2's nominal conditions whatever was asked above.
     const int nominal = stimuli::nominal_range_nmi(intensity_cd);
     const stimuli::IntensityBand band = stimuli::nominal_range_band_cd(nominal);
-    std::printf("  nominal range: %d nmi (IALA E200-2 band %.2f .. %.2f cd; night, V = 10 nmi, no background)\n",
+    std::printf("  nominal range: %d nmi (IALA E200-2 band %.6g .. %.6g cd; night, V = 10 nmi, no background)\n",
                 nominal, band.lower_cd, band.upper_cd);
     for (const double d : o.distances_nmi) {
         const double e_lux = stimuli::allard_illuminance_lux(intensity_cd, d, visibility_nmi);
