@@ -6,12 +6,15 @@
 //  - glare keeps Σ L·Ω within 1e-3 once the reported edge cut is added back.
 // GL only for the rendering (exit status 3 without GL 4.5: skipped).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <regex>
 #include <string>
 #include <vector>
@@ -146,7 +149,7 @@ TEST(ImageCommands, GlareKeepsTheLightsEnergyMinusTheReportedEdgeCut) {
     if (!render(exr, "--set 'eye.glare=\"none\"'")) GTEST_SKIP() << "no OpenGL 4.5 context";
     const ExrImage in = read_exr(exr);
     ASSERT_GT(in.meta.degrees_per_pixel, 0);
-    const double omega_sr = std::pow(in.meta.degrees_per_pixel * M_PI / 180.0, 2);
+    const double omega_sr = std::pow(in.meta.degrees_per_pixel * std::numbers::pi / 180.0, 2);
     for (const std::string model : {"spencer", "gaussian-bloom", "wave-optics", "cie"}) {
         const fs::path out_path = dir / (model + ".exr");
         ASSERT_EQ(shell(std::string(ATONLAB_BINARY) + " glare " + exr.string() + " -o " + out_path.string() +
