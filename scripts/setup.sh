@@ -15,6 +15,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev libnlopt-cxx-dev libstb-dev fonts-dejavu-core
   gnuplot-nox
+  pfstools  # tests and bench only: `atonlab tonemap --operator reinhard` is compared with pfstmo_reinhard02
   xvfb xauth
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)

@@ -34,6 +34,7 @@ const Entry kBenches[] = {
     {"hdr_format", bench_hdr_format},
     {"adaptation_stride", bench_adaptation_stride},
     {"tonemap", bench_tonemap},
+    {"tonemap_pfstools", bench_tonemap_pfstools},
     {"display_skips", bench_display_skips},
     {"lights", bench_lights},
     {"eye_validation", bench_eye_validation},

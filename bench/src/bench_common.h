@@ -74,6 +74,7 @@ void bench_area_layers(Bench& b);
 void bench_hdr_format(Bench& b);
 void bench_adaptation_stride(Bench& b);
 void bench_tonemap(Bench& b);
+void bench_tonemap_pfstools(Bench& b);
 void bench_display_skips(Bench& b);
 void bench_lights(Bench& b);
 void bench_eye_validation(Bench& b);

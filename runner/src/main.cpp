@@ -12,6 +12,8 @@
 #include "atonlab/stimuli/gl/context.h"
 #include "calibrate_command.h"
 #include "commands.h"
+#include "image_commands.h"
+#include "light_command.h"
 #include "view_command.h"
 
 int main(int argc, char** argv) {
@@ -32,6 +34,12 @@ int main(int argc, char** argv) {
     atonlab::runner::add_view_command(app, view);
     atonlab::runner::BenchCommandOptions bench;
     atonlab::runner::add_bench_command(app, bench);
+    atonlab::runner::LightOptions light;
+    atonlab::runner::add_light_command(app, light);
+    atonlab::runner::TonemapOptions tonemap;
+    atonlab::runner::add_tonemap_command(app, tonemap);
+    atonlab::runner::GlareImageOptions glare;
+    atonlab::runner::add_glare_command(app, glare);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -47,6 +55,9 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("calibrate")) return atonlab::runner::run_calibrate(calibrate);
         if (app.got_subcommand("view")) return atonlab::runner::run_view(view);
         if (app.got_subcommand("bench")) return atonlab::runner::run_bench(bench);
+        if (app.got_subcommand("light")) return atonlab::runner::run_light(light);
+        if (app.got_subcommand("tonemap")) return atonlab::runner::run_tonemap(tonemap);
+        if (app.got_subcommand("glare")) return atonlab::runner::run_glare(glare);
     } catch (const atonlab::InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;

@@ -77,6 +77,29 @@ int nominal_range_nmi(double intensity_cd) {
     return static_cast<int>(n);
 }
 
+double allard_illuminance_lux(double intensity_cd, double range_nmi, double visibility_nmi) {
+    assert(range_nmi >= 0 && visibility_nmi > 0);
+    // K2012 eq 2.1 solved for E_t: E = I * 0.05^(d/V) / (3.43e6 d^2).
+    return intensity_cd * std::exp(-range_nmi * ln_twenty / visibility_nmi) / (allard_constant * range_nmi * range_nmi);
+}
+
+double allard_transmissivity_per_nmi(double visibility_nmi) {
+    assert(visibility_nmi > 0);
+    return std::exp(-ln_twenty / visibility_nmi);  // 0.05^(1/V)
+}
+
+double visibility_nmi_from_transmissivity(double transmissivity_per_nmi) {
+    assert(transmissivity_per_nmi > 0 && transmissivity_per_nmi < 1);
+    return -ln_twenty / std::log(transmissivity_per_nmi);  // T^V = 0.05
+}
+
+IntensityBand nominal_range_band_cd(int range_nmi) {
+    assert(range_nmi >= 0);
+    const double n = range_nmi;
+    return {range_nmi == 0 ? 0.0 : allard_intensity_cd(n - 0.5, allard_threshold_night_lux, 10.0),
+            allard_intensity_cd(n + 0.5, allard_threshold_night_lux, 10.0)};
+}
+
 double extinction_per_m_from_visibility_m(double visibility_m) {
     assert(visibility_m > 0);
     // Koschmieder with the 5% contrast threshold of Allard's law: exp(-sigma V) = 0.05.

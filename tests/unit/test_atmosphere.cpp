@@ -112,6 +112,54 @@ TEST(Allard, RangeIsFiniteForExtremeInputsAndZeroForNoLight) {
     }
 }
 
+TEST(Allard, TransmissivityOfTheNominalConditions) {
+    // The IES definition of the nominal range: V = 10 nmi is a transmittance of
+    // "0.74 per nautical mile"; 0.05^(1/10) = exp(-ln 20 / 10) = exp(-0.29957323) = 0.7411344.
+    EXPECT_NEAR(allard_transmissivity_per_nmi(10.0), 0.7411344, 1e-7);
+    // COLREGs 1972 Annex I §8: K = 0.8 "corresponding to a meteorological visibility of
+    // approximately 13 nautical miles": ln 20 / -ln 0.8 = 2.9957323 / 0.2231436 = 13.425.
+    EXPECT_NEAR(visibility_nmi_from_transmissivity(0.8), 13.425, 1e-3);
+    EXPECT_NEAR(allard_transmissivity_per_nmi(visibility_nmi_from_transmissivity(0.8)), 0.8, 1e-15);
+}
+
+TEST(Allard, ColregsAnnexOneTableAtTransmissivityPointEight) {
+    // COLREGs 1972 Annex I §8(b): I = 3.43e6 T D^2 K^-D with T = 2e-7 lx and K = 0.8
+    // tabulates 0.9, 4.3, 12, 27, 52, 94 cd for 1 .. 6 nmi (rounded as printed).
+    const double v = visibility_nmi_from_transmissivity(0.8);
+    const double table[] = {0.9, 4.3, 12, 27, 52, 94};
+    for (int d = 1; d <= 6; ++d) {
+        const double i = allard_intensity_cd(d, night, v);
+        const double printed = table[d - 1];
+        const double step = printed < 10 ? 0.1 : 1.0;  // the table's last digit
+        EXPECT_NEAR(i, printed, 0.5 * step) << d << " nmi";
+    }
+}
+
+TEST(Allard, IlluminanceAtTheRangeIsTheThreshold) {
+    // E = I T^d / (3.43e6 d^2): at the range Allard's law gives, exactly E_t.
+    for (const double d : {0.5, 3.0, 10.0, 25.0}) {
+        const double i = allard_intensity_cd(d, night, 10.0);
+        EXPECT_NEAR(allard_illuminance_lux(i, d, 10.0) / night, 1.0, 1e-14) << d;
+    }
+    // By hand: 1000 cd at 5 nmi, V = 10: 1000 * 20^-0.5 / (3.43e6 * 25) = 223.6068 / 8.575e7 = 2.60766e-6 lx.
+    EXPECT_NEAR(allard_illuminance_lux(1000.0, 5.0, 10.0), 2.60766e-6, 1e-11);
+    EXPECT_TRUE(std::isinf(allard_illuminance_lux(1.0, 0.0, 10.0)));
+}
+
+TEST(Allard, NominalRangeBandsAreTheHalfMileIntensities) {
+    // K2012 §2.3 quotes E200-2: 108..203 cd -> 6 nmi, 204..364 cd -> 7 nmi.
+    EXPECT_NEAR(nominal_range_band_cd(6).lower_cd, 107.80, 0.01);
+    EXPECT_NEAR(nominal_range_band_cd(6).upper_cd, 203.15, 0.01);
+    EXPECT_NEAR(nominal_range_band_cd(7).upper_cd, 364.94, 0.01);
+    EXPECT_EQ(nominal_range_band_cd(0).lower_cd, 0.0);
+    for (int n = 1; n <= 30; ++n) {
+        const IntensityBand b = nominal_range_band_cd(n);
+        EXPECT_EQ(nominal_range_nmi(b.lower_cd * (1 + 1e-9)), n);
+        EXPECT_EQ(nominal_range_nmi(b.upper_cd * (1 - 1e-9)), n);
+        EXPECT_EQ(b.lower_cd, nominal_range_band_cd(n - 1).upper_cd);
+    }
+}
+
 TEST(Bouguer, TransmittanceIsOneAtZeroDistanceAndFalls) {
     EXPECT_EQ(bouguer_transmittance(1e-3, 0.0), 1.0);
     EXPECT_EQ(bouguer_transmittance(0.0, 1e6), 1.0);

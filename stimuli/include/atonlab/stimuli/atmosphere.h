@@ -31,6 +31,29 @@ double allard_range_nmi(double intensity_cd, double threshold_lux, double visibi
 /// 0 for intensity_cd <= 0.
 int nominal_range_nmi(double intensity_cd);
 
+/// Allard's law the other way round (K2012 eq 2.1; IALA Dictionary 2-1-265):
+/// the illuminance (lux) at the eye from intensity_cd at range_nmi,
+/// E = I * T^d / (3.43e6 * d^2) with T = 0.05^(1/V) per nmi; 3.43e6 is IALA's
+/// rounding of 1852^2 m^2 per nmi^2, so allard_illuminance_lux(allard_intensity_cd(d,
+/// E_t, V), d, V) == E_t. +inf at d = 0 for a light that is on.
+double allard_illuminance_lux(double intensity_cd, double range_nmi, double visibility_nmi);
+
+/// The atmospheric transmissivity per nautical mile for meteorological visibility
+/// V (nmi): T = 0.05^(1/V) (IALA E200-2; 0.7411 at V = 10 nmi, the IES's "0.74 per
+/// nautical mile" of the nominal range). And its inverse, V = ln 0.05 / ln T for
+/// 0 < T < 1 (T = 0.8, the COLREGs Annex I §8 value, is V = 13.4 nmi).
+double allard_transmissivity_per_nmi(double visibility_nmi);
+double visibility_nmi_from_transmissivity(double transmissivity_per_nmi);
+
+/// The intensities (cd) that IALA E200-2's table gives a nominal range of n nmi:
+/// [I(n - 0.5), I(n + 0.5)) at night, V = 10 nmi (first = 0 for n = 0); see
+/// nominal_range_nmi. n >= 0.
+struct IntensityBand {
+    double lower_cd = 0;
+    double upper_cd = 0;
+};
+IntensityBand nominal_range_band_cd(int range_nmi);
+
 /// Extinction coefficient (1/m) for meteorological visibility V (metres) with
 /// the 5% contrast threshold that Allard's law uses: sigma = -ln(0.05) / V.
 double extinction_per_m_from_visibility_m(double visibility_m);

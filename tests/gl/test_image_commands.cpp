@@ -1,0 +1,201 @@
+// `atonlab tonemap` and `atonlab glare` on an EXR that `atonlab render` made
+// (docs/tone-mapping.md "HDR images in and out"):
+//  - tonemap --operator reinhard against pfstools' pfstmo_reinhard02 (Debian
+//    pfstools) with the parameters matched as documented: mean |Δcode| <= 0.05,
+//    max <= 1;
+//  - glare keeps Σ L·Ω within 1e-3 once the reported edge cut is added back.
+// GL only for the rendering (exit status 3 without GL 4.5: skipped).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "atonlab/stimuli/image_io.h"
+
+#ifndef ATONLAB_BINARY
+#error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace atonlab::stimuli;
+
+fs::path scratch(const std::string& name) {
+    const fs::path dir =
+        fs::temp_directory_path() / ("atonlab-image-commands-" + name + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+int shell(const std::string& command) {
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A small rendering of the four coloured lights at night (glare included).
+// Returns false (and skips) when there is no GL.
+bool render(const fs::path& exr, const std::string& extra = "") {
+    const std::string scene = std::string(ATONLAB_SOURCE_DIR) + "/scenes/tonemap-four-lights.toml";
+    const int rc = shell(std::string(ATONLAB_BINARY) + " render " + scene + " -o " + exr.string() +
+                         " --set display.width_px=480 --set display.height_px=270 " + extra + " > /dev/null");
+    if (rc == 3) return false;
+    EXPECT_EQ(rc, 0);
+    return rc == 0;
+}
+
+// pfsoutpfm's PFM: "PF\nW H\n-1\n" then little-endian float RGB, bottom row first.
+std::vector<float> read_pfm(const fs::path& path, int& w, int& h) {
+    std::ifstream in(path, std::ios::binary);
+    std::string magic;
+    double scale = 0;
+    in >> magic >> w >> h >> scale;
+    in.get();
+    EXPECT_EQ(magic, "PF");
+    EXPECT_LT(scale, 0) << "little-endian";
+    std::vector<float> bottom_up(static_cast<std::size_t>(w) * h * 3);
+    in.read(reinterpret_cast<char*>(bottom_up.data()), static_cast<std::streamsize>(bottom_up.size() * 4));
+    std::vector<float> top_down(bottom_up.size());
+    for (int y = 0; y < h; ++y)
+        std::copy_n(&bottom_up[static_cast<std::size_t>(h - 1 - y) * w * 3], w * 3,
+                    &top_down[static_cast<std::size_t>(y) * w * 3]);
+    return top_down;
+}
+
+// IEC 61966-2-1 encoding of a linear value clipped to [0, 1], rounded to 8 bits.
+int srgb_code(double v) {
+    v = std::clamp(v, 0.0, 1.0);
+    const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+    return static_cast<int>(std::lround(255.0 * e));
+}
+
+TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
+    if (shell("command -v pfstmo_reinhard02 > /dev/null && command -v pfsoutpfm > /dev/null") != 0)
+        GTEST_SKIP() << "pfstools is not installed (scripts/setup.sh installs it)";
+    const fs::path dir = scratch("reinhard");
+    const fs::path exr = dir / "four.exr";
+    if (!render(exr)) GTEST_SKIP() << "no OpenGL 4.5 context";
+    // pfstmo_reinhard02's global operator: key 0.18, log-average with δ = 1e-5,
+    // L_white = the brightest pixel, the curve applied to Y and XYZ scaled by
+    // L_d / Y (no hue preservation, no blueshift). The display: sRGB, black 0,
+    // no dither (pfsout's sRGB has no black level and no dither).
+    ASSERT_EQ(shell(std::string(ATONLAB_BINARY) + " tonemap " + exr.string() + " -o " + (dir / "atonlab.png").string() +
+                    " --operator reinhard --key 0.18 --reinhard-white max --epsilon-cd-m2 1e-5 --blueshift off"
+                    " --hue-preservation none --display srgb --black-cd-m2 0 --dither off > /dev/null"),
+              0);
+    ASSERT_EQ(shell("pfsin " + exr.string() + " | pfstmo_reinhard02 --key 0.18 | pfsoutpfm " +
+                    (dir / "pfs.pfm").string() + " && pfsin " + exr.string() +
+                    " | pfstmo_reinhard02 --key 0.18 | pfsoutppm " + (dir / "pfs.ppm").string() + " --srgb"),
+              0);
+    int w = 0, h = 0;
+    const std::vector<float> ours = read_png_rgb(dir / "atonlab.png", w, h);
+    int pw = 0, ph = 0;
+    const std::vector<float> pfs = read_pfm(dir / "pfs.pfm", pw, ph);
+    ASSERT_EQ(w, pw);
+    ASSERT_EQ(h, ph);
+    double sum = 0;
+    int worst = 0;
+    std::size_t bright = 0;
+    for (std::size_t i = 0; i < pfs.size(); ++i) {
+        const int a = static_cast<int>(std::lround(ours[i] * 255.0));
+        const int b = srgb_code(pfs[i]);
+        sum += std::abs(a - b);
+        worst = std::max(worst, std::abs(a - b));
+        if (b > 20) ++bright;
+    }
+    const double mean = sum / static_cast<double>(pfs.size());
+    std::printf("tonemap vs pfstmo_reinhard02 (pfsoutpfm, sRGB rounded): mean |dcode| %.5f, max %d over %zu values\n",
+                mean, worst, pfs.size());
+    EXPECT_LE(mean, 0.05);
+    EXPECT_LE(worst, 1);
+    EXPECT_GT(bright, pfs.size() / 2) << "the comparison should see more than a black frame";
+
+    // pfsoutppm --srgb writes the same floats truncated to 8 bits, not rounded:
+    // ours is that code or one above, never anything else.
+    std::ifstream ppm(dir / "pfs.ppm", std::ios::binary);
+    std::string magic;
+    int mw = 0, mh = 0, maxval = 0;
+    ppm >> magic >> mw >> mh >> maxval;
+    ppm.get();
+    ASSERT_EQ(magic, "P6");
+    ASSERT_EQ(maxval, 255);
+    std::vector<unsigned char> codes(static_cast<std::size_t>(mw) * mh * 3);
+    ppm.read(reinterpret_cast<char*>(codes.data()), static_cast<std::streamsize>(codes.size()));
+    std::size_t one_above = 0, other = 0;
+    for (std::size_t i = 0; i < codes.size(); ++i) {
+        const int d = static_cast<int>(std::lround(ours[i] * 255.0)) - codes[i];
+        if (d == 1) ++one_above;
+        if (d != 0 && d != 1) ++other;
+    }
+    std::printf("against pfsoutppm --srgb (8-bit, truncated): %zu of %zu codes one above, %zu otherwise different\n",
+                one_above, codes.size(), other);
+    EXPECT_EQ(other, 0u);
+    fs::remove_all(dir);
+}
+
+TEST(ImageCommands, GlareKeepsTheLightsEnergyMinusTheReportedEdgeCut) {
+    const fs::path dir = scratch("glare");
+    const fs::path exr = dir / "noglare.exr";
+    if (!render(exr, "--set 'eye.glare=\"none\"'")) GTEST_SKIP() << "no OpenGL 4.5 context";
+    const ExrImage in = read_exr(exr);
+    ASSERT_GT(in.meta.degrees_per_pixel, 0);
+    const double omega_sr = std::pow(in.meta.degrees_per_pixel * std::numbers::pi / 180.0, 2);
+    for (const std::string model : {"spencer", "gaussian-bloom", "wave-optics", "cie"}) {
+        const fs::path out_path = dir / (model + ".exr");
+        ASSERT_EQ(shell(std::string(ATONLAB_BINARY) + " glare " + exr.string() + " -o " + out_path.string() +
+                        " --model " + model + (model == "wave-optics" ? " --psf-size 256" : "") + " > /dev/null"),
+                  0)
+            << model;
+        const ExrImage out = read_exr(out_path);
+        ASSERT_EQ(out.image.width, in.image.width);
+        ASSERT_DOUBLE_EQ(out.meta.degrees_per_pixel, in.meta.degrees_per_pixel);
+        const std::string note = out.meta.strings.at("image_glare");
+        std::smatch m;
+        ASSERT_TRUE(
+            std::regex_search(note, m, std::regex(R"(edge_cut_rgb=\[([0-9.e+-]+), ([0-9.e+-]+), ([0-9.e+-]+)\])")))
+            << note;
+        for (int c = 0; c < 3; ++c) {
+            double sum_in = 0, sum_out = 0;  // Σ L·Ω, cd/m² · sr
+            for (int y = 0; y < in.image.height; ++y)
+                for (int x = 0; x < in.image.width; ++x) {
+                    sum_in += in.image.pixel(x, y)[c] * omega_sr;
+                    sum_out += out.image.pixel(x, y)[c] * omega_sr;
+                }
+            const double cut = std::stod(m[c + 1].str());
+            EXPECT_LT(cut, 0.05) << model;
+            EXPECT_NEAR((sum_out + cut * sum_in) / sum_in, 1.0, 1e-3) << model << " channel " << c;
+        }
+        float peak_in = 0, peak_out = 0;
+        for (std::size_t i = 0; i < in.image.rgba.size(); i += 4) {
+            peak_in = std::max(peak_in, in.image.rgba[i + 1]);
+            peak_out = std::max(peak_out, out.image.rgba[i + 1]);
+        }
+        EXPECT_LT(peak_out, peak_in) << model;  // the glare took light from the core
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ImageCommands, BadInputWritesNothing) {
+    const fs::path dir = scratch("bad");
+    const std::string bin = ATONLAB_BINARY;
+    // No such file, an unknown operator, a glare model an image cannot take.
+    EXPECT_EQ(
+        shell(bin + " tonemap " + (dir / "missing.exr").string() + " -o " + (dir / "a.png").string() + " 2>/dev/null"),
+        2);
+    EXPECT_EQ(shell(bin + " tonemap x.exr -o " + (dir / "b.png").string() + " --operator drago 2>/dev/null"), 2);
+    EXPECT_EQ(shell(bin + " glare x.exr -o " + (dir / "c.exr").string() + " --model aperture 2>/dev/null"), 2);
+    EXPECT_TRUE(fs::is_empty(dir));
+    fs::remove_all(dir);
+}
+
+}  // namespace
