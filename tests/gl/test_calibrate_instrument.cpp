@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -231,6 +232,35 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
     EXPECT_EQ(seen, patches_.size()) << r.out;
 }
 
+TEST_F(CalibrateVirtual, ALutDisplayLawIsReadBackThroughItsGreyReadings) {
+    // tests/data/calibration/grey_ramp.csv's grey readings, joined by straight lines.
+    const std::vector<std::pair<double, double>> lut = {
+        {0, 0.2},         {0.0627, 0.7176}, {0.1255, 1.643}, {0.2510, 5.322}, {0.3765, 11.89},
+        {0.5020, 21.76},  {0.6275, 35.32},  {0.7529, 52.86}, {0.8784, 74.67}, {1, 100.1}};
+    auto law = [&](double v) {
+        for (std::size_t i = 1; i < lut.size(); ++i)
+            if (v <= lut[i].first)
+                return lut[i - 1].second +
+                       (v - lut[i - 1].first) / (lut[i].first - lut[i - 1].first) * (lut[i].second - lut[i - 1].second);
+        return lut.back().second;
+    };
+    const Result r = measure(kDisplay, {"--virtual-lut", (kData / "calibration/grey_ramp.csv").string(), "--quiet"});
+    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    ASSERT_EQ(r.code, 0) << r.err;
+    Store s = Store::open_read_only(db());
+    const auto readings = s.calibration_readings(s.latest_calibration("virtual-lcd").value().id);
+    ASSERT_EQ(readings.size(), patches_.size());
+    int greys = 0;
+    for (std::size_t i = 0; i < readings.size(); ++i) {
+        const PatchCodes& p = patches_[i];
+        if (p.r != p.g || p.g != p.b) continue;
+        ++greys;
+        const double want = law(p.r / 255.0);
+        EXPECT_NEAR(readings[i].luminance_cd_m2, want, 1e-9 * want) << p.name;
+    }
+    EXPECT_EQ(greys, 17);
+}
+
 TEST_F(CalibrateVirtual, CheckPassesOnTheSameDisplayAndFailsWhenThePeakDrops) {
     ASSERT_EQ(measure(kDisplay, {"--quiet"}).code, 0);
     if (!skip_.empty()) GTEST_SKIP() << skip_;
@@ -358,6 +388,30 @@ TEST_F(CalibrateSpotread, ReadingsAreParsedExactlyAndStoredWithTheirTranscripts)
             << *readings[i].transcript;
         EXPECT_TRUE(contains(*readings[i].transcript, "any other key to take a reading")) << *readings[i].transcript;
     }
+}
+
+TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) {
+    // atonlab on a terminal (util-linux `script` gives it a pseudo-terminal), Enter typed:
+    // the instruction is shown once, spotread is let go on, and the 18 patches are measured.
+    if (access("/usr/bin/script", X_OK) != 0) GTEST_SKIP() << "no /usr/bin/script (util-linux) to give atonlab a terminal";
+    setenv("ATONLAB_FAKE_SPOTREAD", (kData / "spotread/calibrate_then_read.txt").c_str(), 1);
+    std::ofstream(dir_ / "enter.txt") << "\n";
+    std::string command = std::string(ATONLAB_BINARY) + " calibrate measure --display booth --db " + db().string() +
+                          " --headless --instrument spotread --settle-s 0 --instrument-timeout-s 3 --grey-levels 9 "
+                          "--colour-levels 4 --quiet";
+    for (const std::string& g : kGeometry) command += " " + g;
+    const int code = test::run_to_files(
+        {"/bin/bash", "-c", "script -qec '" + command + "' /dev/null < " + (dir_ / "enter.txt").string()},
+        dir_ / "out.txt", dir_ / "err.txt");
+    std::string out = file_bytes(dir_ / "out.txt");
+    std::erase(out, '\r');  // the terminal's line ends
+    if (contains(out, "OpenGL")) GTEST_SKIP() << out;
+    ASSERT_EQ(code, 0) << out << file_bytes(dir_ / "err.txt");
+    EXPECT_TRUE(contains(out, "the instrument needs calibrating: Place cap on the instrument, or place on a dark "
+                              "surface, or place on the calibration reference.\n  Do it, then press Enter"))
+        << out;
+    Store s = Store::open_read_only(db());
+    EXPECT_EQ(s.calibration_readings(s.latest_calibration("booth").value().id).size(), 18u);
 }
 
 TEST_F(CalibrateSpotread, ACalibrationRequestWithNoTerminalEndsInOneSentence) {

@@ -50,8 +50,11 @@ Scan scan(std::string_view out) {
         if (nl != std::string_view::npos)
             hits.push_back({r, {State::result, nl + 1, trimmed(out.substr(r, nl - r))}});
     }
-    if (const auto k = out.find(kReady); k != std::string_view::npos)
-        hits.push_back({k, {State::ready, k + kReady.size(), trimmed(line_at(out, k))}});
+    if (const auto k = out.find(kReady); k != std::string_view::npos) {
+        std::size_t end = k + kReady.size();
+        if (end < out.size() && out[end] == ' ') ++end;  // the prompt's own space
+        hits.push_back({k, {State::ready, end, trimmed(line_at(out, k))}});
+    }
     if (const auto c = out.find(kCalibrationPrompt); c != std::string_view::npos)
         hits.push_back({c, {State::calibration, c + kCalibrationPrompt.size(), trimmed(line_at(out, c))}});
     for (const std::string_view e : kErrors) {
@@ -113,6 +116,7 @@ std::string calibration_instruction(std::string_view out) {
     };
     drop_word("hit");
     drop_word("or");
+    drop_word("and then hit any key to continue");  // atonlab asks for Enter instead
     return text;
 }
 
