@@ -60,7 +60,8 @@ PtyProcess::PtyProcess(const std::vector<std::string>& argv) {
         dup2(slave, 0);
         dup2(slave, 1);
         dup2(slave, 2);
-        if (slave > 2) ::close(slave);
+        // Nothing else of atonlab's (the study file, the GL device) reaches the child.
+        closefrom(3);
         execvp(cargs[0], cargs.data());
         _exit(127);
     }
