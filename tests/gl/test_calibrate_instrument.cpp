@@ -232,6 +232,37 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
     EXPECT_EQ(seen, patches_.size()) << r.out;
 }
 
+TEST_F(CalibrateVirtual, DisagreeingRepeatsAreMeasuredAgainAtMostThreeTimes) {
+    // 1 % noise against a 3 % tolerance: two readings disagree now and then (|difference|
+    // > 3 % has probability 3.4 %; with seed 3, three patches), and the patch is measured
+    // again; its transcript keeps every attempt.
+    Result r = measure(kDisplay, {"--virtual-noise", "0.01", "--virtual-seed", "3", "--repeat-tolerance-percent", "3"});
+    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    const auto again = r.out.find("; measuring it again (attempt 2 of 3)");
+    ASSERT_NE(again, std::string::npos) << r.out;
+    const std::string patch = r.out.substr(r.out.rfind('\n', again) + 3, r.out.find(':', r.out.rfind('\n', again)) -
+                                                                             r.out.rfind('\n', again) - 3);
+    {
+        Store s = Store::open_read_only(db());
+        bool found = false;
+        for (const auto& reading : s.calibration_readings(s.latest_calibration("virtual-lcd").value().id))
+            if (reading.patch == patch) {
+                found = true;
+                EXPECT_TRUE(contains(reading.transcript.value_or(""), "--- attempt 2, reading 1 of 2"))
+                    << reading.transcript.value_or("");
+            }
+        EXPECT_TRUE(found) << patch;
+    }
+    // 20 % noise against 0.1 %: they never agree, and the run ends at the first patch.
+    const std::string before = file_bytes(db());
+    r = measure(kDisplay, {"--virtual-noise", "0.2", "--repeat-tolerance-percent", "0.1"});
+    EXPECT_EQ(r.code, 5) << r.out << r.err;
+    EXPECT_TRUE(contains(r.err, "patch \"black\" (1 of 41) could not be measured in 3 attempts")) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(file_bytes(db()), before);
+}
+
 TEST_F(CalibrateVirtual, ALutDisplayLawIsReadBackThroughItsGreyReadings) {
     // tests/data/calibration/grey_ramp.csv's grey readings, joined by straight lines.
     const std::vector<std::pair<double, double>> lut = {
