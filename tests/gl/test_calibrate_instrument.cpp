@@ -421,6 +421,23 @@ TEST_F(CalibrateSpotread, ReadingsAreParsedExactlyAndStoredWithTheirTranscripts)
     }
 }
 
+TEST_F(CalibrateSpotread, ANegativeReadingIsRefusedAndThePatchMeasuredAgain) {
+    const Result r = measure("negative.txt");
+    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    EXPECT_TRUE(contains(r.out, "black: X = -0.21 cd/m² is not a reading (finite, >= -0.01 cd/m²); measuring it "
+                                "again (attempt 2 of 3)"))
+        << r.out;
+    const auto results = transcript_results(kData / "spotread/normal.txt");
+    Store s = Store::open_read_only(db());
+    const auto readings = s.calibration_readings(s.latest_calibration("booth").value().id);
+    ASSERT_EQ(readings.size(), 18u);
+    EXPECT_DOUBLE_EQ(readings[0].luminance_cd_m2, (results[0][1] + results[1][1]) / 2);
+    EXPECT_TRUE(contains(readings[0].transcript.value_or(""), "Result is XYZ: -0.210000")) << *readings[0].transcript;
+    EXPECT_TRUE(contains(readings[0].transcript.value_or(""), "--- attempt 2, reading 2 of 2"))
+        << *readings[0].transcript;
+}
+
 TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) {
     // atonlab on a terminal (util-linux `script` gives it a pseudo-terminal), Enter typed:
     // the instruction is shown once, spotread is let go on, and the 18 patches are measured.

@@ -20,11 +20,14 @@ bool settle(PatchScreen& screen, double seconds) {
     return !screen.quit_requested();
 }
 
-/// Why a reading cannot be used, or "" (finite and not negative: an OLED's black reads 0).
+/// Why a reading cannot be used, or "": finite and not negative, but for the
+/// scatter of a meter at black (an OLED's black reads 0, a colorimeter's
+/// correction matrix can put X or Z a little below it).
 std::string refused(const glm::dvec3& xyz) {
     for (int i = 0; i < 3; ++i)
-        if (!std::isfinite(xyz[i]) || xyz[i] < 0.0)
-            return fmt::format("{} = {} is not a luminance (finite, >= 0)", "XYZ"[i], xyz[i]);
+        if (!std::isfinite(xyz[i]) || xyz[i] < -InstrumentOptions::kRepeatFloorCdM2)
+            return fmt::format("{} = {} cd/m² is not a reading (finite, >= -{} cd/m²)", "XYZ"[i], xyz[i],
+                               InstrumentOptions::kRepeatFloorCdM2);
     return {};
 }
 
@@ -80,7 +83,7 @@ std::optional<std::vector<PhotometerReading>> measure_with_instrument(const std:
                     const double type_a = xyz.size() > 1 ? std::sqrt(ss / (m - 1.0) / m) : 0.0;
                     const double type_b = instrument.repeatability() * mean.y / std::sqrt(m);
                     PhotometerReading r;
-                    r.luminance_cd_m2 = mean.y;
+                    r.luminance_cd_m2 = std::max(mean.y, 0.0);  // black's scatter below 0 is 0 cd/m²
                     r.xyz_cd_m2 = mean;
                     r.uncertainty_cd_m2 = std::max(type_a, type_b);
                     accepted = r;
