@@ -128,8 +128,8 @@ fs::path save_typed_readings(const CalibrateOptions& o, const std::vector<Patch>
     const fs::path path = db.parent_path() / fmt::format("{}-{}-{}.readings", db.stem().string(), file_safe(o.display),
                                                          utc_now("%Y%m%dT%H%M%SZ"));
     std::ofstream f(path, std::ios::binary);
-    f << fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n", o.mode,
-                     o.display, how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
+    f << fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n", o.mode, o.display,
+                     how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
     for (std::size_t i = 0; i < patches.size(); ++i) {
         const PhotometerReading& r = readings[i];
         if (r.xyz_cd_m2)
@@ -376,8 +376,7 @@ int run_check(const CalibrateOptions& o) {
     check.checked_at = checked_at;
     check.passed = outcome.passed();
     check.results_json = check_results_json(outcome, o.tolerances, *cal);
-    check.source =
-        o.readings.empty() && o.instrument.kind.empty() ? std::string("measured") : "measured, " + m->source;
+    check.source = o.readings.empty() && o.instrument.kind.empty() ? std::string("measured") : "measured, " + m->source;
     const store::CalibrationCheckId id = db.put_calibration_check(check);
     std::printf("display \"%s\", calibration %lld: check %lld %s\n", o.display.c_str(),
                 static_cast<long long>(cal->id.value), static_cast<long long>(id.value),

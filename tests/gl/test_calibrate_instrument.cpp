@@ -94,8 +94,8 @@ struct Law {
 const Law kDisplay{150.0, 0.3, 2.4};
 
 std::vector<std::string> law_options(const Law& law) {
-    return {"--virtual-peak-cd-m2", fmt::format("{}", law.peak), "--virtual-black-cd-m2", fmt::format("{}", law.black),
-            "--virtual-gamma", fmt::format("{}", law.gamma)};
+    return {"--virtual-peak-cd-m2",       fmt::format("{}", law.peak), "--virtual-black-cd-m2",
+            fmt::format("{}", law.black), "--virtual-gamma",           fmt::format("{}", law.gamma)};
 }
 
 struct PatchCodes {
@@ -123,8 +123,8 @@ std::vector<PatchCodes> list_patches(const std::vector<std::string>& extra, cons
     return out;
 }
 
-const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px", "180", "--width-m", "0.1",
-                                            "--viewing-distance-m", "0.9"};
+const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px",          "180",
+                                            "--width-m",  "0.1", "--viewing-distance-m", "0.9"};
 
 stimuli::DisplayModel stored_model(const store::Calibration& c) {
     const JsonReader j(c.fit_json);
@@ -241,8 +241,8 @@ TEST_F(CalibrateVirtual, DisagreeingRepeatsAreMeasuredAgainAtMostThreeTimes) {
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const auto again = r.out.find("; measuring it again (attempt 2 of 3)");
     ASSERT_NE(again, std::string::npos) << r.out;
-    const std::string patch = r.out.substr(r.out.rfind('\n', again) + 3, r.out.find(':', r.out.rfind('\n', again)) -
-                                                                             r.out.rfind('\n', again) - 3);
+    const std::string patch = r.out.substr(r.out.rfind('\n', again) + 3,
+                                           r.out.find(':', r.out.rfind('\n', again)) - r.out.rfind('\n', again) - 3);
     {
         Store s = Store::open_read_only(db());
         bool found = false;
@@ -266,8 +266,8 @@ TEST_F(CalibrateVirtual, DisagreeingRepeatsAreMeasuredAgainAtMostThreeTimes) {
 TEST_F(CalibrateVirtual, ALutDisplayLawIsReadBackThroughItsGreyReadings) {
     // tests/data/calibration/grey_ramp.csv's grey readings, joined by straight lines.
     const std::vector<std::pair<double, double>> lut = {
-        {0, 0.2},         {0.0627, 0.7176}, {0.1255, 1.643}, {0.2510, 5.322}, {0.3765, 11.89},
-        {0.5020, 21.76},  {0.6275, 35.32},  {0.7529, 52.86}, {0.8784, 74.67}, {1, 100.1}};
+        {0, 0.2},        {0.0627, 0.7176}, {0.1255, 1.643}, {0.2510, 5.322}, {0.3765, 11.89},
+        {0.5020, 21.76}, {0.6275, 35.32},  {0.7529, 52.86}, {0.8784, 74.67}, {1, 100.1}};
     auto law = [&](double v) {
         for (std::size_t i = 1; i < lut.size(); ++i)
             if (v <= lut[i].first)
@@ -326,9 +326,9 @@ TEST_F(CalibrateVirtual, RunUsesTheMeasuredAndCheckedCalibration) {
     if (!skip_.empty()) GTEST_SKIP() << skip_;
     ASSERT_EQ(check(kDisplay).code, 0);
     const fs::path protocol = protocol_for(dir_.path(), "virtual-lcd");
-    const Result r = atonlab({"run", protocol.string(), "--db", db().string(), "--model-observer", "--headless",
-                              "--quiet", "--no-true-pse"},
-                             dir_.path());
+    const Result r = atonlab(
+        {"run", protocol.string(), "--db", db().string(), "--model-observer", "--headless", "--quiet", "--no-true-pse"},
+        dir_.path());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(contains(r.err, "has no calibration")) << r.err;
     EXPECT_FALSE(contains(r.err, "check")) << r.err;
@@ -415,7 +415,8 @@ TEST_F(CalibrateSpotread, ReadingsAreParsedExactlyAndStoredWithTheirTranscripts)
         EXPECT_DOUBLE_EQ(readings[i].xyz_x_cd_m2.value(), (a[0] + b[0]) / 2) << readings[i].patch;
         EXPECT_DOUBLE_EQ(readings[i].xyz_z_cd_m2.value(), (a[2] + b[2]) / 2) << readings[i].patch;
         ASSERT_TRUE(readings[i].transcript.has_value());
-        EXPECT_TRUE(contains(*readings[i].transcript, fmt::format("Result is XYZ: {:.6f} {:.6f} {:.6f}", a[0], a[1], a[2])))
+        EXPECT_TRUE(
+            contains(*readings[i].transcript, fmt::format("Result is XYZ: {:.6f} {:.6f} {:.6f}", a[0], a[1], a[2])))
             << *readings[i].transcript;
         EXPECT_TRUE(contains(*readings[i].transcript, "any other key to take a reading")) << *readings[i].transcript;
     }
@@ -425,8 +426,9 @@ TEST_F(CalibrateSpotread, ANegativeReadingIsRefusedAndThePatchMeasuredAgain) {
     const Result r = measure("negative.txt");
     if (!skip_.empty()) GTEST_SKIP() << skip_;
     ASSERT_EQ(r.code, 0) << r.out << r.err;
-    EXPECT_TRUE(contains(r.out, "black: X = -0.21 cd/m² is not a reading (finite, >= -0.01 cd/m²); measuring it "
-                                "again (attempt 2 of 3)"))
+    EXPECT_TRUE(contains(r.out,
+                         "black: X = -0.21 cd/m² is not a reading (finite, >= -0.01 cd/m²); measuring it "
+                         "again (attempt 2 of 3)"))
         << r.out;
     const auto results = transcript_results(kData / "spotread/normal.txt");
     Store s = Store::open_read_only(db());
@@ -441,7 +443,8 @@ TEST_F(CalibrateSpotread, ANegativeReadingIsRefusedAndThePatchMeasuredAgain) {
 TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) {
     // atonlab on a terminal (util-linux `script` gives it a pseudo-terminal), Enter typed:
     // the instruction is shown once, spotread is let go on, and the 18 patches are measured.
-    if (access("/usr/bin/script", X_OK) != 0) GTEST_SKIP() << "no /usr/bin/script (util-linux) to give atonlab a terminal";
+    if (access("/usr/bin/script", X_OK) != 0)
+        GTEST_SKIP() << "no /usr/bin/script (util-linux) to give atonlab a terminal";
     setenv("ATONLAB_FAKE_SPOTREAD", (kData / "spotread/calibrate_then_read.txt").c_str(), 1);
     std::ofstream(dir_ / "enter.txt") << "\n";
     std::string command = std::string(ATONLAB_BINARY) + " calibrate measure --display booth --db " + db().string() +
@@ -455,16 +458,18 @@ TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) 
     std::erase(out, '\r');  // the terminal's line ends
     if (contains(out, "OpenGL")) GTEST_SKIP() << out;
     ASSERT_EQ(code, 0) << out << file_bytes(dir_ / "err.txt");
-    EXPECT_TRUE(contains(out, "the instrument needs calibrating: Place cap on the instrument, or place on a dark "
-                              "surface, or place on the calibration reference.\n  Do it, then press Enter"))
+    EXPECT_TRUE(contains(out,
+                         "the instrument needs calibrating: Place cap on the instrument, or place on a dark "
+                         "surface, or place on the calibration reference.\n  Do it, then press Enter"))
         << out;
     Store s = Store::open_read_only(db());
     EXPECT_EQ(s.calibration_readings(s.latest_calibration("booth").value().id).size(), 18u);
 }
 
 TEST_F(CalibrateSpotread, ACalibrationRequestWithNoTerminalEndsInOneSentence) {
-    expect_refused("calibrate.txt", "the instrument needs calibrating before it can measure (spotread: \"Place cap on "
-                                    "the instrument, or place on a dark surface, or place on the calibration reference");
+    expect_refused("calibrate.txt",
+                   "the instrument needs calibrating before it can measure (spotread: \"Place cap on "
+                   "the instrument, or place on a dark surface, or place on the calibration reference");
 }
 
 TEST_F(CalibrateSpotread, AnErrorLineEndsInOneSentence) {
@@ -472,11 +477,14 @@ TEST_F(CalibrateSpotread, AnErrorLineEndsInOneSentence) {
 }
 
 TEST_F(CalibrateSpotread, AHangEndsInOneSentence) {
-    expect_refused("hang.txt", "spotread did not answer within 3 s (--instrument-timeout-s; is the instrument connected and lying on the screen?) when asked to give a reading at patch \"black\" (1 of 18)");
+    expect_refused("hang.txt",
+                   "spotread did not answer within 3 s (--instrument-timeout-s; is the instrument connected and lying "
+                   "on the screen?) when asked to give a reading at patch \"black\" (1 of 18)");
 }
 
 TEST_F(CalibrateSpotread, NoInstrumentEndsInOneSentence) {
-    expect_refused("no_instrument.txt", "no instrument was found (spotread: \"spotread: Error - No instrument at port 1\")");
+    expect_refused("no_instrument.txt",
+                   "no instrument was found (spotread: \"spotread: Error - No instrument at port 1\")");
 }
 
 TEST_F(CalibrateSpotread, ErrorsAfterAGoodMeasurementLeaveTheStudyFileAsItWas) {

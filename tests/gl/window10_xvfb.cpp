@@ -93,7 +93,8 @@ protected:
         const GLenum names[3] = {GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, GL_FRAMEBUFFER_ATTACHMENT_GREEN_SIZE,
                                  GL_FRAMEBUFFER_ATTACHMENT_BLUE_SIZE};
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        for (int i = 0; i < 3; ++i) glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_BACK_LEFT, names[i], &bits[i]);
+        for (int i = 0; i < 3; ++i)
+            glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_BACK_LEFT, names[i], &bits[i]);
         if (bits[0] != 10 || bits[1] != 10 || bits[2] != 10)
             GTEST_SKIP() << "the window's framebuffer has " << bits[0] << "/" << bits[1] << "/" << bits[2]
                          << " bits, not 10: the X server (depth of its screen) or the GL driver ("
@@ -110,7 +111,8 @@ protected:
         for (int y = 0; y < height_; ++y)
             for (int x = 0; x < width_; ++x)
                 for (int c = 0; c < 3; ++c)
-                    ldr[(static_cast<std::size_t>(y) * width_ + x) * 4 + c] = static_cast<float>(x) / static_cast<float>(width_ - 1);
+                    ldr[(static_cast<std::size_t>(y) * width_ + x) * 4 + c] =
+                        static_cast<float>(x) / static_cast<float>(width_ - 1);
         gl::Texture2D scene(width_, height_, gl::PixelFormat::rgba32f);
         scene.upload(ldr.data());
         std::vector<float> none(ldr.size(), 0.0f);

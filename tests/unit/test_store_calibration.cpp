@@ -67,7 +67,8 @@ std::vector<CalibrationReading> make_readings() {
     red.luminance_cd_m2 = 5.125;
     red.xyz_x_cd_m2 = 9.5;
     red.xyz_z_cd_m2 = 0.75;
-    red.transcript = "Hit ESC or Q to exit, any other key to take a reading: \n Result is XYZ: 9.500000 5.125000 0.750000";
+    red.transcript =
+        "Hit ESC or Q to exit, any other key to take a reading: \n Result is XYZ: 9.500000 5.125000 0.750000";
     CalibrationReading imported;  // an imported reading: a fraction, no code
     imported.patch = "grey 0.5";
     imported.channel = "grey";
@@ -141,9 +142,9 @@ TEST(StoreSchemaV2, NewerFileIsRefusedUntouched) {
     { Store::create_or_open(path).put_calibration(make_calibration()); }
     {
         RawDb raw(path);
-        ASSERT_EQ(raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = " +
-                           std::to_string(schema_version() + 1)),
-                  "");
+        ASSERT_EQ(
+            raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = " + std::to_string(schema_version() + 1)),
+            "");
     }
     const std::string before = file_bytes(path);
     const std::string msg = expect_store_error(StoreErrc::newer_schema, [&] { Store::create_or_open(path); });

@@ -15,7 +15,8 @@ using Clock = std::chrono::steady_clock;
 
 /// Keeps the window alive for `seconds`; false when the operator gave up.
 bool settle(PatchScreen& screen, double seconds) {
-    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    const auto until =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     while (Clock::now() < until && !screen.quit_requested()) screen.pump();
     return !screen.quit_requested();
 }
@@ -67,15 +68,16 @@ std::optional<std::vector<PhotometerReading>> measure_with_instrument(const std:
                 xyz.push_back(r.xyz_cd_m2);
             }
             if (why.empty()) {
-                const glm::dvec3 mean = std::accumulate(xyz.begin(), xyz.end(), glm::dvec3(0.0)) /
-                                        static_cast<double>(xyz.size());
+                const glm::dvec3 mean =
+                    std::accumulate(xyz.begin(), xyz.end(), glm::dvec3(0.0)) / static_cast<double>(xyz.size());
                 double lo = xyz.front().y, hi = lo, ss = 0.0;
                 for (const glm::dvec3& v : xyz) {
                     lo = std::min(lo, v.y);
                     hi = std::max(hi, v.y);
                     ss += (v.y - mean.y) * (v.y - mean.y);
                 }
-                const double allowed = o.repeat_tolerance_percent / 100.0 * mean.y + InstrumentOptions::kRepeatFloorCdM2;
+                const double allowed =
+                    o.repeat_tolerance_percent / 100.0 * mean.y + InstrumentOptions::kRepeatFloorCdM2;
                 if (hi - lo <= allowed) {
                     const double m = static_cast<double>(xyz.size());
                     // Standard uncertainty of the mean: the repeats' own scatter (GUM

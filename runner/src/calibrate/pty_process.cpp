@@ -81,7 +81,8 @@ void PtyProcess::send(std::string_view bytes) {
 }
 
 bool PtyProcess::read_some(std::chrono::steady_clock::time_point deadline) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return false;
     pollfd p{master_, POLLIN, 0};
     const int ready = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));

@@ -83,7 +83,8 @@ public:
         while (!r.transcript.empty() && r.transcript.front() == '\n') r.transcript.erase(0, 1);
         const auto xyz = spotread::parse_result(s.line);
         if (!xyz)
-            throw InstrumentError(fmt::format("spotread's result line \"{}\" does not hold three numbers X Y Z", s.line));
+            throw InstrumentError(
+                fmt::format("spotread's result line \"{}\" does not hold three numbers X Y Z", s.line));
         r.xyz_cd_m2 = *xyz;
         process_->consume(s.end);
         ready_ = false;
@@ -94,8 +95,8 @@ private:
     /// The next event of spotread's output, pumping the window while waiting;
     /// a timeout or spotread's exit end the run.
     spotread::Scan wait_for_event(PatchScreen* screen, const char* doing) {
-        const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                 std::chrono::duration<double>(o_.timeout_s));
+        const auto deadline =
+            Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o_.timeout_s));
         auto event = [](const std::string& out) { return spotread::scan(out).state != spotread::State::busy; };
         for (;;) {
             const auto slice = std::min(deadline, Clock::now() + std::chrono::milliseconds(50));
@@ -111,10 +112,11 @@ private:
                                                   words.empty() ? "" : fmt::format("; it last said \"{}\"", words)));
             }
             if (Clock::now() >= deadline)
-                throw InstrumentError(fmt::format(
-                    "spotread did not answer within {} s (--instrument-timeout-s; is the instrument connected and lying "
-                    "on the screen?) when asked {}",
-                    o_.timeout_s, doing));
+                throw InstrumentError(
+                    fmt::format("spotread did not answer within {} s (--instrument-timeout-s; is the instrument "
+                                "connected and lying "
+                                "on the screen?) when asked {}",
+                                o_.timeout_s, doing));
             if (screen) screen->pump();
         }
     }
@@ -141,7 +143,8 @@ private:
         if (!isatty(STDIN_FILENO))
             throw InstrumentError(fmt::format(
                 "the instrument needs calibrating before it can measure (spotread: \"{}\") and there is no terminal to "
-                "ask: run `atonlab calibrate` from a terminal, where you are asked once, or calibrate it with `spotread "
+                "ask: run `atonlab calibrate` from a terminal, where you are asked once, or calibrate it with "
+                "`spotread "
                 "-e` and run again with --instrument-args \"-N\" (no calibration at start)",
                 what));
         std::printf("\nthe instrument needs calibrating: %s.\n  Do it, then press Enter (q then Enter gives up): ",

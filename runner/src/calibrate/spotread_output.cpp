@@ -20,10 +20,9 @@ constexpr std::string_view kCalibrationPrompt = "Esc or Q to abort";
 // ierror's "Got '%s' (%s) error.", numlib's error() "spotread: Error - ...",
 // usage()'s "Diagnostic: ...", "Failed to initialise communications with instrument",
 // "Instrument initialisation failed with ...", "Spot read got abort or error ...".
-constexpr std::string_view kErrors[] = {"Spot read failed",  "error.",
-                                        "Error - ",          "Diagnostic:",
-                                        "Failed to initialise", "initialisation failed",
-                                        "got abort or error"};
+constexpr std::string_view kErrors[] = {
+    "Spot read failed",  "error.", "Error - ", "Diagnostic:", "Failed to initialise", "initialisation failed",
+    "got abort or error"};
 
 std::string_view line_at(std::string_view text, std::size_t pos) {
     const std::size_t begin = text.rfind('\n', pos) == std::string_view::npos ? 0 : text.rfind('\n', pos) + 1;
@@ -47,8 +46,7 @@ Scan scan(std::string_view out) {
     std::vector<Hit> hits;
     if (const auto r = out.find(kResult); r != std::string_view::npos) {
         const auto nl = out.find('\n', r);
-        if (nl != std::string_view::npos)
-            hits.push_back({r, {State::result, nl + 1, trimmed(out.substr(r, nl - r))}});
+        if (nl != std::string_view::npos) hits.push_back({r, {State::result, nl + 1, trimmed(out.substr(r, nl - r))}});
     }
     if (const auto k = out.find(kReady); k != std::string_view::npos) {
         std::size_t end = k + kReady.size();
@@ -107,7 +105,8 @@ std::string calibration_instruction(std::string_view out) {
         if (ch == ' ' && (text.empty() || text.back() == ' ')) continue;
         text += ch;
     }
-    // The prompt's own words before "Esc or Q to abort" (" or hit", "Hit any key to retry, or") are not the instruction.
+    // The prompt's own words before "Esc or Q to abort" (" or hit", "Hit any key to retry, or") are not the
+    // instruction.
     auto drop_word = [&](std::string_view w) {
         while (!text.empty() && (text.back() == ' ' || text.back() == ',')) text.pop_back();
         if (text.size() >= w.size() && std::string_view(text).substr(text.size() - w.size()) == w)

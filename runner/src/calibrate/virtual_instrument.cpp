@@ -42,8 +42,8 @@ public:
         r.transcript = fmt::format(
             "virtual: {} x {} px at the centre of the shown frame, mean codes {:.3f} {:.3f} {:.3f} of {}; noise "
             "factor {:.6f}\nResult is XYZ: {:.6f} {:.6f} {:.6f}",
-            a.width_px, a.height_px, a.mean_codes.r, a.mean_codes.g, a.mean_codes.b, a.max_code, factor,
-            r.xyz_cd_m2.x, r.xyz_cd_m2.y, r.xyz_cd_m2.z);
+            a.width_px, a.height_px, a.mean_codes.r, a.mean_codes.g, a.mean_codes.b, a.max_code, factor, r.xyz_cd_m2.x,
+            r.xyz_cd_m2.y, r.xyz_cd_m2.z);
         return r;
     }
 
@@ -74,8 +74,9 @@ VirtualDisplayLaw VirtualDisplayLaw::lut(const std::string& csv_path) {
             ++n;
         }
     if (grey.size() < 2 || grey.begin()->first != 0.0 || grey.rbegin()->first != 1.0)
-        throw InputError(SourceLocation{csv_path, 0, 0, "--virtual-lut"},
-                         "the display law needs grey readings at level 0 (black) and level 1 (white), and any between.");
+        throw InputError(
+            SourceLocation{csv_path, 0, 0, "--virtual-lut"},
+            "the display law needs grey readings at level 0 (black) and level 1 (white), and any between.");
     VirtualDisplayLaw l;
     for (const auto& [level, s] : grey) l.lut_.emplace_back(level, s.first / s.second);
     l.lut_file_ = csv_path;
