@@ -215,6 +215,11 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
     std::istringstream in(r.out);
     std::string line;
     std::size_t seen = 0;
+    struct GreyReading {
+        double drive, cd_m2, u_cd_m2;
+    };
+    std::vector<GreyReading> grey;
+    double black_cd_m2 = 0.0;
     while (std::getline(in, line)) {
         const auto y = line.find(" Y ");
         const auto pm = line.find(" ± ");
@@ -228,8 +233,29 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
         EXPECT_LE(std::abs(mean - want), 4.0 * u) << line << " (law: " << want << ")";
         // and the uncertainty is the noise's: 1 % / sqrt(4) = 0.5 % of the reading, give or take the scatter.
         EXPECT_LT(u, 0.015 * want) << line;
+        if (p.r == p.g && p.g == p.b && p.r > 0) grey.push_back({p.r / 255.0, mean, u});
+        if (p.r == 0 && p.g == 0 && p.b == 0) black_cd_m2 = mean;
     }
     EXPECT_EQ(seen, patches_.size()) << r.out;
+    // The grey ramp's effective γ (the slope of log10(L − L(0)) on log10 V over V in
+    // [0.1, 1]) within 4 of the standard errors the reported uncertainties give that
+    // slope: weighted least squares, σ of log10(L − L(0)) = u / (ln 10 (L − L(0))).
+    double sw = 0, swx = 0, swxx = 0;
+    for (const GreyReading& g : grey) {
+        if (g.drive < 0.1) continue;
+        const double sigma = g.u_cd_m2 / (std::log(10.0) * (g.cd_m2 - black_cd_m2));
+        const double w = 1.0 / (sigma * sigma), x = std::log10(g.drive);
+        sw += w, swx += w * x, swxx += w * x * x;
+    }
+    const double se_gamma = std::sqrt(sw / (sw * swxx - swx * swx));
+    const Store s = Store::open_read_only(db());
+    const JsonReader j(s.latest_calibration("virtual-lcd").value().fit_json);
+    for (int i = 0; i < 4; ++i)
+        if (j.string(fmt::format("$.ramps[{}].channel", i)) == std::optional<std::string>("grey")) {
+            const double gamma = j.number(fmt::format("$.ramps[{}].effective_gamma", i)).value();
+            EXPECT_LE(std::abs(gamma - kDisplay.gamma), 4.0 * se_gamma) << gamma << " ± " << se_gamma;
+            EXPECT_LT(se_gamma, 0.01);  // 1 % noise leaves γ known to better than 0.01
+        }
 }
 
 TEST_F(CalibrateVirtual, DisagreeingRepeatsAreMeasuredAgainAtMostThreeTimes) {
