@@ -332,7 +332,11 @@ TEST_F(CalibrateVirtual, CheckPassesOnTheSameDisplayAndFailsWhenThePeakDrops) {
     EXPECT_TRUE(contains(r.err, "peak_percent")) << r.err;
     Store s = Store::open_read_only(db());
     const auto cal = s.latest_calibration("virtual-lcd").value();
-    EXPECT_EQ(s.calibration_checks(cal.id).size(), 2u);
+    const auto checks = s.calibration_checks(cal.id);
+    ASSERT_EQ(checks.size(), 2u);
+    // Each checked patch keeps the instrument's transcript.
+    const JsonReader j(checks[0].results_json);
+    EXPECT_TRUE(contains(j.string("$.patches[4].transcript").value_or(""), "Result is XYZ")) << checks[0].results_json;
 }
 
 fs::path protocol_for(const fs::path& dir, const std::string& display) {
