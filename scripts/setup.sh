@@ -18,6 +18,7 @@ packages=(
   pfstools  # tests and bench only: `atonlab tonemap --operator reinhard` is compared with pfstmo_reinhard02
   xvfb xauth
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
+  python3 sqlite3  # tests only: the README quick-start walk, the fake spotread's transcripts, reading study files from shell tests
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
 )
 

@@ -19,6 +19,7 @@
 #include "atonlab/stimuli/error.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
+#include "calibrate/instrument_session.h"
 #include "calibration_record.h"
 #include "patch_screen.h"
 #include "patch_session.h"
@@ -122,13 +123,13 @@ std::string file_safe(std::string_view name) {
 /// fitted, in the readings-file format, so that no measurement is lost to a
 /// failing fit: `--readings` takes the file as it is.
 fs::path save_typed_readings(const CalibrateOptions& o, const std::vector<Patch>& patches,
-                             const std::vector<PhotometerReading>& readings) {
+                             const std::vector<PhotometerReading>& readings, const std::string& how = "typed") {
     fs::path db(o.db);
     const fs::path path = db.parent_path() / fmt::format("{}-{}-{}.readings", db.stem().string(), file_safe(o.display),
                                                          utc_now("%Y%m%dT%H%M%SZ"));
     std::ofstream f(path, std::ios::binary);
-    f << fmt::format("# atonlab calibrate {} of display \"{}\", typed {} (cd/m²; X Y Z where given)\n", o.mode,
-                     o.display, utc_now("%Y-%m-%dT%H:%M:%SZ"));
+    f << fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n", o.mode, o.display,
+                     how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
     for (std::size_t i = 0; i < patches.size(); ++i) {
         const PhotometerReading& r = readings[i];
         if (r.xyz_cd_m2)
@@ -159,9 +160,15 @@ struct Measured {
 /// operator gave up. Geometry is resolved against the window's size.
 std::optional<Measured> measure(const CalibrateOptions& o, const std::vector<Patch>& patches,
                                 const std::optional<store::Calibration>& prior, bool need_geometry) {
-    if (o.headless && o.readings.empty())
+    const bool instrument = !o.instrument.kind.empty();
+    if (instrument && !o.readings.empty())
+        throw InputError(SourceLocation{"--instrument", 0, 0, ""},
+                         "the readings come from --instrument or from --readings FILE, not both.");
+    if (instrument) validate_instrument_options(o.instrument);
+    if (o.headless && o.readings.empty() && !instrument)
         throw InputError(SourceLocation{"--headless", 0, 0, ""},
-                         "--headless shows the patches to no one: give the readings with --readings FILE.");
+                         "--headless shows the patches to no one: give the readings with --readings FILE (or "
+                         "--instrument virtual).");
     if (!(o.window_percent > 0.0 && o.window_percent <= 100.0))
         throw InputError(
             SourceLocation{"--window-percent", 0, 0, ""},
@@ -193,6 +200,18 @@ std::optional<Measured> measure(const CalibrateOptions& o, const std::vector<Pat
                          screen.width(), screen.height(), m.geometry.width_px, m.geometry.height_px);
     }
     if (!o.quiet) std::printf("showing %zu patches %s\n", patches.size(), screen.description().c_str());
+    if (instrument) {
+        if (o.headless && o.instrument.kind == "spotread")
+            std::printf("note: --headless: the patches are off-screen; spotread measures whatever the screen shows\n");
+        const std::unique_ptr<Instrument> meter = open_instrument(o.instrument);
+        auto readings = measure_with_instrument(patches, screen, *meter, o.instrument, o.quiet);
+        if (!readings) return std::nullopt;
+        m.readings = std::move(*readings);
+        m.source = meter->description();
+        m.file = save_typed_readings(o, patches, m.readings, "measured with the " + m.source).string();
+        std::printf("the readings are saved in %s (give it to --readings to fit them again)\n", m.file.c_str());
+        return m;
+    }
     auto readings = collect_readings(patches, screen, session);
     if (!readings) return std::nullopt;
     m.readings = std::move(*readings);
@@ -244,6 +263,7 @@ std::vector<store::CalibrationReading> readings_of(const std::vector<Patch>& pat
             s.xyz_z_cd_m2 = r.xyz_cd_m2->z;
         }
         s.source_line = r.line;
+        if (!r.transcript.empty()) s.transcript = r.transcript;
         out.push_back(std::move(s));
     }
     return out;
@@ -305,7 +325,8 @@ int run_measure(const CalibrateOptions& o) {
     const std::vector<stimuli::Measurement> ms = measurements_of(patches, *m);
     stimuli::fit_calibration(ms);
     store::Store db = store::Store::create_or_open(o.db);
-    const std::string source = o.readings.empty() ? std::string("measured") : "measured, " + m->source;
+    const std::string source =
+        o.readings.empty() && o.instrument.kind.empty() ? std::string("measured") : "measured, " + m->source;
     return store_calibration(db, o, ms, readings_of(patches, *m), m->geometry, "measured", source, measured_at);
 }
 
@@ -355,7 +376,7 @@ int run_check(const CalibrateOptions& o) {
     check.checked_at = checked_at;
     check.passed = outcome.passed();
     check.results_json = check_results_json(outcome, o.tolerances, *cal);
-    check.source = o.readings.empty() ? std::string("measured") : "measured, " + m->source;
+    check.source = o.readings.empty() && o.instrument.kind.empty() ? std::string("measured") : "measured, " + m->source;
     const store::CalibrationCheckId id = db.put_calibration_check(check);
     std::printf("display \"%s\", calibration %lld: check %lld %s\n", o.display.c_str(),
                 static_cast<long long>(cal->id.value), static_cast<long long>(id.value),
@@ -418,6 +439,7 @@ void add_patch_options(CLI::App* cmd, CalibrateOptions& o) {
     cmd->add_option("--patch-seconds", o.patch_seconds,
                     "With --readings: show each patch this long, s (for a meter that logs; default 0)");
     cmd->add_flag("--list-patches", o.list_patches, "Print the patches in the order shown and exit");
+    add_instrument_options(cmd, o.instrument);
 }
 
 }  // namespace
@@ -470,6 +492,9 @@ int run_calibrate(const CalibrateOptions& o) {
     } catch (const store::StoreError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 4;
+    } catch (const InstrumentError& e) {
+        std::fprintf(stderr, "atonlab: %s; nothing was stored.\n", e.what());
+        return 5;
     }
 }
 

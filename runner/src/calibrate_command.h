@@ -2,10 +2,11 @@
 // `atonlab calibrate (measure | import FILE | check) --display NAME --db STUDY.db`
 // (docs/calibration.md). Exit status: 0 stored / check passed, 1 check failed
 // or the operator gave up (nothing stored), 2 bad input, 3 no GL or no
-// usable screen, 4 the study file failed.
+// usable screen, 4 the study file failed, 5 the instrument failed (nothing stored).
 #include <optional>
 #include <string>
 
+#include "calibrate/instrument.h"
 #include "calibration_check.h"
 
 namespace CLI {
@@ -32,6 +33,7 @@ struct CalibrateOptions {
     bool list_patches = false;
     int grey_levels = 17;
     int colour_levels = 9;
+    InstrumentOptions instrument;  ///< --instrument and its options; kind "": typed or --readings
     // check
     CheckTolerances tolerances;
     std::string plot;

@@ -97,12 +97,15 @@ std::string check_results_json(const CheckOutcome& o, const CheckTolerances& tol
         if (c.measured.xyz_cd_m2)
             xyz = fmt::format("[{},{},{}]", json_number(c.measured.xyz_cd_m2->x), json_number(c.measured.xyz_cd_m2->y),
                               json_number(c.measured.xyz_cd_m2->z));
+        // With --instrument: what the instrument said for the patch, raw.
+        const std::string transcript =
+            c.measured.transcript.empty() ? "" : ",\"transcript\":" + json_string(c.measured.transcript);
         patches += fmt::format(
             R"({}{{"patch":{},"code":{},"bits":{},"predicted_cd_m2":{},"measured_cd_m2":{},"error_cd_m2":{},)"
-            R"("error_percent":{},"xyz_cd_m2":{}}})",
+            R"("error_percent":{},"xyz_cd_m2":{}{}}})",
             patches.empty() ? "" : ",", json_string(c.patch.name), c.patch.code, Patch::bits,
             json_number(c.predicted_cd_m2), json_number(c.measured.luminance_cd_m2), json_number(c.error_cd_m2),
-            json_number(c.error_percent), xyz);
+            json_number(c.error_percent), xyz, transcript);
     }
     std::string failed;
     for (const std::string& f : o.failed) failed += (failed.empty() ? "" : ",") + json_string(f);

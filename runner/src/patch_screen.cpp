@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/gl/objects.h"
@@ -130,6 +131,41 @@ void PatchScreen::pump() {
     m.window->swap_buffers();  // vsync paces this loop
     m.window->poll_events();
     if (m.window->should_close()) m.quit = true;
+}
+
+PatchScreen::Aperture PatchScreen::read_shown(int side_px) {
+    Impl& m = *impl_;
+    Aperture a;
+    a.width_px = std::min(side_px, m.width);
+    a.height_px = std::min(side_px, m.height);
+    if (m.window) {
+        // The frame about to be presented: the patch drawn again into the back
+        // buffer, read, then swapped. (Mesa's GLX reads GL_FRONT as zeros after
+        // a swap, so the front buffer cannot be read back there.)
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        if (m.has_patch) m.draw(m.current);
+        glReadBuffer(GL_BACK);
+    } else {
+        m.fbo.bind();
+    }
+    gl::finish();
+    std::vector<unsigned char> px(static_cast<std::size_t>(a.width_px) * static_cast<std::size_t>(a.height_px) * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels((m.width - a.width_px) / 2, (m.height - a.height_px) / 2, a.width_px, a.height_px, GL_RGBA,
+                 GL_UNSIGNED_BYTE, px.data());
+    if (m.window) {
+        m.window->swap_buffers();
+        m.window->poll_events();
+    }
+    glm::dvec3 sum{0.0};
+    for (std::size_t i = 0; i < px.size(); i += 4) sum += glm::dvec3(px[i], px[i + 1], px[i + 2]);
+    a.mean_codes = sum / static_cast<double>(a.width_px * a.height_px);
+    a.max_code = Patch::max_code;
+    return a;
+}
+
+void PatchScreen::set_progress(const std::string& text) {
+    if (impl_->window) glfwSetWindowTitle(impl_->window->glfw_window(), text.c_str());
 }
 
 bool PatchScreen::quit_requested() const {

@@ -5,6 +5,7 @@
 // and must hold exactly the code values sent (no sRGB encoding, no dither, no
 // 6-bit panel format in the way). The window also takes typed readings
 // (docs/calibration.md).
+#include <glm/vec3.hpp>
 #include <memory>
 #include <string>
 
@@ -40,6 +41,19 @@ public:
     /// What was typed into the window since the last call: characters, '\n'
     /// for Enter, '\b' for Backspace.
     std::string take_typed();
+
+    /// What an instrument would see: the mean code values of a centred square
+    /// of the presented frame, read back with glReadPixels (the window's back
+    /// buffer with the patch drawn again, just before it is swapped; or the
+    /// off-screen framebuffer).
+    struct Aperture {
+        glm::dvec3 mean_codes{0.0};  ///< R, G, B, 0..max_code
+        int max_code = 255;
+        int width_px = 0, height_px = 0;
+    };
+    Aperture read_shown(int side_px = 32);
+    /// Progress for the operator on the window (its title; the patch itself stays uniform).
+    void set_progress(const std::string& text);
 
     int width() const;
     int height() const;

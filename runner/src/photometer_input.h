@@ -18,6 +18,10 @@ struct PhotometerReading {
     double luminance_cd_m2 = 0.0;         ///< Y, cd/m²
     std::optional<glm::dvec3> xyz_cd_m2;  ///< X, Y, Z (Y = luminance) when the meter gave all three
     std::optional<int> line;              ///< the readings file's line; none when typed
+    /// From an instrument (--instrument): the standard uncertainty of the
+    /// luminance, cd/m², and what the instrument said, raw (calibrate/instrument.h).
+    std::optional<double> uncertainty_cd_m2;
+    std::string transcript;
 };
 
 /// A readings file: one reading per patch, in the order the patches are shown

@@ -52,7 +52,7 @@ void require_calibration(Store::Impl& impl, CalibrationId id, std::string_view d
 std::vector<CalibrationReading> Store::calibration_readings(CalibrationId id) const {
     static constexpr const char* sql_readings =
         "SELECT patch, channel, level, code, bits, drive_r, drive_g, drive_b, luminance_cd_m2, xyz_x_cd_m2, "
-        "xyz_z_cd_m2, source_line FROM calibration_readings WHERE calibration_id = ?1 ORDER BY seq";
+        "xyz_z_cd_m2, source_line, transcript FROM calibration_readings WHERE calibration_id = ?1 ORDER BY seq";
     const std::string doing = fmt::format("read the readings of calibration {}", id.value);
     sql::Transaction tx(*impl_->db, sql::Transaction::Kind::read, doing);
     require_calibration(*impl_, id, doing);
@@ -73,6 +73,7 @@ std::vector<CalibrationReading> Store::calibration_readings(CalibrationId id) co
         r.xyz_x_cd_m2 = optional_real(*s, 9);
         r.xyz_z_cd_m2 = optional_real(*s, 10);
         r.source_line = optional_int(*s, 11);
+        r.transcript = s->optional_text(12);
         out.push_back(std::move(r));
     }
     return out;

@@ -54,8 +54,8 @@ void insert_readings(sql::Connection& db, CalibrationId id, std::span<const Cali
                      std::string_view doing) {
     static constexpr const char* sql_insert =
         "INSERT INTO calibration_readings (calibration_id, seq, patch, channel, level, code, bits, drive_r, "
-        "drive_g, drive_b, luminance_cd_m2, xyz_x_cd_m2, xyz_z_cd_m2, source_line) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)";
+        "drive_g, drive_b, luminance_cd_m2, xyz_x_cd_m2, xyz_z_cd_m2, source_line, transcript) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15)";
     for (std::size_t i = 0; i < readings.size(); ++i) {
         const CalibrationReading& r = readings[i];
         sql::Use s(db.cached(sql_insert));
@@ -73,6 +73,7 @@ void insert_readings(sql::Connection& db, CalibrationId id, std::span<const Cali
         s->bind(12, r.xyz_x_cd_m2);
         s->bind(13, r.xyz_z_cd_m2);
         s->bind(14, r.source_line);
+        s->bind(15, r.transcript);
         s->run(doing);
     }
 }

@@ -194,9 +194,16 @@ CREATE TRIGGER calibration_checks_append_only_delete BEFORE DELETE ON calibratio
 BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be deleted'); END;
 )sql";
 
-constexpr std::array<Migration, 2> migrations = {
+// Version 3: the raw transcript of an instrument's readings of each patch
+// (`calibrate measure --instrument`), kept with the readings as evidence.
+constexpr std::string_view schema_v3 = R"sql(
+ALTER TABLE calibration_readings ADD COLUMN transcript TEXT;  -- what the instrument said; NULL when typed or imported
+)sql";
+
+constexpr std::array<Migration, 3> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
     Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
+    Migration{3, "instrument transcripts of calibration readings", schema_v3},
 };
 
 }  // namespace

@@ -67,6 +67,8 @@ std::vector<CalibrationReading> make_readings() {
     red.luminance_cd_m2 = 5.125;
     red.xyz_x_cd_m2 = 9.5;
     red.xyz_z_cd_m2 = 0.75;
+    red.transcript =
+        "Hit ESC or Q to exit, any other key to take a reading: \n Result is XYZ: 9.500000 5.125000 0.750000";
     CalibrationReading imported;  // an imported reading: a fraction, no code
     imported.patch = "grey 0.5";
     imported.channel = "grey";
@@ -104,7 +106,7 @@ TEST(StoreSchemaV2, VersionOneFileMigratesKeepingEveryRow) {
     }
     {
         Store s = Store::create_or_open(path);
-        EXPECT_EQ(s.file_schema_version(), 2);
+        EXPECT_EQ(s.file_schema_version(), schema_version());
         EXPECT_EQ(s.integrity_check(), "ok");
         const auto cal = s.latest_calibration("lab-lcd");
         ASSERT_TRUE(cal.has_value());
@@ -126,8 +128,8 @@ TEST(StoreSchemaV2, VersionOneFileMigratesKeepingEveryRow) {
         s.put_calibration_check(make_check(cal->id, "2024-01-01", true));
     }
     RawDb raw(path);
-    EXPECT_EQ(raw.integer("PRAGMA user_version"), 2);
-    EXPECT_EQ(raw.text("SELECT group_concat(version, ',') FROM schema_history"), "1,2");
+    EXPECT_EQ(raw.integer("PRAGMA user_version"), schema_version());
+    EXPECT_EQ(raw.text("SELECT group_concat(version, ',') FROM schema_history"), "1,2,3");
     EXPECT_EQ(raw.integer("SELECT count(*) FROM snapshots WHERE data = x'0102'"), 1);
     EXPECT_EQ(raw.text("SELECT source FROM calibrations WHERE id = 1"),
               "the [display] table of the scene s.toml (not measured)");
@@ -140,11 +142,16 @@ TEST(StoreSchemaV2, NewerFileIsRefusedUntouched) {
     { Store::create_or_open(path).put_calibration(make_calibration()); }
     {
         RawDb raw(path);
-        ASSERT_EQ(raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = 3"), "");
+        ASSERT_EQ(
+            raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = " + std::to_string(schema_version() + 1)),
+            "");
     }
     const std::string before = file_bytes(path);
     const std::string msg = expect_store_error(StoreErrc::newer_schema, [&] { Store::create_or_open(path); });
-    EXPECT_NE(msg.find("schema version 3, this build knows up to 2"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("schema version " + std::to_string(schema_version() + 1) + ", this build knows up to " +
+                       std::to_string(schema_version())),
+              std::string::npos)
+        << msg;
     expect_store_error(StoreErrc::newer_schema, [&] { Store::open_read_only(path); });
     EXPECT_EQ(file_bytes(path), before);
 }
@@ -173,6 +180,34 @@ TEST(StoreCalibrationReadings, RoundTripInMeasuringOrder) {
     EXPECT_EQ(raw.integer("SELECT source_line FROM calibration_readings WHERE seq = 0"), 3);
     EXPECT_EQ(
         raw.integer("SELECT count(*) FROM calibration_readings WHERE calibration_id = " + std::to_string(id.value)), 3);
+    // Version 3: an instrument's transcript, byte for byte; NULL for typed and imported readings.
+    EXPECT_EQ(raw.text("SELECT transcript FROM calibration_readings WHERE seq = 1"), *readings[1].transcript);
+    EXPECT_EQ(raw.text("SELECT quote(transcript) FROM calibration_readings WHERE seq = 0"), "NULL");
+}
+
+TEST(StoreSchemaV3, VersionTwoFileKeepsItsReadingsWithoutTranscripts) {
+    TempDir dir;
+    const auto path = dir / "v2.db";
+    detail::migrate_file(path, schema_migrations().first(2));
+    {
+        RawDb raw(path);
+        ASSERT_EQ(raw.exec(R"sql(
+            INSERT INTO displays (id, name) VALUES (1, 'lab-lcd');
+            INSERT INTO calibrations VALUES (1, 1, 1920, 1080, 0.598, 0.3364, 0.9, '{"model":"gog"}', 'measured',
+                                             '2024-01-02', '2024-01-02T10:00:00.000Z');
+            INSERT INTO calibration_readings (calibration_id, seq, patch, channel, level, code, bits, drive_r, drive_g,
+                                              drive_b, luminance_cd_m2, source_line)
+                VALUES (1, 0, 'black', 'grey', 0, 0, 8, 0, 0, 0, 0.25, 2);
+        )sql"),
+                  "");
+    }
+    Store s = Store::create_or_open(path);
+    EXPECT_EQ(s.file_schema_version(), 3);
+    const auto readings = s.calibration_readings(CalibrationId{1});
+    ASSERT_EQ(readings.size(), 1u);
+    EXPECT_EQ(readings[0].luminance_cd_m2, 0.25);
+    EXPECT_EQ(readings[0].source_line, 2);
+    EXPECT_FALSE(readings[0].transcript.has_value());
 }
 
 TEST(StoreCalibrationReadings, BadReadingStoresNothing) {

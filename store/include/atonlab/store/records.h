@@ -65,6 +65,9 @@ struct CalibrationReading {
     /// CIE 1931 X and Z on the same absolute scale as Y (cd/m²), when the meter gave them.
     std::optional<double> xyz_x_cd_m2, xyz_z_cd_m2;
     std::optional<int> source_line;  ///< 1-based line of the file it came from; none when typed
+    /// What the instrument said for this patch, raw (`calibrate --instrument`); none
+    /// for typed or file readings (schema version 3).
+    std::optional<std::string> transcript;
 
     friend bool operator==(const CalibrationReading&, const CalibrationReading&) = default;
 };
