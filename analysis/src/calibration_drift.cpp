@@ -54,7 +54,7 @@ std::string cell(double v, const char* format = "{:.4g}") {
 }
 
 std::string num(double v) {
-    return std::isfinite(v) ? fmt::format("{:.9g}", v) : std::string("NaN");
+    return std::isfinite(v) ? fmt::format("{:.17g}", v) : std::string("NaN");
 }
 
 }  // namespace
@@ -141,7 +141,8 @@ std::vector<std::vector<std::string>> drift_data_rows(const std::vector<DriftPoi
     std::vector<std::vector<std::string>> rows;
     for (const DriftPoint& p : points) {
         const double peak_band = p.peak_predicted_cd_m2 * p.tol_peak_percent / 100.0;
-        rows.push_back({num(epoch_seconds(p.checked_at)), p.passed ? "1" : "0", num(p.peak_cd_m2),
+        const double t = epoch_seconds(p.checked_at);
+        rows.push_back({std::isfinite(t) ? fmt::format("{:.0f}", t) : std::string("NaN"), p.passed ? "1" : "0", num(p.peak_cd_m2),
                         num(p.peak_predicted_cd_m2 - peak_band), num(p.peak_predicted_cd_m2 + peak_band),
                         num(p.black_cd_m2), num(p.black_predicted_cd_m2 - p.tol_black_cd_m2),
                         num(p.black_predicted_cd_m2 + p.tol_black_cd_m2), num(p.gamma_measured),
