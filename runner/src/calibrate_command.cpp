@@ -80,6 +80,8 @@ DisplayGeometry resolve_geometry(const CalibrateOptions& o, const std::optional<
                                  std::optional<std::pair<int, int>> screen_px) {
     // Every missing option is named in one message, so one more run gives them all.
     std::vector<std::string> missing;
+    if (o.mode == "import" && o.file.empty()) missing.push_back("the readings file (FILE.ti3 or FILE.csv)");
+    if (o.display.empty()) missing.push_back("--display (the display's name, e.g. lab-lcd)");
     DisplayGeometry g;
     g.width_px = o.width_px ? *o.width_px : prior ? prior->width_px : screen_px ? screen_px->first : 0;
     g.height_px = o.height_px ? *o.height_px : prior ? prior->height_px : screen_px ? screen_px->second : 0;
@@ -101,9 +103,13 @@ DisplayGeometry resolve_geometry(const CalibrateOptions& o, const std::optional<
         std::string list;
         for (std::size_t i = 0; i < missing.size(); ++i)
             list += (i == 0 ? "" : i + 1 == missing.size() ? " and " : ", ") + missing[i];
-        throw InputError(fmt::format("{} {} needed: display \"{}\" has no calibration in {} to take {} from.", list,
-                                     missing.size() == 1 ? "is" : "are", o.display, o.db,
-                                     missing.size() == 1 ? "it" : "them"));
+        throw InputError(
+            o.display.empty()
+                ? fmt::format("{} {} needed (the geometry may instead come from the display's latest calibration).",
+                              list, missing.size() == 1 ? "is" : "are")
+                : fmt::format("{} {} needed: display \"{}\" has no calibration in {} to take {} from.", list,
+                              missing.size() == 1 ? "is" : "are", o.display, o.db,
+                              missing.size() == 1 ? "it" : "them"));
     }
     const bool same_picture =
         prior && prior->width_px == g.width_px && prior->height_px == g.height_px && prior->width_m == g.width_m;
@@ -127,14 +133,22 @@ std::string file_safe(std::string_view name) {
     return out;
 }
 
+/// A file calibrate writes for the person (typed readings, the check's plot):
+/// STUDY-NAME beside a study file; for the display-profile file (a shared or
+/// per-user data file) profiles-NAME in the current directory.
+fs::path output_path(const CalibrateOptions& o, const std::string& name) {
+    if (o.profiles_file) return fs::path(fmt::format("profiles-{}", name));
+    const fs::path db(o.db);
+    return db.parent_path() / fmt::format("{}-{}", db.stem().string(), name);
+}
+
 /// Typed readings are written next to the study file before anything is
 /// fitted, in the readings-file format, so that no measurement is lost to a
 /// failing fit: `--readings` takes the file as it is.
 fs::path save_typed_readings(const CalibrateOptions& o, const std::vector<Patch>& patches,
                              const std::vector<PhotometerReading>& readings) {
-    fs::path db(o.db);
-    const fs::path path = db.parent_path() / fmt::format("{}-{}-{}.readings", db.stem().string(), file_safe(o.display),
-                                                         utc_now("%Y%m%dT%H%M%SZ"));
+    const fs::path path =
+        output_path(o, fmt::format("{}-{}.readings", file_safe(o.display), utc_now("%Y%m%dT%H%M%SZ")));
     std::ofstream f(path, std::ios::binary);
     f << fmt::format("# atonlab calibrate {} of display \"{}\", typed {} (cd/m²; X Y Z where given)\n", o.mode,
                      o.display, utc_now("%Y-%m-%dT%H:%M:%SZ"));
@@ -423,11 +437,9 @@ int run_check(const CalibrateOptions& o) {
                 outcome.passed() ? "PASSED" : "FAILED");
     print_check(stdout, outcome, o.tolerances);
     if (!o.no_plot) {
-        const fs::path db_path(o.db);
         const fs::path plot = !o.plot.empty()
                                   ? fs::path(o.plot)
-                                  : db_path.parent_path() / fmt::format("{}-check-{}-{}.svg", db_path.stem().string(),
-                                                                        file_safe(o.display), id.value);
+                                  : output_path(o, fmt::format("check-{}-{}.svg", file_safe(o.display), id.value));
         std::string failed;
         for (const std::string& f : outcome.failed) failed += (failed.empty() ? "" : ", ") + f;
         const std::string title =
@@ -459,8 +471,9 @@ void add_file_options(CLI::App* cmd, CalibrateOptions& o) {
     profiles->excludes(db);
 }
 
-void add_display_and_db(CLI::App* cmd, CalibrateOptions& o) {
-    cmd->add_option("--display", o.display, "The display's name (the lab's name for it, e.g. lab-oled-1)")->required();
+void add_display_and_db(CLI::App* cmd, CalibrateOptions& o, bool display_required = true) {
+    cmd->add_option("--display", o.display, "The display's name (the lab's name for it, e.g. lab-oled-1)")
+        ->required(display_required);
     add_file_options(cmd, o);
     cmd->add_option("--date", o.date, "When the readings were taken: YYYY-MM-DD[THH:MM[:SS]Z] (default: now, UTC)");
     cmd->add_flag("--quiet", o.quiet, "No line per patch for file readings");
@@ -509,9 +522,9 @@ void add_calibrate_command(CLI::App& app, CalibrateOptions& o) {
 
     CLI::App* import_cmd =
         cal->add_subcommand("import", "Fit and store the readings of an ArgyllCMS .ti3 or a CSV file");
-    import_cmd->add_option("file", o.file, "The readings: .ti3 (ArgyllCMS dispread) or .csv (level,channel,cd_m2)")
-        ->required();
-    add_display_and_db(import_cmd, o);
+    // Not required here: import names every missing option and argument in one message.
+    import_cmd->add_option("file", o.file, "The readings: .ti3 (ArgyllCMS dispread) or .csv (level,channel,cd_m2)");
+    add_display_and_db(import_cmd, o, false);
     add_geometry(import_cmd, o);
     import_cmd->add_option("--drive-scale", o.drive_scale,
                            "How the CSV's `level` column is written: fraction (0-1, the default), 8bit (0-255) or "
@@ -529,7 +542,8 @@ void add_calibrate_command(CLI::App& app, CalibrateOptions& o) {
     check_cmd->add_option("--tol-peak-percent", o.tolerances.peak_percent, "Largest error of white, % (default 5)");
     check_cmd->add_option("--tol-gamma", o.tolerances.gamma, "Largest error of the effective gamma (default 0.1)");
     check_cmd->add_option("--plot", o.plot,
-                          "Write the plot here (.svg or .png; default: STUDY-check-DISPLAY-ID.svg beside the study)");
+                          "Write the plot here (.svg or .png; default: STUDY-check-DISPLAY-ID.svg beside the study, or "
+                          "profiles-check-DISPLAY-ID.svg here)");
     check_cmd->add_flag("--no-plot", o.no_plot, "Write no plot");
     check_cmd->parse_complete_callback([&o] { o.mode = "check"; });
 
@@ -548,7 +562,7 @@ void add_calibrate_command(CLI::App& app, CalibrateOptions& o) {
 int run_calibrate(const CalibrateOptions& given) {
     try {
         CalibrateOptions o = given;
-        if (o.display.empty() && o.mode != "list")
+        if (o.display.empty() && o.mode != "list" && o.mode != "import")
             throw InputError(SourceLocation{"--display", 0, 0, ""}, "the display's name must not be empty.");
         if (o.db.empty()) {
             const std::optional<ProfilesLocation> where = profiles_location(o.profiles);

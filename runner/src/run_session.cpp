@@ -1193,7 +1193,8 @@ int run_session(const RunOptions& o) {
 
     // --- The display's calibration (calibration_policy.h): warnings before the
     // session; a measured calibration's model encodes every frame.
-    const std::optional<st::Profiles> profiles = open_profiles_for_run(o.profiles, o.no_profiles);
+    // The lab's display-profile file (profile_location.h); a resumed session keeps its own calibration.
+    const std::optional<st::Profiles> profiles = open_profiles_for_run(o.profiles, o.no_profiles || resumed);
     const SessionCalibration calibration = session_calibration(
         existing ? &*existing : nullptr, protocol.display,
         resumed ? existing->session(session).calibration : std::nullopt, utc_today(), o.db,

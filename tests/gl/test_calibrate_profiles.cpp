@@ -9,6 +9,7 @@
 // Skips where the binary finds no GL 4.5 context (exit status 3).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -106,6 +107,14 @@ TEST_F(CalibrateProfiles, ImportNamesEveryMissingOptionAtOnceAndCreatesNothing) 
     EXPECT_TRUE(contains(r.err, "--viewing-distance-m")) << r.err;
     EXPECT_TRUE(contains(r.err, "are needed")) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(profiles()));
+    // Nothing but the file: the readings file, --display and the four geometry options, in one sentence.
+    const Result bare = atonlab({"calibrate", "import", "--profiles", profiles().string()}, dir_.path());
+    EXPECT_EQ(bare.code, 2) << bare.err;
+    for (const char* what : {"the readings file", "--display", "--width-px", "--height-px", "--width-m",
+                             "--viewing-distance-m"})
+        EXPECT_TRUE(contains(bare.err, what)) << what << ": " << bare.err;
+    EXPECT_EQ(std::count(bare.err.begin(), bare.err.end(), '\n'), 1) << bare.err;
     EXPECT_FALSE(fs::exists(profiles()));
     // Without --profiles, --db or ATONLAB_PROFILES: the per-user default, still not created on bad input.
     const Result d = atonlab({"calibrate", "import", (kData / "calibration/grey_ramp.csv").string(), "--display", "x"},
