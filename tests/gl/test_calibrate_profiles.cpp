@@ -7,6 +7,7 @@
 // the stored check in its drift table. XDG_DATA_HOME points into the test's
 // folder, so the user's own profile file is never read or written.
 // Skips where the binary finds no GL 4.5 context (exit status 3).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -122,6 +123,44 @@ TEST_F(CalibrateProfiles, ImportNamesEveryMissingOptionAtOnceAndCreatesNothing) 
     EXPECT_EQ(d.code, 2) << d.err;
     EXPECT_TRUE(contains(d.err, (dir_ / "xdg/atonlab/profiles.sqlite").string())) << d.err;
     EXPECT_FALSE(fs::exists(dir_ / "xdg/atonlab/profiles.sqlite"));
+}
+
+TEST_F(CalibrateProfiles, EightBitLevelsWithTheScaleGivenStoreTheSameFitAsFractions) {
+    // grey_ramp.csv's readings at codes 0, 32, ..., 255 written three ways.
+    const char* codes[] = {"0", "32", "64", "96", "128", "159", "191", "223", "255"};
+    const char* cd[] = {"0.21", "0.74", "2.61", "6.22", "11.9", "19.5", "30.3", "43.4", "59.8"};
+    std::ofstream fractions(dir_ / "fractions.csv"), named(dir_ / "named.csv"), plain(dir_ / "plain.csv");
+    fractions << "level,channel,cd_m2\n";
+    named << "level_8bit,channel,cd_m2\n";
+    plain << "level,channel,cd_m2\n";
+    for (int i = 0; i < 9; ++i) {
+        fractions << fmt::format("{:.17g},grey,{}\n", std::stoi(codes[i]) / 255.0, cd[i]);
+        named << codes[i] << ",grey," << cd[i] << "\n";
+        plain << codes[i] << ",grey," << cd[i] << "\n";
+    }
+    fractions.close();
+    named.close();
+    plain.close();
+    std::vector<std::string> fits;
+    for (const auto& [file, extra] : {std::pair{"fractions.csv", ""}, {"named.csv", ""}, {"plain.csv", "8bit"}}) {
+        SCOPED_TRACE(file);
+        std::vector<std::string> args = {"calibrate", "import", (dir_ / file).string(), "--display", file,
+                                         "--profiles", profiles().string()};
+        if (*extra) args = with(args, {"--drive-scale", extra});
+        const Result r = atonlab(with(args, kGeometry), dir_.path());
+        ASSERT_EQ(r.code, 0) << r.err;
+        fits.push_back(Profiles::open_read_only(profiles()).displays().latest_calibration(file)->fit_json);
+    }
+    EXPECT_EQ(fits[1], fits[0]);
+    EXPECT_EQ(fits[2], fits[0]);
+    // The plain column without the option: refused, naming the scales.
+    const Result r = atonlab(with({"calibrate", "import", (dir_ / "plain.csv").string(), "--display", "x",
+                                   "--profiles", profiles().string()},
+                                  kGeometry),
+                             dir_.path());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "plain.csv:3: key 'level': the drive level 32 is not a fraction")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--drive-scale 8bit or 10bit")) << r.err;
 }
 
 TEST_F(CalibrateProfiles, OneImportServesTwoStudiesEachHoldingACopy) {
