@@ -162,6 +162,8 @@ std::string drift_plot_body(const std::string& data, const std::vector<DriftPoin
     std::string b = "reset\nset datafile separator '\\t'\nset grid\nset xdata time\nset timefmt '%s'\n";
     b += "set format x '%Y-%m-%d'\nset xtics rotate by 20 right font ',8'\n";
     if (std::isfinite(t0)) b += fmt::format("set xrange ['{:.0f}':'{:.0f}']\n", t0 - pad, t1 + pad);
+    // A few days: one tick a day (gnuplot's own would repeat each date at 6-hour ticks).
+    if (std::isfinite(t0) && t1 - t0 + 2 * pad <= 20 * 86400.0) b += "set xtics 86400\n";
     b += "set multiplot layout 4,1 title " + detail::gp_quote(title) + "\nset lmargin 12\nset rmargin 14\n"
          "set key outside right top font ',8'\n";
     // Each panel: the tolerance band around the calibration's prediction
