@@ -108,9 +108,10 @@ std::vector<DriftPoint> display_drift(const store::Store& file, std::string_view
             if (auto p = drift_point(check))
                 out.push_back(std::move(*p));
             else if (problems)
-                problems->push_back(fmt::format("{}: check {} of calibration {} (display \"{}\") has results the "
-                                                "drift table cannot read; it is left out",
-                                                file.path().string(), check.id.value, c.id.value, display));
+                problems->push_back(
+                    fmt::format("{}: check {} of calibration {} (display \"{}\") has results the "
+                                "drift table cannot read; it is left out",
+                                file.path().string(), check.id.value, c.id.value, display));
         }
     std::sort(out.begin(), out.end(), [](const DriftPoint& a, const DriftPoint& b) {
         return a.checked_at != b.checked_at ? a.checked_at < b.checked_at : a.check_id < b.check_id;
@@ -119,9 +120,9 @@ std::vector<DriftPoint> display_drift(const store::Store& file, std::string_view
 }
 
 std::string drift_table(const std::vector<DriftPoint>& points) {
-    std::string out = fmt::format("  {:<20} {:>5} {:<6} {:>22} {:>24} {:>20} {:>20}\n", "checked", "cal", "result",
-                                  "peak cd/m² (pred ± %)", "black cd/m² (pred ± abs)", "gamma (pred ± abs)",
-                                  "worst error % (tol)");
+    std::string out =
+        fmt::format("  {:<20} {:>5} {:<6} {:>22} {:>24} {:>20} {:>20}\n", "checked", "cal", "result",
+                    "peak cd/m² (pred ± %)", "black cd/m² (pred ± abs)", "gamma (pred ± abs)", "worst error % (tol)");
     for (const DriftPoint& p : points) {
         out += fmt::format("  {:<20} {:>5} {:<6} {:>22} {:>24} {:>20} {:>20}\n", p.checked_at.substr(0, 20),
                            p.calibration_id, p.passed ? "passed" : "FAILED",
@@ -142,18 +143,17 @@ std::vector<std::vector<std::string>> drift_data_rows(const std::vector<DriftPoi
     for (const DriftPoint& p : points) {
         const double peak_band = p.peak_predicted_cd_m2 * p.tol_peak_percent / 100.0;
         const double t = epoch_seconds(p.checked_at);
-        rows.push_back({std::isfinite(t) ? fmt::format("{:.0f}", t) : std::string("NaN"), p.passed ? "1" : "0", num(p.peak_cd_m2),
-                        num(p.peak_predicted_cd_m2 - peak_band), num(p.peak_predicted_cd_m2 + peak_band),
-                        num(p.black_cd_m2), num(p.black_predicted_cd_m2 - p.tol_black_cd_m2),
-                        num(p.black_predicted_cd_m2 + p.tol_black_cd_m2), num(p.gamma_measured),
-                        num(p.gamma_predicted - p.tol_gamma), num(p.gamma_predicted + p.tol_gamma),
-                        num(p.worst_error_percent), num(p.tol_luminance_percent)});
+        rows.push_back(
+            {std::isfinite(t) ? fmt::format("{:.0f}", t) : std::string("NaN"), p.passed ? "1" : "0", num(p.peak_cd_m2),
+             num(p.peak_predicted_cd_m2 - peak_band), num(p.peak_predicted_cd_m2 + peak_band), num(p.black_cd_m2),
+             num(p.black_predicted_cd_m2 - p.tol_black_cd_m2), num(p.black_predicted_cd_m2 + p.tol_black_cd_m2),
+             num(p.gamma_measured), num(p.gamma_predicted - p.tol_gamma), num(p.gamma_predicted + p.tol_gamma),
+             num(p.worst_error_percent), num(p.tol_luminance_percent)});
     }
     return rows;
 }
 
-std::string drift_plot_body(const std::string& data, const std::vector<DriftPoint>& points,
-                            const std::string& title) {
+std::string drift_plot_body(const std::string& data, const std::vector<DriftPoint>& points, const std::string& title) {
     // One check has no span of dates: give the axis a day either side.
     double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
     for (const DriftPoint& p : points)
@@ -164,7 +164,8 @@ std::string drift_plot_body(const std::string& data, const std::vector<DriftPoin
     if (std::isfinite(t0)) b += fmt::format("set xrange ['{:.0f}':'{:.0f}']\n", t0 - pad, t1 + pad);
     // A few days: one tick a day (gnuplot's own would repeat each date at 6-hour ticks).
     if (std::isfinite(t0) && t1 - t0 + 2 * pad <= 20 * 86400.0) b += "set xtics 86400\n";
-    b += "set multiplot layout 4,1 title " + detail::gp_quote(title) + "\nset lmargin 12\nset rmargin 14\n"
+    b += "set multiplot layout 4,1 title " + detail::gp_quote(title) +
+         "\nset lmargin 12\nset rmargin 14\n"
          "set key outside right top font ',8'\n";
     // Each panel: the tolerance band around the calibration's prediction
     // (filled where there are two or more checks, and as a bar at each check),

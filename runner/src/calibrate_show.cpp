@@ -95,8 +95,8 @@ int run_show(const CalibrateOptions& o) {
                          fmt::format("display \"{}\" has no calibration in {} (`atonlab calibrate list` shows which "
                                      "displays it has).",
                                      o.display, o.db));
-    std::printf("display \"%s\" in %s: %zu calibration%s, latest first\n", o.display.c_str(), o.db.c_str(),
-                cals.size(), cals.size() == 1 ? "" : "s");
+    std::printf("display \"%s\" in %s: %zu calibration%s, latest first\n", o.display.c_str(), o.db.c_str(), cals.size(),
+                cals.size() == 1 ? "" : "s");
     for (const store::Calibration& c : cals) print_calibration(f, c);
     std::vector<std::string> problems;
     const std::vector<analysis::DriftPoint> drift = analysis::display_drift(f, o.display, &problems);

@@ -66,15 +66,14 @@ fs::path protocol_for(const fs::path& dir, const std::string& display) {
     text.replace(text.find(scene_line), scene_line.size(),
                  "scene = \"" + (kData / "run/small.scene.toml").string() + "\"");
     const std::string header = "[display]\n";
-    text.insert(text.find(header) + header.size(),
-                "name = \"" + display + "\"\nmax_calibration_age_days = 100000\n");
+    text.insert(text.find(header) + header.size(), "name = \"" + display + "\"\nmax_calibration_age_days = 100000\n");
     const fs::path p = dir / (display + ".toml");
     std::ofstream(p) << text;
     return p;
 }
 
-const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px", "180", "--width-m", "0.1",
-                                            "--viewing-distance-m", "0.9"};
+const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px",          "180",
+                                            "--width-m",  "0.1", "--viewing-distance-m", "0.9"};
 
 std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& b) {
     a.insert(a.end(), b.begin(), b.end());
@@ -112,14 +111,14 @@ TEST_F(CalibrateProfiles, ImportNamesEveryMissingOptionAtOnceAndCreatesNothing) 
     // Nothing but the file: the readings file, --display and the four geometry options, in one sentence.
     const Result bare = atonlab({"calibrate", "import", "--profiles", profiles().string()}, dir_.path());
     EXPECT_EQ(bare.code, 2) << bare.err;
-    for (const char* what : {"the readings file", "--display", "--width-px", "--height-px", "--width-m",
-                             "--viewing-distance-m"})
+    for (const char* what :
+         {"the readings file", "--display", "--width-px", "--height-px", "--width-m", "--viewing-distance-m"})
         EXPECT_TRUE(contains(bare.err, what)) << what << ": " << bare.err;
     EXPECT_EQ(std::count(bare.err.begin(), bare.err.end(), '\n'), 1) << bare.err;
     EXPECT_FALSE(fs::exists(profiles()));
     // Without --profiles, --db or ATONLAB_PROFILES: the per-user default, still not created on bad input.
-    const Result d = atonlab({"calibrate", "import", (kData / "calibration/grey_ramp.csv").string(), "--display", "x"},
-                             dir_.path());
+    const Result d =
+        atonlab({"calibrate", "import", (kData / "calibration/grey_ramp.csv").string(), "--display", "x"}, dir_.path());
     EXPECT_EQ(d.code, 2) << d.err;
     EXPECT_TRUE(contains(d.err, (dir_ / "xdg/atonlab/profiles.sqlite").string())) << d.err;
     EXPECT_FALSE(fs::exists(dir_ / "xdg/atonlab/profiles.sqlite"));
@@ -144,8 +143,8 @@ TEST_F(CalibrateProfiles, EightBitLevelsWithTheScaleGivenStoreTheSameFitAsFracti
     std::vector<std::string> fits;
     for (const auto& [file, extra] : {std::pair{"fractions.csv", ""}, {"named.csv", ""}, {"plain.csv", "8bit"}}) {
         SCOPED_TRACE(file);
-        std::vector<std::string> args = {"calibrate", "import", (dir_ / file).string(), "--display", file,
-                                         "--profiles", profiles().string()};
+        std::vector<std::string> args = {"calibrate", "import",     (dir_ / file).string(), "--display",
+                                         file,        "--profiles", profiles().string()};
         if (*extra) args = with(args, {"--drive-scale", extra});
         const Result r = atonlab(with(args, kGeometry), dir_.path());
         ASSERT_EQ(r.code, 0) << r.err;
@@ -154,8 +153,8 @@ TEST_F(CalibrateProfiles, EightBitLevelsWithTheScaleGivenStoreTheSameFitAsFracti
     EXPECT_EQ(fits[1], fits[0]);
     EXPECT_EQ(fits[2], fits[0]);
     // The plain column without the option: refused, naming the scales.
-    const Result r = atonlab(with({"calibrate", "import", (dir_ / "plain.csv").string(), "--display", "x",
-                                   "--profiles", profiles().string()},
+    const Result r = atonlab(with({"calibrate", "import", (dir_ / "plain.csv").string(), "--display", "x", "--profiles",
+                                   profiles().string()},
                                   kGeometry),
                              dir_.path());
     EXPECT_EQ(r.code, 2);
@@ -211,10 +210,10 @@ TEST_F(CalibrateProfiles, OldStudyFilesWithTheirOwnCalibrationStillRun) {
     std::ofstream(dim) << "level,channel,cd_m2\n0,black,0.05\n0.25,grey,0.6\n0.5,grey,2.6\n0.75,grey,6.4\n1,white,12\n";
     // Schema 2: made by `calibrate import --db` as before.
     const fs::path v2 = dir_ / "v2.db";
-    r = atonlab(with({"calibrate", "import", dim.string(), "--display", "booth-2", "--db", v2.string(), "--date",
-                      "2024-05-01"},
-                     kGeometry),
-                dir_.path());
+    r = atonlab(
+        with({"calibrate", "import", dim.string(), "--display", "booth-2", "--db", v2.string(), "--date", "2024-05-01"},
+             kGeometry),
+        dir_.path());
     ASSERT_EQ(r.code, 0) << r.err;
     const std::string own_fit = Store::open_read_only(v2).latest_calibration("booth-2")->fit_json;
     // Schema 1: the version-1 step alone, its calibration row written through SQLite.
@@ -223,9 +222,9 @@ TEST_F(CalibrateProfiles, OldStudyFilesWithTheirOwnCalibrationStillRun) {
     {
         RawDb raw(v1);
         sqlite3_stmt* s = nullptr;
-        ASSERT_EQ(sqlite3_prepare_v2(raw.get(),
-                                     "INSERT INTO displays (id, name) VALUES (1, 'booth-2'); ", -1, &s, nullptr),
-                  SQLITE_OK);
+        ASSERT_EQ(
+            sqlite3_prepare_v2(raw.get(), "INSERT INTO displays (id, name) VALUES (1, 'booth-2'); ", -1, &s, nullptr),
+            SQLITE_OK);
         ASSERT_EQ(sqlite3_step(s), SQLITE_DONE);
         sqlite3_finalize(s);
         ASSERT_EQ(sqlite3_prepare_v2(raw.get(),

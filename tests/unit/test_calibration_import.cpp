@@ -32,7 +32,8 @@ std::string ramp_csv(const std::string& header, int max_code, Level level_text, 
     std::string out = header + "\n";
     for (int i = 0; i <= 8; ++i) {
         const int code = i == 8 ? max_code : i * (max_code + 1) / 8;
-        out += fmt::format("{},grey,{}\n", level_text(code, max_code), reading_text(law_cd_m2(static_cast<double>(code) / max_code)));
+        out += fmt::format("{},grey,{}\n", level_text(code, max_code),
+                           reading_text(law_cd_m2(static_cast<double>(code) / max_code)));
     }
     return out;
 }
@@ -94,9 +95,10 @@ TEST(CalibrationImport, FootLambertsAndXyzAreReadInCdM2) {
     for (std::size_t i = 0; i < in_cd.size(); ++i)
         EXPECT_NEAR(in_fl[i].luminance_cd_m2, in_cd[i].luminance_cd_m2, 1e-12 * in_cd[i].luminance_cd_m2);
     // XYZ: Y is the luminance; X and Z are kept (so are the chromaticities x, y).
-    const auto xyz = parse_calibration_csv("X,Y,Z,level,channel\n0.19,0.2,0.22,0,black\n95.1,100,108.9,1,white\n"
-                                           "20.3,21.4,23.3,0.5,grey\n",
-                                           "xyz.csv");
+    const auto xyz = parse_calibration_csv(
+        "X,Y,Z,level,channel\n0.19,0.2,0.22,0,black\n95.1,100,108.9,1,white\n"
+        "20.3,21.4,23.3,0.5,grey\n",
+        "xyz.csv");
     ASSERT_EQ(xyz.size(), 3u);
     EXPECT_EQ(xyz[1].luminance_cd_m2, 100.0);
     ASSERT_TRUE(xyz[1].xyz_cd_m2.has_value());

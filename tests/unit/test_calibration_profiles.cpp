@@ -80,8 +80,8 @@ std::vector<store::CalibrationReading> two_readings() {
 }
 
 /// A check of `cal` (stored in `file`) with every check patch read as `scale` times the truth.
-CheckOutcome check(store::Store& file, const store::Calibration& cal, const stimuli::DisplayModel& truth,
-                   double scale, const std::string& date, const CheckTolerances& tol = {}) {
+CheckOutcome check(store::Store& file, const store::Calibration& cal, const stimuli::DisplayModel& truth, double scale,
+                   const std::string& date, const CheckTolerances& tol = {}) {
     std::vector<PhotometerReading> readings;
     for (const Patch& p : check_patches())
         readings.push_back({scale * stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8), std::nullopt, std::nullopt});
