@@ -394,7 +394,29 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
 
 // --- display calibration --------------------------------------------------------------
 
+/// A display's checks over time (calibration_drift.h), once per display and file.
+void drift_figures(Drawer& d, const Dataset& data) {
+    std::set<std::pair<std::string, std::string>> drawn;
+    int k = 0;
+    for (const CalibrationInfo& c : data.calibrations) {
+        if (c.drift.empty() || !drawn.insert({c.source, c.display_name}).second) continue;
+        const std::string id = fmt::format("calibration-drift-{}", ++k);
+        Figure f;
+        f.id = id;
+        f.kind = "calibration-drift";
+        f.title = fmt::format("Display calibration checks over time: {}", c.display_name);
+        f.caption = fmt::format(
+            "Every check of display {} stored in {}: white (peak), black, effective gamma and the worst grey "
+            "patch's error against the date, each with the check's tolerance band (shaded, and as a bar at each "
+            "check); failed checks are red crosses.",
+            c.display_name, c.source);
+        d.draw(std::move(f),
+               drift_plot_body(d.data(id + ".tsv", drift_data_rows(c.drift)), c.drift, f.title));
+    }
+}
+
 void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string>& problems) {
+    drift_figures(d, data);
     int k = 0;
     for (const CalibrationInfo& c : data.calibrations) {
         ++k;

@@ -270,7 +270,19 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
         j.field("width_px", c.width_px).field("height_px", c.height_px).field("width_m", c.width_m);
         j.field("height_m", c.height_m).field("viewing_distance_m", c.viewing_distance_m);
         j.field("how", c.how).field("measured_at", c.measured_at);
-        j.field("readings", static_cast<int>(c.readings.size())).field("fit_json", c.fit_json).end_object();
+        j.field("readings", static_cast<int>(c.readings.size())).field("fit_json", c.fit_json);
+        j.key("checks").begin_array();
+        for (const DriftPoint& p : c.drift) {
+            j.begin_object().field("check_id", p.check_id).field("checked_at", p.checked_at);
+            j.field("passed", p.passed).field("peak_cd_m2", p.peak_cd_m2);
+            j.field("peak_predicted_cd_m2", p.peak_predicted_cd_m2).field("black_cd_m2", p.black_cd_m2);
+            j.field("black_predicted_cd_m2", p.black_predicted_cd_m2).field("gamma_measured", p.gamma_measured);
+            j.field("gamma_predicted", p.gamma_predicted).field("worst_error_percent", p.worst_error_percent);
+            j.field("worst_patch", p.worst_patch).field("tol_peak_percent", p.tol_peak_percent);
+            j.field("tol_black_cd_m2", p.tol_black_cd_m2).field("tol_gamma", p.tol_gamma);
+            j.field("tol_luminance_percent", p.tol_luminance_percent).end_object();
+        }
+        j.end_array().end_object();
     }
     j.end_array();
     j.key("figures").begin_array();

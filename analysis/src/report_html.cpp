@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 
 #include <fstream>
+#include <cmath>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "atonlab/analysis/report.h"
@@ -57,6 +59,41 @@ std::string ci_text(const std::optional<Interval>& ci) {
 std::string yes_no(bool reliable, const std::string& reason) {
     if (reliable) return "<span class=\"ok\">yes</span>";
     return "<span class=\"bad\">no</span>" + (reason.empty() ? std::string() : ": " + esc(reason));
+}
+
+/// "12.3 (12.1 ± 5%)": a measured value, the calibration's prediction and the tolerance.
+std::string drift_cell(double measured, double predicted, double tolerance, const char* unit) {
+    auto v = [](double x) { return std::isfinite(x) ? fmt::format("{:.4g}", x) : std::string("&ndash;"); };
+    return fmt::format("{} ({} &plusmn; {}{})", v(measured), v(predicted), v(tolerance), unit);
+}
+
+/// Each display's calibration checks over time, once per display and file (calibration_drift.h).
+std::string drift_html(const Dataset& d) {
+    std::string h;
+    std::set<std::pair<std::string, std::string>> shown;
+    for (const CalibrationInfo& c : d.calibrations) {
+        if (c.drift.empty() || !shown.insert({c.source, c.display_name}).second) continue;
+        h += fmt::format(
+            "<h3>Checks of display {} over time</h3>\n<p>Every <code>atonlab calibrate check</code> of the display "
+            "that {} holds (a session stores the latest check of the calibration it used): measured (predicted "
+            "&plusmn; tolerance).</p>\n",
+            esc(c.display_name), esc(c.source));
+        h += "<table>\n<tr><th>checked</th><th>calibration</th><th>result</th><th>peak cd/m²</th>"
+             "<th>black cd/m²</th><th>effective gamma</th><th>worst grey error %</th></tr>\n";
+        for (const DriftPoint& p : c.drift)
+            h += fmt::format(
+                "<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td>"
+                "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{} {} (&le; {})</td></tr>\n",
+                esc(p.checked_at), p.calibration_id,
+                p.passed ? std::string("<span class=\"ok\">passed</span>") : "<span class=\"bad\">failed</span>",
+                drift_cell(p.peak_cd_m2, p.peak_predicted_cd_m2, p.tol_peak_percent, "%"),
+                drift_cell(p.black_cd_m2, p.black_predicted_cd_m2, p.tol_black_cd_m2, ""),
+                drift_cell(p.gamma_measured, p.gamma_predicted, p.tol_gamma, ""),
+                std::isfinite(p.worst_error_percent) ? fmt::format("{:.2f}", p.worst_error_percent) : "&ndash;",
+                esc(p.worst_patch), p.tol_luminance_percent);
+        h += "</table>\n";
+    }
+    return h;
 }
 
 std::string read_file(const std::filesystem::path& p) {
@@ -344,6 +381,10 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         if (ctx.plots)
             for (const Figure& f : ctx.plots->figures)
                 if (f.kind == "calibration") h += figure_html(out_dir, f);
+        h += drift_html(d);
+        if (ctx.plots)
+            for (const Figure& f : ctx.plots->figures)
+                if (f.kind == "calibration-drift") h += figure_html(out_dir, f);
     }
 
     // --- methods and files

@@ -284,6 +284,7 @@ void add_calibrations(Dataset& d, const store::Store& db, const std::string& fil
             ci.measured_at = c.measured_at;
             for (const store::CalibrationReading& r : db.calibration_readings(store::CalibrationId{id}))
                 ci.readings.push_back({r.patch, r.channel, r.level, r.luminance_cd_m2});
+            ci.drift = display_drift(db, c.display_name, &d.notes);
             d.calibrations.push_back(std::move(ci));
         } catch (const store::StoreError&) {
             if (!salvage) throw;

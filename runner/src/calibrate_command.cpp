@@ -18,9 +18,13 @@
 #include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/store/error.h"
+#include "atonlab/store/json.h"
+#include "atonlab/store/profiles.h"
 #include "atonlab/store/store.h"
 #include "calibrate/instrument_session.h"
+#include "calibrate_show.h"
 #include "calibration_record.h"
+#include "profile_location.h"
 #include "patch_screen.h"
 #include "patch_session.h"
 
@@ -75,28 +79,39 @@ std::string measurement_date(const std::string& date) {
 /// only) the window's size; height_m defaults to square pixels.
 DisplayGeometry resolve_geometry(const CalibrateOptions& o, const std::optional<store::Calibration>& prior,
                                  std::optional<std::pair<int, int>> screen_px) {
-    auto missing = [&](const char* option, const char* what) -> InputError {
-        return InputError(SourceLocation{option, 0, 0, ""},
-                          fmt::format("{} ({}) is needed: display \"{}\" has no calibration in {} to take it from.",
-                                      option, what, o.display, o.db));
-    };
+    // Every missing option is named in one message, so one more run gives them all.
+    std::vector<std::string> missing;
+    if (o.mode == "import" && o.file.empty()) missing.push_back("the readings file (FILE.ti3 or FILE.csv)");
+    if (o.display.empty()) missing.push_back("--display (the display's name, e.g. lab-lcd)");
     DisplayGeometry g;
     g.width_px = o.width_px ? *o.width_px : prior ? prior->width_px : screen_px ? screen_px->first : 0;
     g.height_px = o.height_px ? *o.height_px : prior ? prior->height_px : screen_px ? screen_px->second : 0;
-    if (g.width_px <= 0) throw missing("--width-px", "the display's width in pixels");
-    if (g.height_px <= 0) throw missing("--height-px", "the display's height in pixels");
+    if (g.width_px <= 0) missing.push_back("--width-px (the display's width in pixels)");
+    if (g.height_px <= 0) missing.push_back("--height-px (the display's height in pixels)");
     if (o.width_m)
         g.width_m = *o.width_m;
     else if (prior)
         g.width_m = prior->width_m;
     else
-        throw missing("--width-m", "the picture's visible width in metres");
+        missing.push_back("--width-m (the picture's visible width in metres)");
     if (o.viewing_distance_m)
         g.viewing_distance_m = *o.viewing_distance_m;
     else if (prior)
         g.viewing_distance_m = prior->viewing_distance_m;
     else
-        throw missing("--viewing-distance-m", "eye to screen in metres");
+        missing.push_back("--viewing-distance-m (eye to screen in metres)");
+    if (!missing.empty()) {
+        std::string list;
+        for (std::size_t i = 0; i < missing.size(); ++i)
+            list += (i == 0 ? "" : i + 1 == missing.size() ? " and " : ", ") + missing[i];
+        throw InputError(
+            o.display.empty()
+                ? fmt::format("{} {} needed (the geometry may instead come from the display's latest calibration).",
+                              list, missing.size() == 1 ? "is" : "are")
+                : fmt::format("{} {} needed: display \"{}\" has no calibration in {} to take {} from.", list,
+                              missing.size() == 1 ? "is" : "are", o.display, o.db,
+                              missing.size() == 1 ? "it" : "them"));
+    }
     const bool same_picture =
         prior && prior->width_px == g.width_px && prior->height_px == g.height_px && prior->width_m == g.width_m;
     g.height_m = o.height_m ? *o.height_m : same_picture ? prior->height_m : g.width_m * g.height_px / g.width_px;
@@ -119,14 +134,22 @@ std::string file_safe(std::string_view name) {
     return out;
 }
 
+/// A file calibrate writes for the person (typed readings, the check's plot):
+/// STUDY-NAME beside a study file; for the display-profile file (a shared or
+/// per-user data file) profiles-NAME in the current directory.
+fs::path output_path(const CalibrateOptions& o, const std::string& name) {
+    if (o.profiles_file) return fs::path(fmt::format("profiles-{}", name));
+    const fs::path db(o.db);
+    return db.parent_path() / fmt::format("{}-{}", db.stem().string(), name);
+}
+
 /// Typed readings are written next to the study file before anything is
 /// fitted, in the readings-file format, so that no measurement is lost to a
 /// failing fit: `--readings` takes the file as it is.
 fs::path save_typed_readings(const CalibrateOptions& o, const std::vector<Patch>& patches,
                              const std::vector<PhotometerReading>& readings, const std::string& how = "typed") {
-    fs::path db(o.db);
-    const fs::path path = db.parent_path() / fmt::format("{}-{}-{}.readings", db.stem().string(), file_safe(o.display),
-                                                         utc_now("%Y%m%dT%H%M%SZ"));
+    const fs::path path =
+        output_path(o, fmt::format("{}-{}.readings", file_safe(o.display), utc_now("%Y%m%dT%H%M%SZ")));
     std::ofstream f(path, std::ios::binary);
     f << fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n", o.mode, o.display,
                      how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
@@ -296,14 +319,47 @@ int store_calibration(store::Store& db, const CalibrateOptions& o, const std::ve
 /// reports a study-file problem before any time is spent measuring); none when
 /// the file does not exist yet. A new file is created only when there is a
 /// calibration to store, so bad input leaves no empty study behind.
+/// The file calibrate works on: a study file (--db) or the display-profile file.
+class CalibrationFile {
+public:
+    /// Opens it; `create`: creating it (and, for the per-user default profile
+    /// file only, its folder) when it does not exist.
+    CalibrationFile(const CalibrateOptions& o, bool create) {
+        if (!o.profiles_file) {
+            study_.emplace(create ? store::Store::create_or_open(o.db) : store::Store::open_existing(o.db));
+            return;
+        }
+        if (create && o.profiles_default) {
+            std::error_code ec;
+            fs::create_directories(fs::path(o.db).parent_path(), ec);  // a failure is reported by the open
+        }
+        profiles_.emplace(create ? store::Profiles::create_or_open(o.db) : store::Profiles::open_existing(o.db));
+    }
+    store::Store& displays() { return profiles_ ? profiles_->displays() : *study_; }
+
+private:
+    std::optional<store::Store> study_;
+    std::optional<store::Profiles> profiles_;
+};
+
+/// "--profiles" or "--db": the option that names the file calibrate works on.
+const char* file_option(const CalibrateOptions& o) {
+    return o.profiles_file ? "--profiles" : "--db";
+}
+
+/// "study file" or "display-profile file".
+const char* file_noun(const CalibrateOptions& o) {
+    return o.profiles_file ? "display-profile file" : "study file";
+}
+
 std::optional<store::Calibration> prior_calibration(const CalibrateOptions& o) {
     std::error_code ec;
-    if (fs::exists(o.db, ec)) return store::Store::open_existing(o.db).latest_calibration(o.display);
+    if (fs::exists(o.db, ec)) return CalibrationFile(o, false).displays().latest_calibration(o.display);
     const fs::path dir = fs::path(o.db).parent_path().empty() ? fs::path(".") : fs::path(o.db).parent_path();
-    if (!fs::is_directory(dir, ec))
-        throw InputError(
-            SourceLocation{"--db", 0, 0, ""},
-            fmt::format("cannot create the study file {}: the directory {} does not exist.", o.db, dir.string()));
+    if (!fs::is_directory(dir, ec) && !o.profiles_default)
+        throw InputError(SourceLocation{file_option(o), 0, 0, ""},
+                         fmt::format("cannot create the {} {}: the directory {} does not exist.", file_noun(o), o.db,
+                                     dir.string()));
     return std::nullopt;
 }
 
@@ -324,20 +380,32 @@ int run_measure(const CalibrateOptions& o) {
     // Fitted before the study file is created or written: readings that cannot be fitted store nothing.
     const std::vector<stimuli::Measurement> ms = measurements_of(patches, *m);
     stimuli::fit_calibration(ms);
-    store::Store db = store::Store::create_or_open(o.db);
+    CalibrationFile file(o, true);
     const std::string source =
         o.readings.empty() && o.instrument.kind.empty() ? std::string("measured") : "measured, " + m->source;
-    return store_calibration(db, o, ms, readings_of(patches, *m), m->geometry, "measured", source, measured_at);
+    return store_calibration(file.displays(), o, ms, readings_of(patches, *m), m->geometry, "measured", source,
+                             measured_at);
 }
 
 int run_import(const CalibrateOptions& o) {
     const std::string measured_at = measurement_date(o.date);
-    const std::vector<stimuli::Measurement> ms = stimuli::read_calibration_file(o.file);
-    stimuli::fit_calibration(ms);  // a file that cannot be fitted is refused before the study file is touched
+    stimuli::CalibrationFileOptions file_options;
+    if (!o.drive_scale.empty()) {
+        file_options.drive_scale = stimuli::drive_scale_from_name(o.drive_scale);
+        if (!file_options.drive_scale)
+            throw InputError(SourceLocation{"--drive-scale", 0, 0, ""},
+                             fmt::format("\"{}\" is not a drive scale: fraction (0 to 1), 8bit (codes 0 to 255) or "
+                                         "10bit (codes 0 to 1023).",
+                                         o.drive_scale));
+    }
+    // The options first, so that a user missing several learns of all of them
+    // (with the file's own errors after) in as few runs as possible.
     const DisplayGeometry geometry = resolve_geometry(o, prior_calibration(o), std::nullopt);
-    store::Store db = store::Store::create_or_open(o.db);
-    return store_calibration(db, o, ms, readings_from_measurements(ms), geometry, "imported", "imported " + o.file,
-                             measured_at);
+    const std::vector<stimuli::Measurement> ms = stimuli::read_calibration_file(o.file, file_options);
+    stimuli::fit_calibration(ms);  // a file that cannot be fitted is refused before the study file is touched
+    CalibrationFile file(o, true);
+    return store_calibration(file.displays(), o, ms, readings_from_measurements(ms), geometry, "imported",
+                             "imported " + o.file, measured_at);
 }
 
 int run_check(const CalibrateOptions& o) {
@@ -353,7 +421,14 @@ int run_check(const CalibrateOptions& o) {
                                         {o.tolerances.gamma, "--tol-gamma"}})
         if (!(std::isfinite(value) && value > 0.0))
             throw InputError(SourceLocation{option, 0, 0, ""}, fmt::format("a tolerance must be > 0, not {}.", value));
-    store::Store db = store::Store::open_existing(o.db);
+    std::error_code ec;
+    if (o.profiles_file && !fs::exists(o.db, ec))
+        throw InputError(SourceLocation{"--display", 0, 0, ""},
+                         fmt::format("display \"{}\" has no measured calibration to check: the display-profile file "
+                                     "{} ({}) does not exist yet; run `atonlab calibrate measure` (or import) first.",
+                                     o.display, o.db, o.profiles_default ? "the per-user default" : file_option(o)));
+    CalibrationFile file(o, false);
+    store::Store& db = file.displays();
     const std::optional<store::Calibration> cal = latest_measured_calibration(db, o.display);
     if (!cal)
         throw InputError(SourceLocation{"--display", 0, 0, ""},
@@ -383,11 +458,9 @@ int run_check(const CalibrateOptions& o) {
                 outcome.passed() ? "PASSED" : "FAILED");
     print_check(stdout, outcome, o.tolerances);
     if (!o.no_plot) {
-        const fs::path db_path(o.db);
         const fs::path plot = !o.plot.empty()
                                   ? fs::path(o.plot)
-                                  : db_path.parent_path() / fmt::format("{}-check-{}-{}.svg", db_path.stem().string(),
-                                                                        file_safe(o.display), id.value);
+                                  : output_path(o, fmt::format("check-{}-{}.svg", file_safe(o.display), id.value));
         std::string failed;
         for (const std::string& f : outcome.failed) failed += (failed.empty() ? "" : ", ") + f;
         const std::string title =
@@ -409,9 +482,20 @@ int run_check(const CalibrateOptions& o) {
     return outcome.passed() ? 0 : 1;
 }
 
-void add_display_and_db(CLI::App* cmd, CalibrateOptions& o) {
-    cmd->add_option("--display", o.display, "The display's name (the lab's name for it, e.g. lab-oled-1)")->required();
-    cmd->add_option("--db", o.db, "Study file (SQLite; see docs/store.md)")->required();
+void add_file_options(CLI::App* cmd, CalibrateOptions& o) {
+    CLI::Option* db =
+        cmd->add_option("--db", o.db, "Work on this study file (SQLite; docs/store.md) instead of the profile file");
+    CLI::Option* profiles = cmd->add_option(
+        "--profiles", o.profiles,
+        "The lab's display-profile file (default: $ATONLAB_PROFILES, else $XDG_DATA_HOME/atonlab/profiles.sqlite)");
+    db->excludes(profiles);
+    profiles->excludes(db);
+}
+
+void add_display_and_db(CLI::App* cmd, CalibrateOptions& o, bool display_required = true) {
+    cmd->add_option("--display", o.display, "The display's name (the lab's name for it, e.g. lab-oled-1)")
+        ->required(display_required);
+    add_file_options(cmd, o);
     cmd->add_option("--date", o.date, "When the readings were taken: YYYY-MM-DD[THH:MM[:SS]Z] (default: now, UTC)");
     cmd->add_flag("--quiet", o.quiet, "No line per patch for file readings");
 }
@@ -460,10 +544,13 @@ void add_calibrate_command(CLI::App& app, CalibrateOptions& o) {
 
     CLI::App* import_cmd =
         cal->add_subcommand("import", "Fit and store the readings of an ArgyllCMS .ti3 or a CSV file");
-    import_cmd->add_option("file", o.file, "The readings: .ti3 (ArgyllCMS dispread) or .csv (level,channel,cd_m2)")
-        ->required();
-    add_display_and_db(import_cmd, o);
+    // Not required here: import names every missing option and argument in one message.
+    import_cmd->add_option("file", o.file, "The readings: .ti3 (ArgyllCMS dispread) or .csv (level,channel,cd_m2)");
+    add_display_and_db(import_cmd, o, false);
     add_geometry(import_cmd, o);
+    import_cmd->add_option("--drive-scale", o.drive_scale,
+                           "How the CSV's `level` column is written: fraction (0-1, the default), 8bit (0-255) or "
+                           "10bit (0-1023)");
     import_cmd->parse_complete_callback([&o] { o.mode = "import"; });
 
     CLI::App* check_cmd = cal->add_subcommand(
@@ -477,17 +564,43 @@ void add_calibrate_command(CLI::App& app, CalibrateOptions& o) {
     check_cmd->add_option("--tol-peak-percent", o.tolerances.peak_percent, "Largest error of white, % (default 5)");
     check_cmd->add_option("--tol-gamma", o.tolerances.gamma, "Largest error of the effective gamma (default 0.1)");
     check_cmd->add_option("--plot", o.plot,
-                          "Write the plot here (.svg or .png; default: STUDY-check-DISPLAY-ID.svg beside the study)");
+                          "Write the plot here (.svg or .png; default: STUDY-check-DISPLAY-ID.svg beside the study, or "
+                          "profiles-check-DISPLAY-ID.svg here)");
     check_cmd->add_flag("--no-plot", o.no_plot, "Write no plot");
     check_cmd->parse_complete_callback([&o] { o.mode = "check"; });
+
+    CLI::App* list_cmd = cal->add_subcommand("list", "List the displays, their calibrations and latest checks");
+    add_file_options(list_cmd, o);
+    list_cmd->parse_complete_callback([&o] { o.mode = "list"; });
+
+    CLI::App* show_cmd = cal->add_subcommand(
+        "show", "Show a display's calibrations and its drift: every check over time, as a table and a plot");
+    show_cmd->add_option("--display", o.display, "The display's name")->required();
+    add_file_options(show_cmd, o);
+    show_cmd->add_option("--plot", o.plot, "Write the drift plot here (.svg or .png); default: none");
+    show_cmd->parse_complete_callback([&o] { o.mode = "show"; });
 }
 
-int run_calibrate(const CalibrateOptions& o) {
+int run_calibrate(const CalibrateOptions& given) {
     try {
-        if (o.display.empty())
+        CalibrateOptions o = given;
+        if (o.display.empty() && o.mode != "list" && o.mode != "import")
             throw InputError(SourceLocation{"--display", 0, 0, ""}, "the display's name must not be empty.");
+        if (o.db.empty()) {
+            const std::optional<ProfilesLocation> where = profiles_location(o.profiles);
+            if (!where)
+                throw InputError(SourceLocation{"--profiles", 0, 0, ""},
+                                 fmt::format("no display-profile file: give --profiles FILE (or --db STUDY.db), or "
+                                             "set {} (HOME and XDG_DATA_HOME are both unset).",
+                                             kProfilesEnv));
+            o.db = where->path.string();
+            o.profiles_file = true;
+            o.profiles_default = !where->explicit_path;
+        }
         if (o.mode == "measure") return run_measure(o);
         if (o.mode == "import") return run_import(o);
+        if (o.mode == "list") return run_list(o);
+        if (o.mode == "show") return run_show(o);
         return run_check(o);
     } catch (const store::StoreError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());

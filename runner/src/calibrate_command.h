@@ -1,8 +1,11 @@
 #pragma once
-// `atonlab calibrate (measure | import FILE | check) --display NAME --db STUDY.db`
-// (docs/calibration.md). Exit status: 0 stored / check passed, 1 check failed
-// or the operator gave up (nothing stored), 2 bad input, 3 no GL or no
-// usable screen, 4 the study file failed, 5 the instrument failed (nothing stored).
+// `atonlab calibrate (measure | import FILE | check | show) --display NAME` and
+// `atonlab calibrate list`, on a study file (--db STUDY.db) or the lab's
+// display-profile file (--profiles FILE, ATONLAB_PROFILES or the per-user
+// default; docs/calibration.md). Exit status: 0 stored / check passed, 1
+// check failed or the operator gave up (nothing stored), 2 bad input, 3 no GL
+// or no usable screen, 4 the study or profile file failed, 5 the instrument
+// failed (nothing stored).
 #include <optional>
 #include <string>
 
@@ -16,9 +19,17 @@ class App;
 namespace atonlab::runner {
 
 struct CalibrateOptions {
-    std::string mode;  ///< "measure", "import" or "check": the subcommand given
+    std::string mode;  ///< "measure", "import", "check", "list" or "show": the subcommand given
     std::string display;
+    /// --db: a study file. Empty: the display-profile file (--profiles, else
+    /// ATONLAB_PROFILES, else the per-user default; profile_location.h).
     std::string db;
+    std::string profiles;  ///< --profiles FILE
+    /// Set by run_calibrate: `db` holds the display-profile file's path.
+    bool profiles_file = false;
+    /// Set by run_calibrate: that path is the per-user default (its folder may be created).
+    bool profiles_default = false;
+    std::string drive_scale;  ///< import: --drive-scale fraction|8bit|10bit (CSV drive levels)
     std::string file;  ///< import: the .csv or .ti3
     // Geometry (measure, import); unset: from the display's latest calibration.
     std::optional<int> width_px, height_px;

@@ -69,9 +69,10 @@ void apply_display_model(stimuli::Scene& scene, const stimuli::DisplayModel& mod
 
 SessionCalibration session_calibration(const store::Store* store, const protocols::Display& display,
                                        std::optional<store::CalibrationId> resumed_with, const std::string& today,
-                                       const std::string& db) {
+                                       const std::string& db, const RunProfiles& profiles) {
     SessionCalibration out;
     std::optional<store::Calibration> cal;
+    const store::Store* source = store;  // the file `cal` is in
     if (resumed_with && store) {
         // A session continues with what it began with.
         store::Calibration c = store->calibration(*resumed_with);
@@ -84,19 +85,40 @@ SessionCalibration session_calibration(const store::Store* store, const protocol
         return out;
     } else {
         if (store) cal = latest_measured_calibration(*store, display.name);
+        // The display-profile file's, when it is measured later than the
+        // study file's own (or on the same date: it may hold a newer check).
+        if (profiles.file)
+            if (auto p = latest_measured_calibration(*profiles.file, display.name);
+                p && (!cal || p->measured_at >= cal->measured_at)) {
+                cal = std::move(p);
+                source = profiles.file;
+            }
         if (!cal) {
-            out.warnings.push_back(fmt::format(
-                "display \"{}\" has no calibration in {}: the session encodes for the scene's nominal display "
-                "model; measure it first with `atonlab calibrate measure --display {} --db {}` (or import a .ti3)",
-                display.name, db, display.name, db));
+            out.warnings.push_back(
+                profiles.file
+                    ? fmt::format("display \"{}\" has no calibration in the display-profile file {} or in {}: the "
+                                  "session encodes for the scene's nominal display model; measure it first with "
+                                  "`atonlab calibrate measure --display {}` (or import a .ti3)",
+                                  display.name, profiles.path, db, display.name)
+                    : fmt::format("display \"{}\" has no calibration in {}: the session encodes for the scene's "
+                                  "nominal display model; measure it first with `atonlab calibrate measure --display "
+                                  "{}` into the lab's display-profile file (or --db {}; or import a .ti3)",
+                                  display.name, db, display.name, db));
             return out;
         }
     }
-    out.calibration = cal->id;
     out.display = display_model_of(*cal);
-    const std::string which = fmt::format("calibration {} of display \"{}\" (measured {})", cal->id.value,
-                                          cal->display_name, cal->measured_at);
-    if (const auto check = store->latest_calibration_check(cal->id); check && !check->passed)
+    const std::optional<store::CalibrationCheck> latest_check = source->latest_calibration_check(cal->id);
+    const std::string which =
+        source == store ? fmt::format("calibration {} of display \"{}\" (measured {})", cal->id.value,
+                                      cal->display_name, cal->measured_at)
+                        : fmt::format("calibration {} of display \"{}\" in the display-profile file {} (measured {})",
+                                      cal->id.value, cal->display_name, profiles.path, cal->measured_at);
+    if (source == store)
+        out.calibration = cal->id;
+    else
+        out.from_profiles = ProfileCopy{profiles.path, *cal, source->calibration_readings(cal->id), latest_check};
+    if (const auto& check = latest_check; check && !check->passed)
         out.warnings.push_back(
             fmt::format("the latest check of {} failed on {} ({}): recalibrate the display "
                         "with `atonlab calibrate measure`",
@@ -117,6 +139,38 @@ SessionCalibration session_calibration(const store::Store* store, const protocol
             which, cal->width_px, cal->height_px, cal->width_m, cal->viewing_distance_m, display.width_px,
             display.height_px, display.width_m, display.viewing_distance_m));
     return out;
+}
+
+store::CalibrationId copy_into_study(store::Store& study, const ProfileCopy& copy) {
+    const store::Calibration& c = copy.calibration;
+    std::optional<store::CalibrationId> id;
+    for (const store::Calibration& s : study.calibrations(c.display_name))
+        if (s.measured_at == c.measured_at && s.fit_json == c.fit_json && s.width_px == c.width_px &&
+            s.height_px == c.height_px && s.width_m == c.width_m && s.height_m == c.height_m &&
+            s.viewing_distance_m == c.viewing_distance_m) {
+            id = s.id;
+            break;
+        }
+    if (!id) {
+        store::Calibration copied = c;
+        copied.source = fmt::format("copied from the display-profile file {} (calibration {}): {}",
+                                    copy.profiles_file, c.id.value, c.source);
+        id = study.put_calibration(copied, copy.readings);
+    }
+    if (copy.latest_check) {
+        bool present = false;
+        for (const store::CalibrationCheck& k : study.calibration_checks(*id))
+            present = present || (k.checked_at == copy.latest_check->checked_at &&
+                                  k.results_json == copy.latest_check->results_json);
+        if (!present) {
+            store::CalibrationCheck k = *copy.latest_check;
+            k.calibration = *id;
+            k.source = fmt::format("copied from the display-profile file {} (check {}): {}", copy.profiles_file,
+                                   copy.latest_check->id.value, copy.latest_check->source);
+            study.put_calibration_check(k);
+        }
+    }
+    return *id;
 }
 
 void print_calibration_warnings(const SessionCalibration& calibration, bool quiet) {

@@ -49,6 +49,8 @@ int run_psf(const PsfOptions& options);
 struct RunOptions {
     std::string protocol;
     std::string db;
+    std::string profiles;      ///< --profiles: the display-profile file (default: profile_location.h)
+    bool no_profiles = false;  ///< --no-profiles: the study file's calibrations only
     bool model_observer = false;
     std::string observer;  ///< the observer code (--observer)
     std::string script;    ///< scripted answers (--script)

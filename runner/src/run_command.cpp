@@ -38,6 +38,12 @@ void add_run_command(CLI::App& app, RunOptions& o) {
         "observer, logging every trial to a study file");
     cmd->add_option("protocol", o.protocol, "Protocol file (TOML; see docs/protocol-file.md)")->required();
     cmd->add_option("--db", o.db, "Study file (SQLite; created if absent; see docs/store.md)")->required();
+    auto* profiles = cmd->add_option("--profiles", o.profiles,
+                                     "The lab's display-profile file to take the display's calibration from (default: "
+                                     "$ATONLAB_PROFILES, else $XDG_DATA_HOME/atonlab/profiles.sqlite if it exists)");
+    auto* no_profiles =
+        cmd->add_flag("--no-profiles", o.no_profiles, "Use only the calibrations the study file holds itself");
+    profiles->excludes(no_profiles);
     auto* model =
         cmd->add_flag("--model-observer", o.model_observer, "Answer with the model observer (observer code \"model\")");
     auto* script = cmd->add_option("--script", o.script,

@@ -40,6 +40,7 @@
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
 #include "calibration_policy.h"
+#include "profile_location.h"
 #include "session_display.h"
 
 namespace atonlab::runner {
@@ -1192,9 +1193,12 @@ int run_session(const RunOptions& o) {
 
     // --- The display's calibration (calibration_policy.h): warnings before the
     // session; a measured calibration's model encodes every frame.
-    const SessionCalibration calibration =
-        session_calibration(existing ? &*existing : nullptr, protocol.display,
-                            resumed ? existing->session(session).calibration : std::nullopt, utc_today(), o.db);
+    // The lab's display-profile file (profile_location.h); a resumed session keeps its own calibration.
+    const std::optional<st::Profiles> profiles = open_profiles_for_run(o.profiles, o.no_profiles || resumed);
+    const SessionCalibration calibration = session_calibration(
+        existing ? &*existing : nullptr, protocol.display,
+        resumed ? existing->session(session).calibration : std::nullopt, utc_today(), o.db,
+        profiles ? RunProfiles{&profiles->displays(), profiles->path().string()} : RunProfiles{});
     print_calibration_warnings(calibration, o.quiet);
     if (calibration.display) apply_display_model(display_scene, *calibration.display);
 
@@ -1233,8 +1237,9 @@ int run_session(const RunOptions& o) {
         start.protocol_text = protocol_text;
         start.protocol_name = std::filesystem::path(o.protocol).filename().string();
         start.seed = seed;
-        start.calibration =
-            calibration.calibration ? *calibration.calibration : record_display(store, display_scene, scene_file);
+        start.calibration = calibration.calibration     ? *calibration.calibration
+                            : calibration.from_profiles ? copy_into_study(store, *calibration.from_profiles)
+                                                        : record_display(store, display_scene, scene_file);
         session = store.begin_session(start);
     }
     // From here on a StoreError names the session to continue.

@@ -102,13 +102,39 @@ std::string luminance_key(const Measurement& m) {
 // ---------------------------------------------------------------------------
 // CSV.
 
-std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name) {
+const char* drive_scale_name(DriveScale scale) {
+    switch (scale) {
+        case DriveScale::bits8:
+            return "8bit";
+        case DriveScale::bits10:
+            return "10bit";
+        default:
+            return "fraction";
+    }
+}
+
+std::optional<DriveScale> drive_scale_from_name(std::string_view name) {
+    if (name == "fraction") return DriveScale::fraction;
+    if (name == "8bit") return DriveScale::bits8;
+    if (name == "10bit") return DriveScale::bits10;
+    return std::nullopt;
+}
+
+std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name,
+                                               const CalibrationFileOptions& options) {
     std::vector<Measurement> out;
     const auto lines = split_lines(text);
-    // Column index of level, channel, cd_m2; -1 until the header is read.
-    int col_level = -1, col_channel = -1, col_cd = -1;
+    // Column index of the level, channel and reading columns; -1 until the header is read.
+    int col_level = -1, col_channel = -1, col_cd = -1, col_x = -1, col_z = -1;
+    std::string level_key = "level", reading_key = "cd_m2";
+    std::optional<DriveScale> named_scale;  // from the level column's name
+    double reading_scale = 1.0;             // cd/m² per unit of the reading column
+    DriveScale scale = DriveScale::fraction;
     std::size_t n_columns = 0;
     int header_line = 0;
+    const char* header_help =
+        "the header names the drive level (level, level_fraction, level_8bit or level_10bit), channel, and the "
+        "reading (cd_m2, fL, or X,Y,Z)";
     for (std::size_t li = 0; li < lines.size(); ++li) {
         const int line_no = static_cast<int>(li) + 1;
         std::string_view line = lines[li];
@@ -132,25 +158,59 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
         if (header_line == 0) {
             header_line = line_no;
             n_columns = fields.size();
+            int col_y = -1;
             for (std::size_t i = 0; i < fields.size(); ++i) {
                 const auto name = fields[i].first;
-                int* slot = name == "level"     ? &col_level
-                            : name == "channel" ? &col_channel
-                            : name == "cd_m2"   ? &col_cd
-                                                : nullptr;
+                const bool level_name =
+                    name == "level" || name == "level_fraction" || name == "level_8bit" || name == "level_10bit";
+                const bool reading_name = name == "cd_m2" || name == "fL";
+                int* slot = level_name              ? &col_level
+                            : name == "channel"     ? &col_channel
+                            : reading_name          ? &col_cd
+                            : name == "X"           ? &col_x
+                            : name == "Y"           ? &col_y
+                            : name == "Z"           ? &col_z
+                                                    : nullptr;
                 if (slot == nullptr)
                     throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
-                                     "unknown column; the header must be `level,channel,cd_m2`");
+                                     fmt::format("unknown column; {}", header_help));
                 if (*slot >= 0)
                     throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
-                                     "this column appears twice in the header");
+                                     level_name || reading_name ? "a second drive-level or reading column"
+                                                                : "this column appears twice in the header");
                 *slot = static_cast<int>(i);
+                if (level_name) {
+                    level_key = std::string(name);
+                    if (name != "level") named_scale = drive_scale_from_name(name.substr(6));  // after "level_"
+                }
+                if (reading_name) {
+                    reading_key = std::string(name);
+                    // 1 fL = (1/π) cd/ft², 1 ft = 0.3048 m: 3.4262591 cd/m² (NIST SP 811, B.9).
+                    reading_scale = name == "fL" ? 3.4262590996353905 : 1.0;
+                }
+            }
+            const bool xyz = col_x >= 0 || col_y >= 0 || col_z >= 0;
+            if (xyz && (col_x < 0 || col_y < 0 || col_z < 0))
+                throw InputError(SourceLocation{file_name, line_no, 0, col_x < 0 ? "X" : col_y < 0 ? "Y" : "Z"},
+                                 "XYZ readings need all three columns X, Y and Z");
+            if (xyz && col_cd >= 0)
+                throw InputError(SourceLocation{file_name, line_no, 0, reading_key},
+                                 "the header has both X,Y,Z and a luminance column; give one reading per row");
+            if (xyz) {
+                col_cd = col_y;
+                reading_key = std::string("Y");  // moved in: GCC 12 misreads assigning a literal (-Wrestrict)
             }
             for (const auto& [slot, name] :
                  {std::pair{col_level, "level"}, {col_channel, "channel"}, {col_cd, "cd_m2"}})
                 if (slot < 0)
                     throw InputError(SourceLocation{file_name, line_no, 0, name},
-                                     "the header lacks this column; it must be `level,channel,cd_m2`");
+                                     fmt::format("the header lacks this column; {}", header_help));
+            if (named_scale && options.drive_scale && *named_scale != *options.drive_scale)
+                throw InputError(SourceLocation{file_name, line_no, fields[static_cast<std::size_t>(col_level)].second,
+                                                level_key},
+                                 fmt::format("the column says the drive levels are {} but --drive-scale says {}",
+                                             drive_scale_name(*named_scale), drive_scale_name(*options.drive_scale)));
+            scale = named_scale.value_or(options.drive_scale.value_or(DriveScale::fraction));
             continue;
         }
 
@@ -162,13 +222,32 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
         const auto& [channel_text, channel_col] = fields[static_cast<std::size_t>(col_channel)];
         const auto& [cd_text, cd_col] = fields[static_cast<std::size_t>(col_cd)];
 
-        const auto level = parse_number(level_text);
-        if (!level)
-            throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
+        const auto raw_level = parse_number(level_text);
+        if (!raw_level)
+            throw InputError(SourceLocation{file_name, line_no, level_col, level_key},
                              fmt::format("'{}' is not a number", level_text));
-        if (*level < 0.0 || *level > 1.0)
-            throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
-                             fmt::format("the drive level must be in [0, 1], not {}", *level));
+        double level_value = *raw_level;
+        if (scale == DriveScale::fraction) {
+            if (*raw_level < 0.0 || *raw_level > 1.0) {
+                const bool codes = !named_scale && !options.drive_scale && *raw_level > 1.0 &&
+                                   *raw_level == std::floor(*raw_level) && *raw_level <= 1023.0;
+                throw InputError(
+                    SourceLocation{file_name, line_no, level_col, level_key},
+                    codes ? fmt::format("the drive level {} is not a fraction in [0, 1]; drive levels are fractions "
+                                        "(0 to 1), 8-bit codes (0 to 255) or 10-bit codes (0 to 1023): name the "
+                                        "column level_8bit or level_10bit, or give --drive-scale 8bit or 10bit",
+                                        *raw_level)
+                          : fmt::format("the drive level must be a fraction in [0, 1], not {}", *raw_level));
+            }
+        } else {
+            const int max_code = scale == DriveScale::bits8 ? 255 : 1023;
+            if (*raw_level < 0.0 || *raw_level > max_code || *raw_level != std::floor(*raw_level))
+                throw InputError(SourceLocation{file_name, line_no, level_col, level_key},
+                                 fmt::format("a {} drive level is a whole code from 0 to {}, not {}",
+                                             drive_scale_name(scale), max_code, *raw_level));
+            level_value = *raw_level / max_code;
+        }
+        const double* level = &level_value;
         Channel channel = Channel::other;
         if (channel_text == "red") {
             channel = Channel::red;
@@ -180,7 +259,7 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
             channel = Channel::grey;
             const double want = channel_text == "white" ? 1.0 : 0.0;
             if (channel_text != "grey" && *level != want)
-                throw InputError(SourceLocation{file_name, line_no, level_col, "level"},
+                throw InputError(SourceLocation{file_name, line_no, level_col, level_key},
                                  fmt::format("a '{}' reading must have level {}, not {}", channel_text, want, *level));
         } else {
             throw InputError(
@@ -189,22 +268,37 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
         }
         const auto cd = parse_number(cd_text);
         if (!cd)
-            throw InputError(SourceLocation{file_name, line_no, cd_col, "cd_m2"},
+            throw InputError(SourceLocation{file_name, line_no, cd_col, reading_key},
                              fmt::format("'{}' is not a number", cd_text));
         if (*cd < 0.0)
-            throw InputError(SourceLocation{file_name, line_no, cd_col, "cd_m2"},
-                             fmt::format("a luminance cannot be negative ({} cd/m²)", *cd));
-        out.push_back(Measurement{*level, channel, *cd, line_no, rgb_of(channel, *level), file_name});
+            throw InputError(SourceLocation{file_name, line_no, cd_col, reading_key},
+                             fmt::format("a luminance cannot be negative ({} {})", *cd,
+                                         reading_key == "fL" ? "fL" : "cd/m²"));
+        Measurement m{*level, channel, *cd * reading_scale, line_no, rgb_of(channel, *level), file_name};
+        if (col_x >= 0) {
+            double xz[2] = {};
+            for (int k = 0; k < 2; ++k) {
+                const auto& [text_k, col_k] = fields[static_cast<std::size_t>(k == 0 ? col_x : col_z)];
+                const auto v = parse_number(text_k);
+                if (!v || *v < 0.0)
+                    throw InputError(SourceLocation{file_name, line_no, col_k, k == 0 ? "X" : "Z"},
+                                     fmt::format("'{}' is not a number >= 0", text_k));
+                xz[k] = *v;
+            }
+            m.xyz_cd_m2 = glm::dvec3(xz[0], *cd, xz[1]);
+        }
+        out.push_back(m);
     }
     if (header_line == 0)
         throw InputError(SourceLocation{file_name, 0, 0, ""},
-                         "the file is empty; it needs the header `level,channel,cd_m2`");
+                         fmt::format("the file is empty; {}", header_help));
     if (out.empty()) throw InputError(SourceLocation{file_name, header_line, 0, ""}, "the file has no measurements");
     return out;
 }
 
-std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path) {
-    return parse_calibration_csv(read_text(path), path.string());
+std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path,
+                                              const CalibrationFileOptions& options) {
+    return parse_calibration_csv(read_text(path), path.string(), options);
 }
 
 // ---------------------------------------------------------------------------
@@ -444,10 +538,17 @@ std::vector<Measurement> read_argyll_ti3(const std::filesystem::path& path) {
     return parse_argyll_ti3(read_text(path), path.string());
 }
 
-std::vector<Measurement> read_calibration_file(const std::filesystem::path& path) {
+std::vector<Measurement> read_calibration_file(const std::filesystem::path& path,
+                                               const CalibrationFileOptions& options) {
     const auto ext = path.extension().string();
-    if (ext == ".ti3") return read_argyll_ti3(path);
-    if (ext == ".csv") return read_calibration_csv(path);
+    if (ext == ".ti3") {
+        if (options.drive_scale)
+            throw InputError(SourceLocation{path.string(), 0, 0, ""},
+                             "--drive-scale applies to a CSV file; an ArgyllCMS .ti3 gives RGB_R, RGB_G, RGB_B in "
+                             "percent");
+        return read_argyll_ti3(path);
+    }
+    if (ext == ".csv") return read_calibration_csv(path, options);
     throw InputError(SourceLocation{path.string(), 0, 0, ""},
                      fmt::format("unknown calibration file type '{}'; use .csv or an ArgyllCMS .ti3", ext));
 }

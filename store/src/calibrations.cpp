@@ -179,3 +179,16 @@ Calibration Store::calibration(CalibrationId id) const {
 }
 
 }  // namespace atonlab::store
+
+namespace atonlab::store {
+
+std::vector<std::string> Store::display_names() const {
+    sql::Use s(impl_->db->cached(
+        "SELECT d.name FROM displays d WHERE EXISTS (SELECT 1 FROM calibrations c WHERE c.display_id = d.id) "
+        "ORDER BY d.name"));
+    std::vector<std::string> out;
+    while (s->step("list the displays")) out.push_back(s->text(0));
+    return out;
+}
+
+}  // namespace atonlab::store

@@ -1,4 +1,5 @@
-// Opening, checking, configuring and migrating a study file (see open.h).
+// Opening, checking, configuring and migrating a study file or a display-profile
+// file (see open.h).
 #include "open.h"
 
 #include <fmt/format.h>
@@ -27,24 +28,38 @@ std::string str(const fs::path& p) {
     throw StoreError(kind, path, message);
 }
 
+// What the messages call the file, its PRAGMA application_id, and what to do
+// with a damaged one (salvage reads sessions and trials: studies only).
+const char* noun(FileKind kind) {
+    return kind == FileKind::study ? "study file" : "display-profile file";
+}
+int app_id_of(FileKind kind) {
+    return kind == FileKind::study ? application_id : profile_application_id;
+}
+const char* damaged_hint(FileKind kind) {
+    return kind == FileKind::study
+               ? "restore it from a backup, or read what is left with atonlab analyze --salvage"
+               : "restore it from a backup, or measure the displays again into a new profile file";
+}
+
 // Checks SQLite would only answer with "unable to open database file".
-void check_path(const fs::path& path, Access access) {
+void check_path(const fs::path& path, Access access, FileKind kind) {
     std::error_code ec;
     if (access == Access::create_or_open) {
         const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
         if (!fs::exists(dir, ec)) {
             fail(StoreErrc::cannot_open, path,
-                 fmt::format("{}: cannot create the study file: the directory {} does not exist", str(path), str(dir)));
+                 fmt::format("{}: cannot create the {}: the directory {} does not exist", str(path), noun(kind), str(dir)));
         }
         if (!fs::is_directory(dir, ec)) {
             fail(StoreErrc::cannot_open, path,
-                 fmt::format("{}: cannot create the study file: {} is not a directory", str(path), str(dir)));
+                 fmt::format("{}: cannot create the {}: {} is not a directory", str(path), noun(kind), str(dir)));
         }
     } else if (!fs::exists(path, ec)) {
-        fail(StoreErrc::cannot_open, path, fmt::format("{}: cannot open the study file: it does not exist", str(path)));
+        fail(StoreErrc::cannot_open, path, fmt::format("{}: cannot open the {}: it does not exist", str(path), noun(kind)));
     }
     if (fs::is_directory(path, ec)) {
-        fail(StoreErrc::cannot_open, path, fmt::format("{}: cannot open the study file: it is a directory", str(path)));
+        fail(StoreErrc::cannot_open, path, fmt::format("{}: cannot open the {}: it is a directory", str(path), noun(kind)));
     }
 }
 
@@ -53,15 +68,15 @@ void check_path(const fs::path& path, Access access) {
 // new schema over it (a study file truncated to 1 byte would silently become a
 // new, empty study). 0 bytes is a new file (or one whose content is still in
 // its -wal file, which SQLite reads). The header layout: sqlite.org/fileformat2.html.
-void check_header(const fs::path& path) {
+void check_header(const fs::path& path, FileKind kind) {
     std::error_code ec;
     const auto size = fs::file_size(path, ec);
     if (ec || size == 0) return;  // absent (created by SQLite) or empty
     if (size < 100) {
         fail(StoreErrc::not_a_database, path,
-             fmt::format("{} is not an SQLite database, so not an atonlab study file: it is {} byte{} long, shorter "
+             fmt::format("{} is not an SQLite database, so not an atonlab {}: it is {} byte{} long, shorter "
                          "than SQLite's 100-byte header (a truncated file?); it was not changed",
-                         str(path), size, size == 1 ? "" : "s"));
+                         str(path), noun(kind), size, size == 1 ? "" : "s"));
     }
     std::array<unsigned char, 100> h{};
     std::ifstream in(path, std::ios::binary);
@@ -82,9 +97,8 @@ void check_header(const fs::path& path) {
         size < static_cast<std::uintmax_t>(pages) * static_cast<std::uintmax_t>(page)) {
         fail(StoreErrc::corrupt, path,
              fmt::format("{} is damaged: it is {} bytes long but its header says {} pages of {} bytes ({} bytes), "
-                         "so it was cut short; it was not changed (restore it from a backup, or read what is "
-                         "left with atonlab analyze --salvage)",
-                         str(path), size, pages, page, static_cast<std::uintmax_t>(pages) * page));
+                         "so it was cut short; it was not changed ({})",
+                         str(path), size, pages, page, static_cast<std::uintmax_t>(pages) * page, damaged_hint(kind)));
     }
 }
 
@@ -126,7 +140,7 @@ std::string one_line(const std::string& text) {
 // free list, every record's format, CHECK and NOT NULL constraints, and that
 // every index matches its table (quick_check skips that last part). Measured
 // at about 1 s for a 100 MB study (docs/store.md, "Opening").
-void verify(sql::Connection& db) {
+void verify(sql::Connection& db, FileKind kind) {
     std::string report;
     try {
         report = db.query_text("PRAGMA integrity_check(1)", "check the file's integrity");
@@ -140,9 +154,8 @@ void verify(sql::Connection& db) {
     }
     if (report == "ok") return;
     fail(StoreErrc::corrupt, db.path(),
-         fmt::format("{} is damaged (SQLite's integrity check: {}); it was not changed (restore it from a backup, "
-                     "or read what is left with atonlab analyze --salvage)",
-                     str(db.path()), one_line(report)));
+         fmt::format("{} is damaged (SQLite's integrity check: {}); it was not changed ({})", str(db.path()),
+                     one_line(report), damaged_hint(kind)));
 }
 
 // PRAGMA journal_mode = WAL needs an exclusive lock on a file not yet in WAL
@@ -169,7 +182,7 @@ std::string pragma(const char* name, std::int64_t value) {
     return fmt::format("PRAGMA {} = {}", name, value);
 }
 
-void migrate(sql::Connection& db, std::span<const Migration> steps) {
+void migrate(sql::Connection& db, std::span<const Migration> steps, FileKind kind) {
     const int latest = steps.empty() ? 0 : steps.back().to_version;
     sql::Transaction tx(db, sql::Transaction::Kind::write, "start the schema migration");
     // Read again under the write lock: another process may have migrated the
@@ -182,7 +195,7 @@ void migrate(sql::Connection& db, std::span<const Migration> steps) {
                          str(db.path()), version, latest));
     }
     // A study from before application_id was stamped gets it with its next writer.
-    const bool stamped = db.query_int("PRAGMA application_id", "read the file header") == application_id;
+    const bool stamped = db.query_int("PRAGMA application_id", "read the file header") == app_id_of(kind);
     if (version == latest && stamped) return;  // nothing to do; the transaction ends with no change
     for (const Migration& step : steps) {
         if (step.to_version <= version) continue;
@@ -205,7 +218,8 @@ void migrate(sql::Connection& db, std::span<const Migration> steps) {
         db.exec(pragma("user_version", step.to_version).c_str(), doing);
         version = step.to_version;
     }
-    db.exec(pragma("application_id", application_id).c_str(), "stamp the file as an atonlab study");
+    db.exec(pragma("application_id", app_id_of(kind)).c_str(),
+            kind == FileKind::study ? "stamp the file as an atonlab study" : "stamp the file as a display-profile file");
     tx.commit();
 }
 
@@ -213,8 +227,13 @@ void migrate(sql::Connection& db, std::span<const Migration> steps) {
 
 std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access, const StoreOptions& options,
                                             std::span<const Migration> steps) {
-    check_path(path, access);
-    check_header(path);
+    return open_file(path, access, options, steps, FileKind::study);
+}
+
+std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, const StoreOptions& options,
+                                           std::span<const Migration> steps, FileKind kind) {
+    check_path(path, access, kind);
+    check_header(path, kind);
     const int flags = access == Access::read_only       ? SQLITE_OPEN_READONLY
                       : access == Access::open_existing ? SQLITE_OPEN_READWRITE
                                                         : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
@@ -224,9 +243,9 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
     // SQLITE_OPEN_READWRITE silently falls back to read-only on a write-protected file.
     if (access != Access::read_only && sqlite3_db_readonly(db->get(), "main") == 1) {
         fail(StoreErrc::read_only, path,
-             fmt::format("{}: cannot open the study file for writing: the file is write-protected "
+             fmt::format("{}: cannot open the {} for writing: the file is write-protected "
                          "(it can still be opened read-only)",
-                         str(path)));
+                         str(path), noun(kind)));
     }
     sqlite3_busy_timeout(db->get(), options.busy_timeout_ms);
     db->exec("PRAGMA foreign_keys = ON", "turn on foreign keys");
@@ -251,33 +270,42 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
     } catch (const StoreError& e) {
         if (e.kind() == StoreErrc::not_a_database) {
             fail(StoreErrc::not_a_database, path,
-                 fmt::format("{} is not an SQLite database, so not an atonlab study file (SQLite: {}); it was not "
+                 fmt::format("{} is not an SQLite database, so not an atonlab {} (SQLite: {}); it was not "
                              "changed",
-                             str(path), sqlite3_errstr(e.sqlite_code())));
+                             str(path), noun(kind), sqlite3_errstr(e.sqlite_code())));
         }
         // A lock, the OS or permissions failing is not damage; SQLite's
         // "malformed" or "unsupported file format" is.
         if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other) throw;
         fail(StoreErrc::corrupt, path,
-             fmt::format("{} is damaged: SQLite cannot read its header or schema ({}, {}); it was not changed "
-                         "(restore it from a backup, or read what is left with atonlab analyze --salvage)",
-                         str(path), sqlite3_errstr(e.sqlite_code()), sql::code_name(e.sqlite_code())));
+             fmt::format("{} is damaged: SQLite cannot read its header or schema ({}, {}); it was not changed ({})",
+                         str(path), sqlite3_errstr(e.sqlite_code()), sql::code_name(e.sqlite_code()),
+                         damaged_hint(kind)));
     }
     const int latest = steps.empty() ? 0 : steps.back().to_version;
     const bool empty = app_id == 0 && version == 0 && objects == 0;
-    if (app_id != application_id) {
+    if (app_id != app_id_of(kind)) {
+        // The other kind of atonlab file: say which option takes it.
+        if (app_id == app_id_of(FileKind::study) || app_id == app_id_of(FileKind::profiles)) {
+            const bool is_study = app_id == app_id_of(FileKind::study);
+            fail(StoreErrc::not_a_study, path,
+                 fmt::format("{} is an atonlab {}, not a {} ({}); it was not changed", str(path),
+                             is_study ? "study file" : "display-profile file", noun(kind),
+                             is_study ? "a study file is given with --db" : "a display-profile file is given with "
+                                                                             "--profiles"));
+        }
         // A study written before application_id was stamped would carry no id but
         // the study's own tables and a schema version: still a study.
-        const bool unstamped_study = app_id == 0 && version >= 1 && study_tables;
+        const bool unstamped_study = kind == FileKind::study && app_id == 0 && version >= 1 && study_tables;
         if (!empty && !unstamped_study) {
             fail(StoreErrc::not_a_study, path,
-                 fmt::format("{} is an SQLite database but not an atonlab study file (application_id {}, "
+                 fmt::format("{} is an SQLite database but not an atonlab {} (application_id {}, "
                              "{} schema objects); it was not changed",
-                             str(path), app_id, objects));
+                             str(path), noun(kind), app_id, objects));
         }
         if (empty && access == Access::read_only) {
             fail(StoreErrc::not_a_study, path,
-                 fmt::format("{} is an empty database, not yet an atonlab study file", str(path)));
+                 fmt::format("{} is an empty database, not yet an atonlab {}", str(path), noun(kind)));
         }
     }
     if (version > latest) {
@@ -287,7 +315,7 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
                          str(path), version, latest));
     }
 
-    if (!empty && options.verify) verify(*db);
+    if (!empty && options.verify) verify(*db, kind);
 
     if (access == Access::read_only) {
         if (version < latest) {
@@ -316,7 +344,7 @@ std::unique_ptr<sql::Connection> open_study(const fs::path& path, Access access,
         db->exec(pragma("max_page_count", std::max<std::int64_t>(1, options.max_size_bytes / page)).c_str(),
                  "limit the file size");
     }
-    migrate(*db, steps);
+    migrate(*db, steps, kind);
     return db;
 }
 

@@ -12,7 +12,7 @@ namespace atonlab::store {
 void Store::Impl::require_writable(std::string_view doing) const {
     if (read_only) {
         throw StoreError(StoreErrc::read_only, path(),
-                         fmt::format("{}: cannot {}: the study file was opened read-only", path().string(), doing));
+                         fmt::format("{}: cannot {}: the {} was opened read-only", path().string(), doing, noun));
     }
 }
 

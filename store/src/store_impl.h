@@ -18,6 +18,8 @@ namespace atonlab::store {
 struct Store::Impl {
     std::unique_ptr<sql::Connection> db;
     bool read_only = false;
+    /// What messages call the file: "study file" or "display-profile file".
+    const char* noun = "study file";
 
     const std::filesystem::path& path() const { return db->path(); }
 

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "atonlab/protocols/protocol_file.h"
@@ -82,7 +83,8 @@ inline double phi(double z) {
 /// session's id.
 inline store::SessionId run_simulated(const std::filesystem::path& db, const std::string& protocol_text,
                                       const SimObserver& obs, std::uint64_t seed = 7, bool finish = true,
-                                      std::size_t max_trials = 1u << 30) {
+                                      std::size_t max_trials = 1u << 30,
+                                      std::optional<store::CalibrationId> calibration = std::nullopt) {
     namespace p = atonlab::protocols;
     const p::Protocol protocol = p::parse_protocol(protocol_text, "sim.toml");
     p::Schedule schedule(protocol, seed);
@@ -92,6 +94,7 @@ inline store::SessionId run_simulated(const std::filesystem::path& db, const std
     start.protocol_text = protocol_text;
     start.protocol_name = "sim.toml";
     start.seed = seed;
+    start.calibration = calibration;
     const store::SessionId session = s.begin_session(start);
     p::Rng rng(obs.seed);
     std::size_t n = 0;

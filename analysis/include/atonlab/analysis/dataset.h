@@ -22,6 +22,8 @@
 #include <string_view>
 #include <vector>
 
+#include "atonlab/analysis/calibration_drift.h"
+
 namespace atonlab::analysis {
 
 /// Bad input for an analysis (a CSV without a required column, a value that is
@@ -140,6 +142,10 @@ struct CalibrationInfo {
     std::string how;       ///< the row's `source`: "measured", "imported FILE", ...
     std::string measured_at;
     std::vector<CalibrationPoint> readings;  ///< in measuring order; empty for a nominal model
+    /// Every check of this display's calibrations in the same file, oldest
+    /// first: the copies `atonlab run` stores with the calibration it used
+    /// (calibration_drift.h). Empty when none was checked.
+    std::vector<DriftPoint> drift;
 };
 
 /// A stored stimulus snapshot (an EXR) of one condition in one session.

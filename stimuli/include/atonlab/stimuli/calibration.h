@@ -36,11 +36,32 @@ struct Measurement {
 // Readers. Errors are InputError with the file, the line and the column or
 // field name (SourceLocation::key).
 
-/// CSV with the header `level,channel,cd_m2` (any order). channel is red,
-/// green, blue, grey, white (= grey at level 1) or black (= grey at level 0);
-/// level in [0, 1]; cd_m2 >= 0. `#` starts a comment; blank lines are skipped.
-std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name);
-std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path);
+/// How a CSV file's drive levels are written: fractions in [0, 1], 8-bit codes
+/// 0..255 (level = code / 255) or 10-bit codes 0..1023 (level = code / 1023).
+enum class DriveScale { fraction, bits8, bits10 };
+
+/// "fraction", "8bit", "10bit" (the words of `--drive-scale` and docs/calibration.md).
+const char* drive_scale_name(DriveScale scale);
+/// The inverse of drive_scale_name; std::nullopt for any other word.
+std::optional<DriveScale> drive_scale_from_name(std::string_view name);
+
+struct CalibrationFileOptions {
+    /// The scale of a CSV `level` column (`--drive-scale`); unset: fraction. A
+    /// column named level_fraction, level_8bit or level_10bit names its own
+    /// scale, and a different one here is refused.
+    std::optional<DriveScale> drive_scale;
+};
+
+/// CSV with a header naming, in any order: the drive level (`level`, or
+/// `level_fraction`, `level_8bit`, `level_10bit` naming the scale), `channel`,
+/// and the reading: `cd_m2`, `fL` (foot-lamberts, 1 fL = 3.426259 cd/m²) or
+/// `X,Y,Z` (CIE 1931 XYZ in cd/m²; Y is the luminance, X and Z are kept).
+/// channel is red, green, blue, grey, white (= grey at full drive) or black (=
+/// grey at level 0); readings >= 0. `#` starts a comment; blank lines are skipped.
+std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name,
+                                               const CalibrationFileOptions& options = {});
+std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path,
+                                              const CalibrationFileOptions& options = {});
 
 /// ArgyllCMS .ti3 (CGATS text, identifier CTI3) as written by dispread: fields
 /// RGB_R RGB_G RGB_B (0..100) and XYZ_Y. If NORMALIZED_TO_Y_100 is YES the XYZ
@@ -52,7 +73,9 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
 std::vector<Measurement> read_argyll_ti3(const std::filesystem::path& path);
 
 /// Reads a .csv or .ti3 file, choosing by extension.
-std::vector<Measurement> read_calibration_file(const std::filesystem::path& path);
+/// options.drive_scale applies to a CSV only (a .ti3 gives RGB in percent).
+std::vector<Measurement> read_calibration_file(const std::filesystem::path& path,
+                                               const CalibrationFileOptions& options = {});
 
 // ---------------------------------------------------------------------------
 // Checks and fits.

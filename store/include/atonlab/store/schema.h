@@ -1,6 +1,7 @@
 #pragma once
 // The study file's schema as an ordered list of migrations (PRAGMA user_version
-// counts the ones applied). The SQL itself lives in store/src/schema.cpp.
+// counts the ones applied). The SQL itself lives in store/src/schema.cpp; the
+// display-profile file's, in store/src/profile_schema.cpp.
 #include <filesystem>
 #include <span>
 #include <string_view>
@@ -24,6 +25,16 @@ int schema_version() noexcept;
 
 /// PRAGMA application_id of every atonlab study file: 'ATON' as a big-endian int.
 inline constexpr int application_id = 0x41544F4E;
+
+/// The display-profile file's migrations (profiles.h; SQL in
+/// store/src/profile_schema.cpp), in order, to_version 1, 2, ...
+std::span<const Migration> profile_migrations() noexcept;
+
+/// The display-profile schema version this code writes.
+int profile_schema_version() noexcept;
+
+/// PRAGMA application_id of every display-profile file: 'ATPF' as a big-endian int.
+inline constexpr int profile_application_id = 0x41545046;
 
 namespace detail {
 /// Opens `path` (creating it if missing) and applies `steps` above the file's

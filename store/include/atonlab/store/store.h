@@ -86,6 +86,8 @@ public:
     std::optional<CalibrationCheck> latest_calibration_check(CalibrationId id) const;
     /// Every check of the calibration, latest first.
     std::vector<CalibrationCheck> calibration_checks(CalibrationId id) const;
+    /// The names of the displays the file holds calibrations of, in name order.
+    std::vector<std::string> display_names() const;
 
     // --- Sessions -----------------------------------------------------------
     /// Records the observer and the protocol (once per text hash) if new and
@@ -141,6 +143,7 @@ public:
     struct Impl;
 
 private:
+    friend class Profiles;  // a display-profile file shares the display methods (profiles.h)
     explicit Store(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
