@@ -61,6 +61,7 @@ CREATE TABLE calibration_readings (
     xyz_x_cd_m2     REAL,
     xyz_z_cd_m2     REAL,
     source_line     INTEGER CHECK (source_line > 0),
+    transcript      TEXT,  -- what the instrument said; NULL when typed or imported (the study file's version 3)
     CHECK ((code IS NULL) = (bits IS NULL)),
     CHECK ((xyz_x_cd_m2 IS NULL) = (xyz_z_cd_m2 IS NULL)),
     UNIQUE (calibration_id, seq)
