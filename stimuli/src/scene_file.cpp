@@ -82,7 +82,8 @@ constexpr std::string_view kLightKeys[] = {
     "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
     "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
     "sectors", "rhythm",     "rhythm_phase_s", "ramp_s"};
-constexpr std::string_view kDiscKeys[] = {"name", "position_m", "diameter_deg", "luminance_cd_m2", "colour", "xy", "spd"};
+constexpr std::string_view kDiscKeys[] = {"name",   "position_m", "diameter_deg", "luminance_cd_m2",
+                                          "colour", "xy",         "spd"};
 
 /// Keys of which a table may hold at most one. An override that sets one of
 /// them removes the others from its table, so "--set light.buoy.colour=red"

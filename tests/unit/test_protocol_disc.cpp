@@ -37,7 +37,9 @@ level_key = "disc.plain.luminance_cd_m2"
 procedure = { kind = "constant-stimuli", levels = [1.0, 1.5], repetitions = 2 }
 )";
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) {
+    return std::find(v.begin(), v.end(), s) != v.end();
+}
 
 TEST(ProtocolDisc, SideBySideMovesTheDiscAndSetsItsLuminance) {
     const Protocol p = parse_protocol(kProtocol, "inline.toml");
