@@ -378,7 +378,7 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
         if (condition.level_on == role) f.overrides.push_back(level_override);
         return f;
     };
-    auto light_of = [&](Role role) { return role == Role::Test ? condition.test_light : condition.reference_light; };
+    auto light_of = [&](Role role) { return condition.judged(role); };
 
     switch (condition.presentation) {
         case Presentation::Single:
@@ -406,7 +406,9 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
             const std::array<double, 3> right = condition.right_position_m.value_or(std::array<double, 3>{});
             f.overrides.push_back(
                 fmt::format("light.{}.position_m={}", condition.test_light, position_text(test_first ? left : right)));
-            f.overrides.push_back(fmt::format("light.{}.position_m={}", condition.reference_light,
+            // A reference disc moves like a light (scene.h Disc: its centre's direction).
+            const char* reference_table = condition.reference_disc.empty() ? "light" : "disc";
+            f.overrides.push_back(fmt::format("{}.{}.position_m={}", reference_table, condition.judged(Role::Reference),
                                               position_text(test_first ? right : left)));
             s.frames.push_back(std::move(f));
             const Role left_role = test_first ? Role::Test : Role::Reference;

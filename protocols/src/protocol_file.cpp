@@ -46,7 +46,7 @@ constexpr std::string_view kActionNames[] = {"left",    "right",     "yes",     
 constexpr std::string_view kConditionKeys[] = {
     "task",        "presentation", "prompt", "set",        "test_set",        "reference_set",   "level_key",
     "level_scale", "level_on",     "choice", "test_light", "reference_light", "left_position_m", "right_position_m",
-    "procedure"};
+    "procedure",   "reference_disc"};
 constexpr std::string_view kBlockOwnKeys[] = {"name",       "adaptation_s", "repetitions",
                                               "interleave", "instructions", "condition"};
 
@@ -806,6 +806,14 @@ private:
 
         c.test_light = r.string("test_light").value_or("");
         c.reference_light = r.string("reference_light").value_or("");
+        c.reference_disc = r.string("reference_disc").value_or("");
+        if (!c.reference_disc.empty() && !c.reference_light.empty())
+            r.fail(*r.find("reference_disc"),
+                   fmt::format("the reference is one thing: give reference_light (\"{}\") or reference_disc (\"{}\"), "
+                               "not both.",
+                               c.reference_light, c.reference_disc));
+        if (!c.reference_disc.empty() && c.presentation == Presentation::Single)
+            r.fail(*r.find("reference_disc"), "a single presentation has no reference: reference_disc is not used.");
         if (auto f = r.find("left_position_m"))
             c.left_position_m = doc_.vec3(f->node, f->key, "left_position_m", r.context());
         if (auto f = r.find("right_position_m"))
@@ -813,7 +821,8 @@ private:
         if (c.presentation == Presentation::SideBySide) {
             const std::string_view what = "side-by-side needs both lights and both positions";
             if (c.test_light.empty()) r.missing("test_light", what);
-            if (c.reference_light.empty()) r.missing("reference_light", what);
+            if (c.reference_light.empty() && c.reference_disc.empty())
+                r.missing("reference_light", "side-by-side needs both lights (or a reference_disc) and both positions");
             if (c.test_light == c.reference_light)
                 r.fail(*r.find("reference_light"),
                        fmt::format("side-by-side needs two different lights, got \"{}\" twice.", c.test_light));

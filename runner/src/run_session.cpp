@@ -142,6 +142,20 @@ const s::Light* find_light(const s::Scene& scene, std::string_view name) {
     return nullptr;
 }
 
+/// The scene's disc (an extended reference, scene.h Disc) called `name`, or nullptr.
+const s::Disc* find_disc(const s::Scene& scene, std::string_view name) {
+    for (const s::Disc& d : scene.discs)
+        if (d.name == name) return &d;
+    return nullptr;
+}
+
+/// The override that takes a judged light or disc out of a frame: a light dark,
+/// a disc of zero diameter (the background shows where it was).
+std::string judged_off_override(const s::Scene& scene, const std::string& name) {
+    if (find_disc(scene, name) && !find_light(scene, name)) return fmt::format("disc.{}.diameter_deg=0", name);
+    return fmt::format("light.{}.intensity_cd=0", name);
+}
+
 /// The moment within [0, interval_s] at which the judged lights are brightest
 /// (their rhythms' summed level), so that a model observer looking at one
 /// frame sees, e.g., the flash that the interval holds. Rhythms are piecewise
@@ -310,6 +324,14 @@ std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::st
     return names;
 }
 
+std::vector<std::string> StimulusRenderer::all_off(const std::vector<std::string>& overrides) const {
+    const s::Scene sc = scene(overrides);
+    std::vector<std::string> off;
+    for (const s::Light& l : sc.lights) off.push_back(fmt::format("light.{}.intensity_cd=0", l.name));
+    for (const s::Disc& d : sc.discs) off.push_back(fmt::format("disc.{}.diameter_deg=0", d.name));
+    return off;
+}
+
 const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame, const std::vector<std::string>& lights,
                                                           double time_s) {
     // The frame with every judged light off, at the same moment: what the
@@ -317,8 +339,9 @@ const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame,
     // comparison it is the same for every level of a condition, so a few
     // cached frames serve a whole session.
     p::Frame off = frame;
+    const s::Scene on = scene(frame.overrides);
     for (const std::string& name : lights)
-        if (!name.empty()) off.overrides.push_back(fmt::format("light.{}.intensity_cd=0", name));
+        if (!name.empty()) off.overrides.push_back(judged_off_override(on, name));
     const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
     for (auto it = background_lru_.begin(); it != background_lru_.end(); ++it)
         if (it->first == key) {
@@ -392,10 +415,13 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
             std::size_t index = sc.lights.size();
             for (std::size_t i = 0; i < sc.lights.size() && index == sc.lights.size(); ++i)
                 if (sc.lights[i].name == name) index = i;
+            const s::Disc* disc = index == sc.lights.size() ? find_disc(sc, name) : nullptr;
             if (index < draws.size() && draws[index].area_px2 > 0) {
                 centre_win = draws[index].centre_px;
-            } else if (index < sc.lights.size()) {
-                const glm::dvec3 v = proj.view_from_world(sc.lights[index].position_m - proj.eye_position_m);
+            } else if (index < sc.lights.size() || disc) {
+                // A disc's centre: the same pinhole (its outline is a circle of visual angle around it).
+                const glm::dvec3 v = proj.view_from_world((disc ? disc->position_m : sc.lights[index].position_m) -
+                                                          proj.eye_position_m);
                 if (v.z < 0) {
                     centre_win = glm::dvec2(0.5 * proj.width_px, 0.5 * proj.height_px) +
                                  proj.focal_px * glm::dvec2(v.x, v.y) / -v.z;
@@ -517,7 +543,18 @@ void check_stimulus(const p::Protocol& protocol, const std::string& scene_text, 
     for (std::size_t f = 0; f < stim.frames.size(); ++f) {
         const s::Scene scene = condition_scene(scene_text, scene_file, protocol, c, stim.frames[f]);
         for (const p::StimulusView& v : stim.views) {
-            if (v.frame != f || v.light.empty() || find_light(scene, v.light)) continue;
+            if (v.frame != f || v.light.empty()) continue;
+            if (v.role == p::Role::Reference && !c.reference_disc.empty()) {
+                if (find_disc(scene, v.light)) continue;
+                std::string names;
+                for (const s::Disc& d : scene.discs) names += (names.empty() ? "\"" : ", \"") + d.name + "\"";
+                throw InputError(SourceLocation{protocol.file, c.line, 0, "reference_disc"},
+                                 fmt::format("in condition \"{}\", the reference disc \"{}\" is not a [[disc]] of the "
+                                             "scene {} (its discs: {}).",
+                                             c.name, v.light, scene_file.filename().string(),
+                                             names.empty() ? "none" : names));
+            }
+            if (find_light(scene, v.light)) continue;
             std::string names;
             for (const s::Light& l : scene.lights) names += (names.empty() ? "\"" : ", \"") + l.name + "\"";
             throw InputError(

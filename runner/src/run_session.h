@@ -89,6 +89,9 @@ public:
     void present(int x, int y) const;
     /// The names of the scene's lights (the template with the display).
     std::vector<std::string> light_names(const std::vector<std::string>& overrides) const;
+    /// The overrides that take every light and disc of the scene out (lights
+    /// dark, discs of zero diameter): what surrounds the stimuli.
+    std::vector<std::string> all_off(const std::vector<std::string>& overrides) const;
 
     /// Encode every frame for this display model instead of the scene's (the
     /// display's measured calibration: calibration_policy.h). Set before the first frame.

@@ -70,7 +70,7 @@ SessionDisplay::SessionDisplay(Presenter& presenter, StimulusRenderer& renderer,
     // Sized in degrees of visual angle, so it reads the same at any resolution;
     // never below 12 px, where DejaVu Sans stops being legible.
     text_px_ = std::max(12.0, protocol.screens.text_size_deg * pixels_per_degree_);
-    light_names_ = renderer.light_names(protocol.display_overrides());
+    all_off_ = renderer.all_off(protocol.display_overrides());
     // Headless the virtual clock itself moves there, so that its flips stay on
     // the k / rate grid of the session clock.
     set_clock(clock_origin_s);
@@ -141,7 +141,7 @@ Screen SessionDisplay::background_screen(const p::Condition& c) {
     p::Frame bg;
     bg.overrides = protocol_.display_overrides();
     for (const p::Override& o : c.set) bg.overrides.push_back(o.text());
-    for (const std::string& name : light_names_) bg.overrides.push_back(fmt::format("light.{}.intensity_cd=0", name));
+    for (const std::string& off : all_off_) bg.overrides.push_back(off);
     sc.picture = renderer_.codes(bg, {});
     return sc;
 }

@@ -15,6 +15,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "atonlab/stimuli/disc.h"
 #include "atonlab/stimuli/display_threshold.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -83,6 +84,8 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
 struct FrameRenderer::Impl {
     gl::Program background = gl::Program::build(
         {{gl::ShaderStage::vertex, "fullscreen.vert"}, {gl::ShaderStage::fragment, "background.frag"}});
+    gl::Program disc = gl::Program::build(
+        {{gl::ShaderStage::vertex, "fullscreen.vert"}, {gl::ShaderStage::fragment, "disc.frag"}});
     gl::Program light_eval = gl::Program::build({{gl::ShaderStage::compute, "light_eval.comp"}});
     gl::Program light_direct = gl::Program::build(
         {{gl::ShaderStage::vertex, "light_direct.vert"}, {gl::ShaderStage::fragment, "light_direct.frag"}});
@@ -145,6 +148,9 @@ std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const
     const Environment& env = scene.environment;
     double floor_cd_m2 = std::max(0.0, env.luminance_cd_m2);
     if (env.background == Background::sky_sea) floor_cd_m2 *= std::clamp(env.sea_reflectance_f0, 0.0, 1.0);
+    // A disc darker than the background is a darker surround for a light over it.
+    for (const Disc& d : scene.discs)
+        if (d.diameter_deg > 0.0) floor_cd_m2 = std::min(floor_cd_m2, std::max(0.0, d.luminance_cd_m2));
     const double omega_min = pixel_solid_angle_sr(-0.5 * P.width_px, -0.5 * P.height_px, P.focal_px);
 
     std::string key;
@@ -254,6 +260,30 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     m.vao.bind();
     begin(0);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    // 1b. Discs (scene.h Disc): uniform patches over the background, under the
+    // lights; colour only, the depth target keeps the background's depth.
+    if (!scene.discs.empty()) {
+        const GLenum only_colour[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+        glNamedFramebufferDrawBuffers(m.fbo.id(), 2, only_colour);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+        glBlendEquation(GL_FUNC_ADD);
+        m.disc.set("principal_px", 0.5f * w, 0.5f * h);
+        m.disc.set("focal_px", f);
+        for (const Disc& d : scene.discs) {
+            const glm::dvec3 c = disc_direction_view(d, P);
+            if (!(d.diameter_deg > 0.0) || glm::length(c) == 0.0) continue;
+            const glm::dvec3 rgb = d.rgb_per_cd_m2 * d.luminance_cd_m2 * m.pre_exposure;
+            m.disc.set("centre_view", static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
+            m.disc.set("radius_rad", static_cast<float>(0.5 * d.diameter_deg * std::numbers::pi / 180.0));
+            m.disc.set("rgb", static_cast<float>(rgb.r), static_cast<float>(rgb.g), static_cast<float>(rgb.b));
+            m.disc.use();
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        glDisable(GL_BLEND);
+        const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glNamedFramebufferDrawBuffers(m.fbo.id(), 2, both);
+    }
     end(0);
 
     // 2. Per-light evaluation, projection and occlusion (compute).

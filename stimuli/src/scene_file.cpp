@@ -52,7 +52,8 @@ constexpr std::string_view kSetPrefix = "--set ";  // source path of an override
 
 using KeyList = std::span<const std::string_view>;
 
-constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light"};
+constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light",
+                                           "disc"};
 constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",     "viewing_distance_m",
                                              "peak_cd_m2", "black_cd_m2", "transfer",    "calibration",
                                              "bits",       "dither",      "dither_seed"};
@@ -81,6 +82,8 @@ constexpr std::string_view kLightKeys[] = {
     "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
     "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
     "sectors", "rhythm",     "rhythm_phase_s", "ramp_s"};
+constexpr std::string_view kDiscKeys[] = {"name",   "position_m", "diameter_deg", "luminance_cd_m2",
+                                          "colour", "xy",         "spd"};
 
 /// Keys of which a table may hold at most one. An override that sets one of
 /// them removes the others from its table, so "--set light.buoy.colour=red"
@@ -1062,6 +1065,42 @@ struct SceneBuilder {
         }
     }
 
+    /// One [[disc]]: a uniform patch of luminance (scene.h Disc). Its name is
+    /// unique among lights and discs, so that a protocol's view names one thing.
+    void read_disc(const toml::node& node, std::size_t index) {
+        const std::string path = fmt::format("disc[{}]", index);
+        if (!node.is_table())
+            doc.fail(&node, path, fmt::format("each disc must be a [[disc]] table, got {}.", type_phrase(node.type())));
+        Section s(doc, *node.as_table(), path, fmt::format("[[disc]] number {} ({})", index + 1, path));
+        s.allow(kDiscKeys);
+        Disc disc;
+        disc.name = s.string("name").value_or(fmt::format("disc{}", index));
+        if (disc.name.empty()) s.fail(s.get("name"), "name", "a disc's name must not be empty.");
+        s.set_context(fmt::format("in disc \"{}\", ", text::echo(disc.name)));
+        s.set_title(fmt::format("[[disc]] \"{}\" ({})", text::echo(disc.name), path));
+        auto position = s.vec3("position_m");
+        if (!position) s.missing("position_m", "a point [x, y, z] in metres on the line of sight to the disc's centre");
+        disc.position_m = *position;
+        disc.diameter_deg = s.required_number("diameter_deg", "the disc's angular diameter in degrees");
+        s.within("diameter_deg", disc.diameter_deg, 0.0, 90.0);
+        disc.luminance_cd_m2 = s.required_number("luminance_cd_m2", "the disc's luminance in cd/m²");
+        s.at_least("luminance_cd_m2", disc.luminance_cd_m2, 0.0);
+        std::vector<std::string_view> given;
+        for (std::string_view k : {"colour", "xy", "spd"})
+            if (s.has(k)) given.push_back(k);
+        if (given.size() > 1)
+            s.fail(s.get(given[1]), given[1],
+                   fmt::format("give only one of colour, xy and spd; this disc has {}.", join(given)));
+        disc.rgb_per_cd_m2 = read_colour(s);
+        const toml::node* at = s.has("name") ? s.get("name") : &s.table();
+        if (auto it = names.find(disc.name); it != names.end())
+            s.fail(at, "name",
+                   fmt::format("the name \"{}\" is already used by {}; lights and discs need names of their own.",
+                               text::echo(disc.name), it->second));
+        names.emplace(disc.name, path);
+        scene.discs.push_back(std::move(disc));
+    }
+
     glm::dvec3 chart_letter_rgb(const Section& s, const std::string& letter, const std::string& rhythm_text) {
         if (auto name = iala_colour_from_chart_letter(letter))
             if (auto rgb = iala_colour_rgb(*name)) return *rgb;
@@ -1115,6 +1154,17 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
     doc.fail(node_in("display", "viewing_distance_m"), "display.viewing_distance_m", message);
 }
 
+void read_discs(const Section& root, SceneBuilder& builder) {
+    const toml::node* discs = root.get("disc");
+    if (discs == nullptr) return;
+    if (!discs->is_array())
+        root.fail(discs, "disc",
+                  fmt::format("expected an array of [[disc]] tables, got {}; write [[disc]], not [disc].",
+                              type_phrase(discs->type())));
+    const toml::array& a = *discs->as_array();
+    for (std::size_t i = 0; i < a.size(); ++i) builder.read_disc(*a.get(i), i);
+}
+
 Scene build_scene(const Document& doc, const toml::table& root_table) {
     Section root(doc, root_table, "", "the scene");
     {
@@ -1145,15 +1195,16 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     check_billboard(doc, root, scene);
     const Profiles profiles = read_profiles(doc, root);
 
+    SceneBuilder builder{doc, scene, profiles, {}};
     if (const toml::node* lights = root.get("light")) {
         if (!lights->is_array())
             root.fail(lights, "light",
                       fmt::format("expected an array of [[light]] tables, got {}; write [[light]], not [light].",
                                   type_phrase(lights->type())));
-        SceneBuilder builder{doc, scene, profiles, {}};
         const toml::array& a = *lights->as_array();
         for (std::size_t i = 0; i < a.size(); ++i) builder.read_light(*a.get(i), i);
     }
+    read_discs(root, builder);
     return scene;
 }
 
@@ -1223,58 +1274,61 @@ toml::table& table_for_override(Document& doc, toml::table& parent, std::string_
     return *n->as_table();
 }
 
-/// The [[light]] table an override addresses: "light[INDEX].key" or
-/// "light.NAME.key" (NAME may contain dots; the key after the last dot never does).
-std::pair<toml::table*, std::string> light_for_override(const Document& doc, toml::table& root, const SceneOverride& o,
-                                                        std::string& key) {
-    toml::node* node = root.get("light");
+/// The [[light]] or [[disc]] table (`array`: "light", "disc") an override
+/// addresses: "ARRAY[INDEX].key" or "ARRAY.NAME.key" (NAME may contain dots; the
+/// key after the last dot never does).
+std::pair<toml::table*, std::string> element_for_override(const Document& doc, toml::table& root,
+                                                          const SceneOverride& o, std::string& key,
+                                                          const std::string& array) {
+    const std::string written = fmt::format("a {0} key is written {0}.NAME.KEY or {0}[INDEX].KEY.", array);
+    toml::node* node = root.get(array);
     if (node == nullptr || !node->is_array() || node->as_array()->empty())
-        override_error(o.key, "the scene has no [[light]] tables to override.");
-    toml::array& lights = *node->as_array();
+        override_error(o.key, fmt::format("the scene has no [[{}]] tables to override.", array));
+    toml::array& elements = *node->as_array();
     const std::string& k = o.key;
     const auto last_dot = k.rfind('.');
-    if (last_dot == std::string::npos || last_dot == k.size() - 1)
-        override_error(o.key, "a light key is written light.NAME.KEY or light[INDEX].KEY.");
+    if (last_dot == std::string::npos || last_dot == k.size() - 1) override_error(o.key, written);
     key = k.substr(last_dot + 1);
 
     std::size_t index = 0;
-    if (k.starts_with("light[")) {
+    const std::size_t skip = array.size() + 1;  // "light[" or "light."
+    if (k.starts_with(array + "[")) {
         const auto close = k.find(']');
-        const std::string digits = k.substr(6, close == std::string::npos ? 0 : close - 6);
+        const std::string digits = k.substr(skip, close == std::string::npos ? 0 : close - skip);
         if (close == std::string::npos || close + 1 != last_dot || digits.empty() ||
             !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
             digits.size() > 6)
-            override_error(o.key, "a light key is written light.NAME.KEY or light[INDEX].KEY.");
+            override_error(o.key, written);
         index = static_cast<std::size_t>(std::stoul(digits));
-        if (index >= lights.size())
-            override_error(
-                o.key, fmt::format("there is no light[{}]: the scene has {} light{} (light[0] to light[{}]).", index,
-                                   lights.size(), lights.size() == 1 ? "" : "s", lights.size() - 1));
+        if (index >= elements.size())
+            override_error(o.key, fmt::format("there is no {0}[{1}]: the scene has {2} {0}{3} ({0}[0] to {0}[{4}]).",
+                                              array, index, elements.size(), elements.size() == 1 ? "" : "s",
+                                              elements.size() - 1));
     } else {
-        const std::string name = k.substr(6, last_dot - 6);  // after "light."
+        const std::string name = k.substr(skip, last_dot - skip);
         std::vector<std::string> known;
         bool found = false;
-        for (std::size_t i = 0; i < lights.size(); ++i) {
-            std::string light_name = fmt::format("light{}", i);
-            if (const toml::table* t = lights.get(i)->as_table())
+        for (std::size_t i = 0; i < elements.size(); ++i) {
+            std::string element_name = fmt::format("{}{}", array, i);
+            if (const toml::table* t = elements.get(i)->as_table())
                 if (const toml::node* n = t->get("name"); n != nullptr && n->is_string())
-                    light_name = n->as_string()->get();
-            if (light_name == name && !found) {
+                    element_name = n->as_string()->get();
+            if (element_name == name && !found) {
                 index = i;
                 found = true;
             }
-            known.push_back(light_name);
+            known.push_back(element_name);
         }
         if (!found)
-            override_error(o.key, fmt::format("no light is named \"{}\"; the lights are {}.", text::echo(name),
+            override_error(o.key, fmt::format("no {} is named \"{}\"; the {}s are {}.", array, text::echo(name), array,
                                               join(known, "\"")));
     }
-    toml::node* light = lights.get(index);
-    if (!light->is_table()) {
-        const SourceLocation w = doc.where(light, fmt::format("light[{}]", index));
-        override_error(o.key, fmt::format("light[{}] in {}:{} is not a table.", index, w.file, w.line));
+    toml::node* element = elements.get(index);
+    if (!element->is_table()) {
+        const SourceLocation w = doc.where(element, fmt::format("{}[{}]", array, index));
+        override_error(o.key, fmt::format("{}[{}] in {}:{} is not a table.", array, index, w.file, w.line));
     }
-    return {light->as_table(), fmt::format("light[{}]", index)};
+    return {element->as_table(), fmt::format("{}[{}]", array, index)};
 }
 
 void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
@@ -1290,8 +1344,13 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
     };
 
     if (k == "light" || k.starts_with("light.") || k.starts_with("light[")) {
-        auto [table, path] = light_for_override(doc, root, o, key);
+        auto [table, path] = element_for_override(doc, root, o, key, "light");
         if (!contains(kLightKeys, key)) unknown("[light]", kLightKeys, key);
+        target = table;
+        schema_key = path + "." + key;
+    } else if (k == "disc" || k.starts_with("disc.") || k.starts_with("disc[")) {
+        auto [table, path] = element_for_override(doc, root, o, key, "disc");
+        if (!contains(kDiscKeys, key)) unknown("[disc]", kDiscKeys, key);
         target = table;
         schema_key = path + "." + key;
     } else if (k.starts_with("profiles.")) {

@@ -227,5 +227,7 @@ TEST(ExampleConvergence, GlareBrightness2afc) { expect_convergence("glare_bright
 TEST(ExampleConvergence, GlareBrightnessAdjust) { expect_convergence("glare_brightness_adjust.toml"); }
 TEST(ExampleConvergence, GlareConstantStimuli) { expect_convergence("glare_constant_stimuli.toml"); }
 TEST(ExampleConvergence, FlashDetection) { expect_convergence("flash_detection.toml"); }
+// Side by side, a glared light against a [[disc]] reference (issue 14 item 5).
+TEST(ExampleConvergence, Suzuki2019GlareMatching) { expect_convergence("suzuki2019_glare_matching.toml"); }
 
 }  // namespace

@@ -151,6 +151,15 @@ struct Condition {
     ChoiceMapping choice = ChoiceMapping::ChoseReference;  ///< 2AFC: what Yes means to the procedure
     std::string test_light;       ///< the scene light the observer judges as the test; empty: image centre
     std::string reference_light;  ///< the scene light of the reference; empty: image centre
+    /// The scene disc of the reference instead of a light ([[disc]], a uniform
+    /// patch of luminance: docs/scene-file.md); empty: none. At most one of
+    /// reference_light and reference_disc. Side-by-side moves it with
+    /// "disc.NAME.position_m"; its level key is e.g. "disc.NAME.luminance_cd_m2".
+    std::string reference_disc;
+    /// The name of the scene light or disc judged as `role`.
+    const std::string& judged(Role role) const {
+        return role == Role::Test ? test_light : reference_disc.empty() ? reference_light : reference_disc;
+    }
     /// Side-by-side: where the left and right lights go (metres, world frame);
     /// the test goes left when the forced choice says so.
     std::optional<std::array<double, 3>> left_position_m;
@@ -301,7 +310,7 @@ struct Frame {
 /// One light the observer judges: in which frame and which scene light.
 struct StimulusView {
     std::size_t frame = 0;
-    std::string light;  ///< scene light name; empty: the image centre
+    std::string light;  ///< scene light (or, for a reference, disc) name; empty: the image centre
     Role role = Role::Test;
 };
 

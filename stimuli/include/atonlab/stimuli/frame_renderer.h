@@ -1,5 +1,6 @@
 #pragma once
-// One HDR frame of a scene (docs/architecture.md "The pipeline, one frame", steps 1-3): the background and
+// One HDR frame of a scene (docs/architecture.md "The pipeline, one frame", steps 1-3): the background, the
+// discs (scene.h Disc, over the background, never glared), and
 // each light's direct image or glare, into an RGBA32F target in absolute units
 // (pixel Y = cd/m², linear Rec.709, D65; FrameOptions can make it RGBA16F with a
 // pre-exposure) plus a linear view-depth target (metres along the view axis,

@@ -82,6 +82,21 @@ struct Light {
     std::string spd;
 };
 
+/// A uniform disc of luminance: the extended reference of luminance-matching
+/// designs (Yoshida et al. 2008, Suzuki et al. 2019: a plain patch beside a
+/// glare stimulus; docs/scene-file.md "[[disc]]"). Not a light: it replaces the
+/// background within its outline, before tone mapping, and no glare model
+/// touches it. Its outline is the set of directions within diameter_deg / 2 of
+/// its centre's direction (a circle of visual angle, whatever the projection),
+/// its edge pixels weighted by the area they cover (disc.h).
+struct Disc {
+    std::string name;
+    glm::dvec3 position_m{0.0, 0.0, -1.0};  ///< a world point on the line of sight to its centre, metres
+    double diameter_deg = 1.0;              ///< angular diameter, degrees of visual angle; 0 draws nothing
+    double luminance_cd_m2 = 1.0;           ///< Y of every point inside, cd/m²
+    glm::dvec3 rgb_per_cd_m2{1.0};          ///< linear Rec.709, normalised to Y = 1 (a light's colour keys)
+};
+
 /// The glare stage (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3). Every model
 /// conserves each light's energy; all but `cie` go through the same billboards,
 /// `cie` convolves the whole frame (its veil reaches tens of degrees).
@@ -136,6 +151,7 @@ struct Scene {
     Environment environment;
     ProfileTables profiles;
     std::vector<Light> lights;
+    std::vector<Disc> discs;  ///< drawn over the background, under the lights, in order
     double adaptation_cd_m2 = 0.001;  ///< recorded in image headers; drives later stages
     GlareSettings glare;
     /// Adaptation, tone mapping, display model and encoding ([eye], [tonemap],
