@@ -227,5 +227,8 @@ TEST(ExampleConvergence, GlareBrightness2afc) { expect_convergence("glare_bright
 TEST(ExampleConvergence, GlareBrightnessAdjust) { expect_convergence("glare_brightness_adjust.toml"); }
 TEST(ExampleConvergence, GlareConstantStimuli) { expect_convergence("glare_constant_stimuli.toml"); }
 TEST(ExampleConvergence, FlashDetection) { expect_convergence("flash_detection.toml"); }
+// Issue 14: a glare test light beside a no-glare reference in one frame, at
+// 0.001, 0.03 and 1 cd/m² (each light its own glare model).
+TEST(ExampleConvergence, GlareSideBySide) { expect_convergence("glare_side_by_side.toml"); }
 
 }  // namespace
