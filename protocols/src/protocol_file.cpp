@@ -878,17 +878,17 @@ private:
     /// Which frames an override applies to.
     enum class Scope : std::uint8_t { every_frame, test, reference };
     /// Where it was written, general to specific.
-    enum class Layer : std::uint8_t { defaults, block, condition };
+    enum class Origin : std::uint8_t { defaults, block, condition };
     struct Written {
         Override o;
         Scope scope = Scope::every_frame;
-        Layer layer = Layer::defaults;
+        Origin layer = Origin::defaults;
         std::string path;  ///< "block[0].test_set[1]"
     };
 
-    static Layer layer_of(const std::string& found_key) {
-        if (found_key.starts_with("defaults.")) return Layer::defaults;
-        return found_key.find(".condition[") != std::string::npos ? Layer::condition : Layer::block;
+    static Origin layer_of(const std::string& found_key) {
+        if (found_key.starts_with("defaults.")) return Origin::defaults;
+        return found_key.find(".condition[") != std::string::npos ? Origin::condition : Origin::block;
     }
 
     static std::string_view scope_name(Scope s) {
@@ -985,7 +985,7 @@ private:
                 for (std::size_t i = 0; i < j; ++i) {
                     const Written& a = written[i];
                     if (!applies(a) || a.o.key != b.o.key || same_value(a.o.value, b.o.value)) continue;
-                    const bool a_default = a.layer == Layer::defaults, b_default = b.layer == Layer::defaults;
+                    const bool a_default = a.layer == Origin::defaults, b_default = b.layer == Origin::defaults;
                     if (a_default != b_default) {
                         // A block's or condition's value replaces the default.
                         if (side_by_side) dropped.insert(a_default ? a.path : b.path);

@@ -217,7 +217,7 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
             scene.lights[1].intensity_cd = b_cd;
             renderer->render(scene, 0.0);
             const VeilReport& v = renderer->veil_report();
-            EXPECT_EQ(v.applied, a_model == GlareModel::cie) << name;
+            EXPECT_EQ(v.applied, light_glare_model(scene, scene.lights[0]) == GlareModel::cie) << name;
             kept_a = v.applied ? luminance_of_linear_rgb(glm::dvec3(1.0) - v.outside_frame) : 1.0;
             return renderer->read_hdr();
         };
@@ -233,13 +233,30 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
         EXPECT_NEAR(got_b / e_b, 1.0, 1e-3) << name;
         EXPECT_NEAR(got_both / (e_a * kept_a + e_b), 1.0, 1e-3) << name;
         EXPECT_NEAR(kept_both, kept_a, 1e-9) << name << ": the veil is a's alone";
+        // a's model is really applied: a alone differs from a drawn without glare.
+        {
+            const std::optional<GlareModel> own = a.glare;
+            a.glare = GlareModel::none;
+            double unused = 1;
+            const ImageRGBA32F plain_a = frame(100.0, 0.0, unused);
+            a.glare = own;
+            float plain_peak = 0.0f, glare_peak = 0.0f;
+            for (std::size_t i = 0; i < plain_a.rgba.size(); ++i)
+                if (i % 4 != 3) {
+                    plain_peak = std::max(plain_peak, plain_a.rgba[i]);
+                    glare_peak = std::max(glare_peak, only_a.rgba[i]);
+                }
+            EXPECT_LT(glare_peak, 0.9f * plain_peak) << name << ": a's glare spreads its light";
+        }
 
-        // The frame is the sum of the two lights' frames, pixel by pixel.
+        // The frame is the sum of the two lights' frames, pixel by pixel (RGB; alpha is not light).
         float peak = 0.0f;
-        for (float v : both.rgba) peak = std::max(peak, v);
         double worst = 0.0;
-        for (std::size_t i = 0; i < both.rgba.size(); ++i)
+        for (std::size_t i = 0; i < both.rgba.size(); ++i) {
+            if (i % 4 == 3) continue;
+            peak = std::max(peak, both.rgba[i]);
             worst = std::max(worst, std::abs(double(both.rgba[i]) - double(only_a.rgba[i]) - double(only_b.rgba[i])));
+        }
         EXPECT_LE(worst, 1e-5 * peak) << name;
         // Around b (its centre ± 12 px): b's direct image and a's spill, which a
         // billboard 1° wide does not have there; b's pixels are b's own.
@@ -251,12 +268,19 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
                                                   only_b.pixel(xx, yy)[2]});
                 a_spill += luminance_of_linear_rgb({only_a.pixel(xx, yy)[0], only_a.pixel(xx, yy)[1],
                                                     only_a.pixel(xx, yy)[2]});
-                if (glare_path(a_model) == GlarePath::billboard)
-                    for (int c = 0; c < 4; ++c) EXPECT_EQ(both.pixel(xx, yy)[c], only_b.pixel(xx, yy)[c]) << name;
+                if (glare_path(a_model) == GlarePath::billboard) {
+                    for (int c = 0; c < 3; ++c) {
+                        EXPECT_EQ(both.pixel(xx, yy)[c], only_b.pixel(xx, yy)[c]) << name;
+                    }
+                }
             }
         EXPECT_GT(b_sum, 0.0) << name << ": b is drawn within ±12 px of its centre";
-        if (a_model == GlareModel::cie) EXPECT_GT(a_spill, 0.0) << name << ": the veil reaches b";
-        if (glare_path(a_model) == GlarePath::billboard) EXPECT_EQ(a_spill, 0.0) << name;
+        if (a_model == GlareModel::cie) {
+            EXPECT_GT(a_spill, 0.0) << name << ": the veil reaches b";
+        }
+        if (glare_path(a_model) == GlarePath::billboard) {
+            EXPECT_EQ(a_spill, 0.0) << name;
+        }
     }
 }
 

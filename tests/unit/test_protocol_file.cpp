@@ -663,22 +663,18 @@ procedure = { kind = "staircase", start = 1.0, step_type = "lin", n_reversals = 
 std::string conflict_case(const std::string& presentation, const std::string& defaults, const std::string& block,
                           const std::string& condition) {
     return "[defaults]\ntask = \"2afc\"\npresentation = \"" + presentation +
-           "\"\ntest_light = \"t\"\nreference_light = \"r\"\n"
-           "left_position_m = [-10.0, 3.0, -500.0]\nright_position_m = [10.0, 3.0, -500.0]\n"
-           "level_key = \"light.r.intensity_cd\"\n"
-           "procedure = { kind = \"staircase\", start = 1.0, step_type = \"lin\", n_reversals = 4 }\n" +
+           "\"\ntest_light = \"t\"\nreference_light = \"r\"\n" +
+           (presentation == "side-by-side"
+                ? "left_position_m = [-10.0, 3.0, -500.0]\nright_position_m = [10.0, 3.0, -500.0]\n"
+                : "\n\n") +  // (the same line numbers either way)
+           std::string("level_key = \"light.r.intensity_cd\"\n"
+           "procedure = { kind = \"staircase\", start = 1.0, step_type = \"lin\", n_reversals = 4 }\n") +
            defaults + "\n[[block]]\n" + block + "\n[[block.condition]]\nname = \"c\"\n" + condition + "\n";
 }
 
 std::string conflict_error(const std::string& text) {
     try {
-        // left/right positions are side-by-side only: drop them for other presentations.
-        std::string t = text;
-        if (t.find("\"side-by-side\"") == std::string::npos) {
-            for (const char* k : {"left_position_m = [-10.0, 3.0, -500.0]\n", "right_position_m = [10.0, 3.0, -500.0]\n"})
-                t.erase(t.find(k), std::string(k).size());
-        }
-        (void)parse(t);
+        (void)parse(text);
     } catch (const ProtocolError& e) {
         return e.what();
     }
@@ -707,7 +703,8 @@ TEST(ProtocolConflicts, SideBySideTestAndReferenceSetsMustAgree) {
     Proposal prop;
     prop.level = 0.5;
     prop.test_on_left = true;
-    const auto& o = make_stimulus(p, c, prop).frames[0].overrides;
+    const Stimulus stimulus = make_stimulus(p, c, prop);
+    const auto& o = stimulus.frames[0].overrides;
     EXPECT_NE(std::find(o.begin(), o.end(), "light.t.glare=\"wave-optics\""), o.end());
     EXPECT_NE(std::find(o.begin(), o.end(), "light.r.glare=\"none\""), o.end());
     // Equal values are not a conflict (numbers compare as numbers).
@@ -746,10 +743,11 @@ TEST(ProtocolConflicts, DefaultsAndRoleListsReplaceByDesign) {
         std::string last;
         for (const std::string& o : s.frames[0].overrides)
             if (o.starts_with("eye.pupil_mm=")) last = o;
-        if (presentation == "side-by-side")
+        if (presentation == "side-by-side") {
             EXPECT_EQ(last, "eye.pupil_mm=5");
-        else if (s.frames[0].role == Role::Test)
+        } else if (s.frames[0].role == Role::Test) {
             EXPECT_EQ(last, "eye.pupil_mm=3");
+        }
     }
     // Two-interval: a block's set and the defaults' role list (the glare examples'
     // light.test.intensity_cd) are fine; side by side a block's set and a
