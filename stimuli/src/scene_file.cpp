@@ -80,7 +80,7 @@ constexpr std::string_view kSectorKeys[] = {"from_deg", "to_deg", "level", "edge
 constexpr std::string_view kLightKeys[] = {
     "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
     "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
-    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s",          "glare"};
+    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s",   "glare"};
 
 /// Keys of which a table may hold at most one. An override that sets one of
 /// them removes the others from its table, so "--set light.buoy.colour=red"
