@@ -284,6 +284,33 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
     }
 }
 
+TEST_F(GlareFrames, LdrPathTakesTheGlareOfTheGlareLightsOnly) {
+    // K2012 §6.2.2 with lights of their own models: every direct image in the
+    // HDR frame, and in the glare buffer only the glare of the light that has a
+    // model (a), none of b's.
+    const double d = 1000.0, x = std::tan(1.5 * std::numbers::pi / 180.0), f = 2880.0;
+    Scene scene = black_scene(GlareModel::none);
+    scene.output.ldr_glare = true;
+    Light a = light_at(glm::dvec3(-x, 0.003, -1.0) * d, 100.0);
+    a.glare = GlareModel::gaussian_bloom;
+    Light b = light_at(glm::dvec3(x, 0.003, -1.0) * d, 40.0);
+    scene.lights = {a, b};
+    const double e_a = 100.0 / glm::dot(a.position_m, a.position_m);
+    const double e_b = 40.0 / glm::dot(b.position_m, b.position_m);
+    renderer->render(scene, 0.0);
+    const double direct = image_illuminance_lux(renderer->read_hdr(), f);
+    ASSERT_NE(renderer->glare_texture(), nullptr);
+    ImageRGBA32F glare;
+    glare.width = renderer->glare_texture()->width();
+    glare.height = renderer->glare_texture()->height();
+    glare.rgba = renderer->glare_texture()->download_floats();  // rows bottom-up: Σ L·Ω is the same
+    const double glare_lux = image_illuminance_lux(glare, f);
+    std::printf("ldr path: HDR Σ L·Ω / (E_a + E_b) %.6f, glare buffer / E_a %.6f\n", direct / (e_a + e_b),
+                glare_lux / e_a);
+    EXPECT_NEAR(direct / (e_a + e_b), 1.0, 1e-3);
+    EXPECT_NEAR(glare_lux / e_a, 1.0, 1e-3);
+}
+
 TEST_F(GlareFrames, CieVeilOfOneLightIsTheCie146EquationAndKeepsItsEnergy) {
     // 261×121 px at 12 px per degree (±10.9° × ±5°); a 10⁴ cd light 1 km straight
     // ahead (E = 0.01 lx) lands in the centre pixel. L/E at 1°, 3° and 10° to the
