@@ -49,6 +49,14 @@ struct Frame {
     }
 };
 
+/// The glare model a frame's overrides give a light: its own
+/// (light.NAME.glare), else the eye's (eye.glare); nullopt: the scene's.
+std::optional<std::string> glare_of(const Frame& frame, const std::string& light) {
+    if (!light.empty())
+        if (auto v = frame.value("light." + light + ".glare")) return v;
+    return frame.value("eye.glare");
+}
+
 /// Fills the trial's task, level scale and stimulus parameters from its
 /// stimulus JSON (docs/running.md "What each trial stores"), read with the
 /// store's JsonReader (SQLite's JSON functions: no second JSON library).
@@ -79,11 +87,24 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
         }
         frames.push_back(std::move(frame));
     }
-    std::string test_light;
+    std::string test_light, reference_light;
+    // The glare model each view's light was drawn with, as the runner stored
+    // it (its own model, else the eye's); absent in files written before lights
+    // had their own model.
+    std::optional<std::string> test_glare, reference_glare;
     const std::size_t n_views = j.array_length("$.views");
-    for (std::size_t v = 0; v < n_views; ++v)
-        if (j.string(fmt::format("$.views[{}].role", v)).value_or("") == "test")
-            test_light = j.string(fmt::format("$.views[{}].light", v)).value_or("");
+    for (std::size_t v = 0; v < n_views; ++v) {
+        const std::string role = j.string(fmt::format("$.views[{}].role", v)).value_or("");
+        const std::string light = j.string(fmt::format("$.views[{}].light", v)).value_or("");
+        const std::optional<std::string> glare = j.string(fmt::format("$.views[{}].glare", v));
+        if (role == "test") {
+            test_light = light;
+            test_glare = glare;
+        } else if (role == "reference") {
+            reference_light = light;
+            reference_glare = glare;
+        }
+    }
     const Frame* test = nullptr;
     const Frame* reference = nullptr;
     for (const Frame& f : frames) {
@@ -94,7 +115,7 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
     if (test) {
         if (const auto v = test->value("eye.adaptation_cd_m2")) t.adaptation_cd_m2 = toml_number(*v);
         if (const auto v = test->value("tonemap.operator")) t.tone_operator = toml_string(*v);
-        if (const auto v = test->value("eye.glare")) t.glare_test = toml_string(*v);
+        if (const auto v = glare_of(*test, test_light)) t.glare_test = toml_string(*v);
         if (!test_light.empty()) {
             if (const auto v = test->value("light." + test_light + ".intensity_cd")) {
                 const auto cd = toml_number(*v);
@@ -103,8 +124,10 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
         }
     }
     if (reference) {
-        if (const auto v = reference->value("eye.glare")) t.glare_reference = toml_string(*v);
+        if (const auto v = glare_of(*reference, reference_light)) t.glare_reference = toml_string(*v);
     }
+    if (test_glare) t.glare_test = *test_glare;
+    if (reference_glare) t.glare_reference = *reference_glare;
 }
 
 /// The binary outcome of a trial (Trial::outcome).

@@ -9,9 +9,12 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <system_error>
 
@@ -769,15 +772,23 @@ private:
         }
         c.prompt = r.string("prompt").value_or("");
 
-        for (const Found& f : r.find_all("set")) append(c.set, doc_.scene_overrides(f.node, f.key, r.context()));
-        for (const Found& f : r.find_all("test_set"))
-            append(c.test_set, doc_.scene_overrides(f.node, f.key, r.context()));
+        // Every override with where it was written, for the conflict check below.
+        std::vector<Written> written;
+        auto take = [&](const Found& f, Scope scope, std::vector<Override>& into) {
+            std::vector<Override> list = doc_.scene_overrides(f.node, f.key, r.context());
+            for (std::size_t i = 0; i < list.size(); ++i)
+                written.push_back(Written{list[i], scope, layer_of(f.key),
+                                          f.node->is_string() ? f.key : fmt::format("{}[{}]", f.key, i)});
+            append(into, std::move(list));
+        };
+        for (const Found& f : r.find_all("set")) take(f, Scope::every_frame, c.set);
+        for (const Found& f : r.find_all("test_set")) take(f, Scope::test, c.test_set);
         for (const Found& f : r.find_all("reference_set")) {
             if (c.presentation == Presentation::Single)
                 r.fail(f,
                        "a single presentation has no reference: reference_set is not used; put the overrides in "
                        "set or test_set.");
-            append(c.reference_set, doc_.scene_overrides(f.node, f.key, r.context()));
+            take(f, Scope::reference, c.reference_set);
         }
 
         const auto level_key = r.find("level_key");
@@ -835,6 +846,8 @@ private:
                                            to_string(c.presentation)));
         }
 
+        check_conflicts(r, c, written, level_key->key);
+
         // The procedure.
         const std::vector<Found> tables = r.find_all("procedure");
         if (tables.empty())
@@ -867,6 +880,150 @@ private:
             pr.fail(e.parameter(), fmt::format("{} {}.", e.parameter(), strip_period(e.message())));
         }
         return c;
+    }
+
+    // --- Conflicting overrides (docs/protocol-file.md "When two overrides set one key").
+
+    /// Which frames an override applies to.
+    enum class Scope : std::uint8_t { every_frame, test, reference };
+    /// Where it was written, general to specific.
+    enum class Origin : std::uint8_t { defaults, block, condition };
+    struct Written {
+        Override o;
+        Scope scope = Scope::every_frame;
+        Origin layer = Origin::defaults;
+        std::string path;  ///< "block[0].test_set[1]"
+    };
+
+    static Origin layer_of(const std::string& found_key) {
+        if (found_key.starts_with("defaults.")) return Origin::defaults;
+        return found_key.find(".condition[") != std::string::npos ? Origin::condition : Origin::block;
+    }
+
+    static std::string_view scope_name(Scope s) {
+        switch (s) {
+            case Scope::every_frame:
+                return "set";
+            case Scope::test:
+                return "test_set";
+            case Scope::reference:
+                return "reference_set";
+        }
+        return "set";
+    }
+
+    /// Two TOML value texts that mean the same value: equal numbers, or equal
+    /// text once the quotes of a string are set aside.
+    static bool same_value(std::string_view a, std::string_view b) {
+        auto trim = [](std::string_view v) {
+            while (!v.empty() && (v.front() == ' ' || v.front() == '\t')) v.remove_prefix(1);
+            while (!v.empty() && (v.back() == ' ' || v.back() == '\t')) v.remove_suffix(1);
+            if (v.size() >= 2 && (v.front() == '"' || v.front() == '\'') && v.back() == v.front())
+                v = v.substr(1, v.size() - 2);
+            return v;
+        };
+        a = trim(a);
+        b = trim(b);
+        if (a == b) return true;
+        auto number = [](std::string_view v) -> std::optional<double> {
+            double x = 0.0;
+            const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+            if (ec != std::errc() || ptr != v.data() + v.size()) return std::nullopt;
+            return x;
+        };
+        const auto x = number(a), y = number(b);
+        return x && y && *x == *y;
+    }
+
+    /// One frame must not take one key from two places that both mean it
+    /// (docs/protocol-file.md). By design, a later layer replaces an earlier:
+    /// a [[block]] or condition value replaces the [defaults] value of the
+    /// same key; in a frame of one role (single, two-interval) the role's
+    /// test_set or reference_set replaces `set`. Refused: a block and its
+    /// condition, or one list twice, giving one key two values; in a
+    /// side-by-side frame (which holds both lights) set, test_set and
+    /// reference_set giving one key two values; any override of the key the
+    /// procedure's level sets, in the frame the level is on; any override of
+    /// a side-by-side light's position_m. In a side-by-side frame a [defaults]
+    /// value that a block or condition replaces is dropped, so that the
+    /// replacement holds whatever list it is in.
+    void check_conflicts(const ConditionReader& r, Condition& c, const std::vector<Written>& written,
+                         const std::string& level_key_path) const {
+        const bool side_by_side = c.presentation == Presentation::SideBySide;
+        auto conflict = [&](const Written& a, const Written& b, const std::string& why) {
+            doc_.fail_at_line(b.o.line, b.path,
+                              r.context() + fmt::format("{} is set to {} here and to {} by {} (line {}): {} Remove one "
+                                                        "of them (docs/protocol-file.md \"When two overrides set one "
+                                                        "key\").",
+                                                        b.o.key, b.o.value, a.o.value, a.path, a.o.line, why));
+        };
+        // Frames of the condition, by the scopes that apply to each.
+        std::vector<std::vector<Scope>> frames;
+        if (side_by_side)
+            frames = {{Scope::every_frame, Scope::test, Scope::reference}};
+        else if (c.presentation == Presentation::Single)
+            frames = {{Scope::every_frame, Scope::test}};
+        else
+            frames = {{Scope::every_frame, Scope::test}, {Scope::every_frame, Scope::reference}};
+        std::set<std::string> dropped;  // paths of [defaults] values a side-by-side frame drops
+        for (const auto& scopes : frames) {
+            auto applies = [&](const Written& w) {
+                return std::find(scopes.begin(), scopes.end(), w.scope) != scopes.end();
+            };
+            const bool has_level =
+                side_by_side || std::find(scopes.begin(), scopes.end(),
+                                          c.level_on == Role::Test ? Scope::test : Scope::reference) != scopes.end();
+            for (std::size_t j = 0; j < written.size(); ++j) {
+                const Written& b = written[j];
+                if (!applies(b)) continue;
+                if (has_level && b.o.key == c.level_key)
+                    doc_.fail_at_line(
+                        b.o.line, b.path,
+                        r.context() +
+                            fmt::format("{} is set to {} here, but it is the level_key ({}): the procedure's level "
+                                        "sets it on every trial in the {} frame. Remove this override (docs/protocol-"
+                                        "file.md \"When two overrides set one key\").",
+                                        b.o.key, b.o.value, level_key_path, side_by_side ? "side-by-side" : to_string(c.level_on)));
+                if (side_by_side && (b.o.key == fmt::format("light.{}.position_m", c.test_light) ||
+                                     b.o.key == fmt::format("light.{}.position_m", c.reference_light)))
+                    doc_.fail_at_line(
+                        b.o.line, b.path,
+                        r.context() + fmt::format("{} is set to {} here, but a side-by-side frame places its lights "
+                                                  "at left_position_m and right_position_m. Remove this override.",
+                                                  b.o.key, b.o.value));
+                for (std::size_t i = 0; i < j; ++i) {
+                    const Written& a = written[i];
+                    if (!applies(a) || a.o.key != b.o.key || same_value(a.o.value, b.o.value)) continue;
+                    const bool a_default = a.layer == Origin::defaults, b_default = b.layer == Origin::defaults;
+                    if (a_default != b_default) {
+                        // A block's or condition's value replaces the default.
+                        if (side_by_side) dropped.insert(a_default ? a.path : b.path);
+                        if (side_by_side || a.scope == b.scope) continue;
+                    }
+                    if (!side_by_side && a.scope != b.scope) continue;  // the role's list replaces `set`
+                    std::string why;
+                    if (side_by_side && a.scope != b.scope)
+                        why = fmt::format("a side-by-side frame holds both lights, and {} and {} both apply to "
+                                          "all of it.",
+                                          scope_name(a.scope), scope_name(b.scope));
+                    else if (a.layer != b.layer)
+                        why = "a condition and its block apply to the same frames.";
+                    else
+                        why = "one list sets it twice.";
+                    conflict(a, b, why);
+                }
+            }
+        }
+        if (dropped.empty()) return;
+        // Rebuild the lists without the replaced defaults (order kept).
+        c.set.clear();
+        c.test_set.clear();
+        c.reference_set.clear();
+        for (const Written& w : written) {
+            if (dropped.contains(w.path)) continue;
+            (w.scope == Scope::every_frame ? c.set : w.scope == Scope::test ? c.test_set : c.reference_set)
+                .push_back(w.o);
+        }
     }
 
     static void append(std::vector<Override>& to, std::vector<Override> from) {

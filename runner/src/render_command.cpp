@@ -81,6 +81,15 @@ int run_render(const RenderOptions& o) {
     meta.strings["time_s"] = fmt::format("{}", o.time_s);
     meta.strings["software"] = "atonlab " ATONLAB_VERSION;
     meta.strings["glare"] = std::string(stimuli::glare_model_name(scene.glare.model));
+    {
+        // Lights with a glare model of their own ([[light]] glare).
+        std::string own;
+        for (const auto& l : scene.lights)
+            if (l.glare.has_value())
+                own += fmt::format("{}{}={}", own.empty() ? "" : " ", l.name,
+                                   stimuli::glare_model_name(stimuli::light_glare_model(scene, l)));
+        if (!own.empty()) meta.strings["glare_lights"] = own;
+    }
     const double adapted = pipeline.display().adaptation_cd_m2();
     meta.strings["tonemap"] = fmt::format(
         "operator={} adaptation={} adapted_cd_m2={:.6g} blueshift={} hue_preservation={} display={} peak_cd_m2={} "
@@ -101,8 +110,11 @@ int run_render(const RenderOptions& o) {
             g.spd.empty() ? "d65" : g.spd, g.pupil_mm, g.kernel_size_px, g.radius_deg,
             stimuli::glare_window_name(scene.glare.window), g.window_cut.r, g.window_cut.g, g.window_cut.b,
             g.area_layers, g.area_max_radius_px);
-        meta.strings[fmt::format("glare_{}", g.spd.empty() ? "d65" : g.spd)] = line;
-        glare_note += fmt::format("  glare ({}): {}\n", stimuli::glare_model_name(scene.glare.model), line);
+        const std::string spd = g.spd.empty() ? "d65" : g.spd;
+        meta.strings[g.model == scene.glare.model
+                         ? fmt::format("glare_{}", spd)
+                         : fmt::format("glare_{}_{}", stimuli::glare_model_name(g.model), spd)] = line;
+        glare_note += fmt::format("  glare ({}): {}\n", stimuli::glare_model_name(g.model), line);
     }
     if (const stimuli::VeilReport& v = renderer.veil_report(); v.applied) {
         // The `cie` model: what the frame-sized convolution carried beyond the frame.

@@ -271,7 +271,7 @@ void StimulusRenderer::encode_scene(const s::Scene& sc, double time_s) {
     const s::OutputSettings& os = sc.output;
     display_.reset_adaptation();
     if (const gl::Texture2D* glare = frame_.glare_texture();
-        glare && os.ldr_glare && sc.glare.model != s::GlareModel::none) {
+        glare && os.ldr_glare && (sc.glare.model != s::GlareModel::none || s::any_light_glare(sc))) {
         const s::ToneMapSettings& tm = os.tonemap;
         const double white = tm.white_cd_m2
                                  ? *tm.white_cd_m2
@@ -722,8 +722,19 @@ private:
 
 // --- Stored records ------------------------------------------------------------
 
+/// The glare model a view's light is drawn with in its frame's scene: the
+/// light's own, else the eye's (also for a view of the image centre, or of an
+/// alternating light, whose channels are "NAME/W", ...).
+std::string view_glare(const s::Scene& sc, const std::string& light) {
+    for (const s::Light& l : sc.lights)
+        if (!light.empty() && (l.name == light || l.name.starts_with(light + "/")))
+            return std::string(s::glare_model_name(s::light_glare_model(sc, l)));
+    return std::string(s::glare_model_name(sc.glare.model));
+}
+
 std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, const p::ScheduledTrial& t,
-                          const std::vector<double>& frame_times, const std::string& frames_shown_json) {
+                          const std::vector<double>& frame_times, const std::string& frames_shown_json,
+                          const std::vector<std::string>& view_glares) {
     const p::Stimulus& stim = t.stimulus;
     std::string j = "{";
     j += fmt::format("\"task\":{},\"presentation\":{},", json_string(p::to_string(c.task)),
@@ -745,8 +756,10 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
     j += "],\"views\":[";
     for (std::size_t i = 0; i < stim.views.size(); ++i) {
         const p::StimulusView& v = stim.views[i];
-        j += fmt::format("{}{{\"frame\":{},\"light\":{},\"role\":{}}}", i ? "," : "", v.frame, json_string(v.light),
+        j += fmt::format("{}{{\"frame\":{},\"light\":{},\"role\":{}", i ? "," : "", v.frame, json_string(v.light),
                          json_string(p::to_string(v.role)));
+        if (i < view_glares.size()) j += fmt::format(",\"glare\":{}", json_string(view_glares[i]));
+        j += '}';
     }
     j += "]";
     if (stim.adjusted_view) j += fmt::format(",\"adjusted_view\":{}", *stim.adjusted_view);
@@ -1428,9 +1441,12 @@ int run_session(const RunOptions& o) {
                 }
             }
             std::vector<double> frame_times;
+            std::vector<std::string> view_glares(t.stimulus.views.size());
             for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
                 const s::Scene sc = renderer.scene(t.stimulus.frames[f].overrides);
                 frame_times.push_back(brightest_moment_s(sc, judged_lights(t.stimulus, f), interval_s));
+                for (std::size_t v = 0; v < t.stimulus.views.size(); ++v)
+                    if (t.stimulus.views[v].frame == f) view_glares[v] = view_glare(sc, t.stimulus.views[v].light);
             }
             st::TrialRecord tr;
             tr.trial_index = static_cast<std::int64_t>(row);
@@ -1439,7 +1455,7 @@ int run_session(const RunOptions& o) {
             tr.procedure_id = t.procedure_id;
             tr.level = t.proposal.level;
             tr.test_on_left = t.proposal.test_on_left;
-            tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json);
+            tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json, view_glares);
             tr.response = counted ? std::string(p::response_word(*shown.response))
                                   : std::string(shown.end == TrialEnd::timeout ? "timeout" : "missed");
             if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;

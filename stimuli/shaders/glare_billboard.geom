@@ -33,7 +33,8 @@ flat out float g_layer;
 void main() {
     int i = v_light[0];
     LightDraw d = draws[i];
-    if (d.centre.w <= 0.0 || lights[i].rhythm.z != group) return;
+    // Only the lights whose glare model draws a billboard (rhythm.w, scene.h GlarePath), of this group.
+    if (d.centre.w <= 0.0 || lights[i].rhythm.w != 1u || lights[i].rhythm.z != group) return;
     float radius_px = sqrt(d.centre.w / PI);
     float layer = layer_step_px > 0.0 ? min(radius_px / layer_step_px, float(layer_count - 1)) : 0.0;
     float extent = min(kernel_half_px + ceil(radius_px) + 1.0, layer_half_px) + 1.0;

@@ -9,6 +9,7 @@ struct LightDraw {
 layout(std430, binding = 3) readonly buffer Draws { LightDraw draws[]; };
 
 uniform vec2 image_size;
+uniform int path;  // draw only the lights of this glare path (LightDraw skip.z); -1: every light
 
 flat out vec2 v_centre;
 flat out float v_area;
@@ -21,7 +22,7 @@ void main() {
     v_area = d.centre.w;
     v_illuminance = d.illuminance.rgb;
     v_radius = sqrt(max(d.centre.w, 0.0) / 3.14159265358979);
-    if (d.centre.w <= 0.0) {  // not drawn: a degenerate quad outside the clip volume
+    if (d.centre.w <= 0.0 || (path >= 0 && int(d.skip.z) != path)) {  // not drawn: a degenerate quad outside the clip volume
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
         return;
     }

@@ -16,7 +16,8 @@ struct LightDraw {
     vec4 centre;       // xy: projected centre (px, window coordinates); z: view depth (m); w: footprint area (px², 0 = not drawn)
     vec4 illuminance;  // rgb: illuminance at the eye (lux per channel); w: distance (m)
     vec4 factors;      // vertical, horizontal, rhythm, transmittance
-    vec4 skip;         // x: cropped billboard half-extent (px, 0 = uncropped); y: invisible illuminance (lux)
+    vec4 skip;         // x: cropped billboard half-extent (px, 0 = uncropped); y: invisible illuminance (lux);
+                       // z: the light's glare path (0 direct, 1 billboard, 2 veil: scene.h GlarePath)
 };
 layout(std430, binding = 3) writeonly buffer Draws { LightDraw draws[]; };
 // Per SPD group, envelope_stride entries (glare_stage.h envelope_buffer()):
@@ -50,7 +51,9 @@ void main() {
     d.factors = vec4(ev.vertical, ev.horizontal, ev.rhythm, ev.transmittance);
     d.centre = vec4(0.0);
     float invisible = L.rhythm_period.y;  // lux (Y); 0: never culled or cropped
-    d.skip = vec4(0.0, invisible, 0.0, 0.0);
+    uint path = L.rhythm.w;  // scene.h GlarePath of the light's own glare model, else the eye's
+    bool billboard = path == 1u;
+    d.skip = vec4(0.0, invisible, float(path), 0.0);
 
     vec3 v = view_from_world * L.position_radius.xyz;
     float radius = L.position_radius.w;
@@ -78,14 +81,14 @@ void main() {
             hidden = scene_depth < depth - radius;
         }
         float disc_px = area >= 1.0 ? sqrt(area / PI) : 0.5;
-        float extent = disc_px + 1.0 + glare_extent_px;
+        float extent = disc_px + 1.0 + (billboard ? glare_extent_px : 0.0);
         // Display skips: a pixel receives at most E_Y · K_peak / Ω (glare) or
         // E_Y / (max(A, 1) Ω) (direct image), Ω ≥ the smallest pixel solid
         // angle, which `invisible` (= ΔY · Ω_min) already holds.
         bool invisible_light = false;
         if (invisible > 0.0) {
             float e_y = dot(ev.illuminance_rgb, LUMINANCE);
-            if (envelope_stride > 0u) {
+            if (envelope_stride > 0u && billboard) {
                 uint base = L.rhythm.z * envelope_stride;
                 invisible_light = cull_invisible != 0 && e_y * envelope[base] < invisible;
                 if (crop_billboards != 0 && !invisible_light) {

@@ -58,6 +58,9 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
     for (std::size_t li = 0; li < scene.lights.size(); ++li) {
         const Light& L = scene.lights[li];
         const unsigned group = li < glare_groups.size() ? glare_groups[li] : 0u;
+        // How its glare model draws it (scene.h GlarePath): light_eval.comp, the
+        // direct pass and the billboards each take only their own lights.
+        const auto path = static_cast<std::uint32_t>(glare_path(light_glare_model(scene, L)));
         const double invisible = li < invisible_lux.size() ? invisible_lux[li] : 0.0;
         const auto knot_offset = static_cast<std::uint32_t>(t.rhythm_knots.size());
         for (const RhythmKnot& k : L.rhythm)
@@ -72,7 +75,7 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
             static_cast<float>(L.orientation.z), static_cast<float>(L.orientation.w),
             static_cast<float>(I.r), static_cast<float>(I.g), static_cast<float>(I.b), static_cast<float>(L.rhythm_phase_s),
             bits(v.first), bits(v.second), bits(h.first), bits(h.second),
-            bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(group), bits(0),
+            bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(group), bits(path),
             static_cast<float>(L.rhythm_period_s), static_cast<float>(invisible), 0.0f, 0.0f};
         t.lights.insert(t.lights.end(), std::begin(rec), std::end(rec));
     }
@@ -293,7 +296,15 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     const auto prepare_started = Clock::now();
     const double glare_extent_px = m.glare.prepare(scene, P, time_s);
     m.cpu_timings.glare_prepare_cpu_ms = ms_since(prepare_started);
-    const bool glare = scene.glare.model != GlareModel::none;
+    // Which paths this frame's lights take (each light's own glare model, else the eye's).
+    bool any_direct = false, any_billboard = false, any_veil = false;
+    for (const Light& L : scene.lights) {
+        const GlarePath path = glare_path(light_glare_model(scene, L));
+        any_direct |= path == GlarePath::direct;
+        any_billboard |= path == GlarePath::billboard;
+        any_veil |= path == GlarePath::veil;
+    }
+    const bool glare = any_billboard || any_veil;
     const std::vector<double> invisible = m.invisible_lux(scene, P);
     const GpuLightTables tables = pack_lights(scene, P.eye_position_m, m.glare.light_groups(), invisible);
     m.light_count = static_cast<int>(scene.lights.size());
@@ -309,8 +320,8 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     m.knots.bind_storage(2);
     m.draws.bind_storage(3);
     const bool skips = !invisible.empty();
-    const bool crop = skips && glare && m.options.skips.crop_billboards && m.glare.envelope_stride() > 0;
-    (glare && m.glare.envelope_stride() > 0 ? m.glare.envelope_buffer() : m.no_envelope).bind_storage(4);
+    const bool crop = skips && any_billboard && m.options.skips.crop_billboards && m.glare.envelope_stride() > 0;
+    (any_billboard && m.glare.envelope_stride() > 0 ? m.glare.envelope_buffer() : m.no_envelope).bind_storage(4);
     if (m.light_count == 0 && m.timed) {
         begin(1);
         end(1);
@@ -329,7 +340,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         m.light_eval.set("glare_extent_px", static_cast<float>(glare_extent_px));
         m.light_eval.set("cull_invisible", skips && m.options.skips.cull_invisible_lights ? 1 : 0);
         m.light_eval.set("crop_billboards", crop ? 1 : 0);
-        m.light_eval.set("envelope_stride", glare ? m.glare.envelope_stride() : 0u);
+        m.light_eval.set("envelope_stride", any_billboard ? m.glare.envelope_stride() : 0u);
         m.light_eval.use();
         begin(1);
         glDispatchCompute(static_cast<unsigned>((m.light_count + 63) / 64), 1, 1);
@@ -343,33 +354,41 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
         glBlendEquation(GL_FUNC_ADD);
-        const bool ldr = glare && scene.output.ldr_glare;
-        const bool veil = scene.glare.model == GlareModel::cie;
-        auto draw_direct = [&](float pre_exposure) {
+        // The LDR path (K2012 §6.2.2): every direct image in the HDR frame, the
+        // glare alone in its own buffer. Kept whenever the eye or a light has a
+        // glare model, so the buffer exists (and is black) without glare lights.
+        const bool ldr = scene.output.ldr_glare && (glare || scene.glare.model != GlareModel::none);
+        // path: the GlarePath whose lights are drawn; -1: every light.
+        auto draw_direct = [&](float pre_exposure, int path) {
             m.light_direct.set("image_size", w, h);
             m.light_direct.set("focal_px", f);
             m.light_direct.set("pre_exposure", pre_exposure);
+            m.light_direct.set("path", path);
             m.light_direct.use();
             m.vao.bind();
             glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, m.light_count);
         };
         begin(2);
-        if (glare && !ldr && !veil) {
+        if (ldr) {
+            draw_direct(pre, -1);
+        } else {
+            if (any_direct) draw_direct(pre, static_cast<int>(GlarePath::direct));
             // The glare billboard replaces the direct image (docs/architecture.md: energy-matched).
-            m.glare.draw(m.light_count, P, m.pre_exposure);
-        } else if (!veil || ldr) {
-            draw_direct(pre);
+            if (any_billboard) m.glare.draw(m.light_count, P, m.pre_exposure);
         }
-        if (veil) {
-            // `cie`: the direct images alone (cd/m²) convolved over the whole frame
-            // with the CIE 146 GSF (veiling_glare.h), which replaces them in the
-            // HDR frame, or is the glare buffer of the LDR path.
-            const auto veil_started = Clock::now();
+        if (ldr || any_veil) {
             m.ensure_glare_target();
             m.glare_fbo.bind();
             const float zero[4] = {0, 0, 0, 0};
             glClearBufferfv(GL_COLOR, 0, zero);
-            draw_direct(1.0f);
+        }
+        if (any_veil) {
+            // `cie`: the direct images of its lights alone (cd/m²) convolved over
+            // the whole frame with the CIE 146 GSF (veiling_glare.h), which
+            // replaces them in the HDR frame, or is the glare buffer of the LDR
+            // path. Lights with another model are not in the convolution.
+            const auto veil_started = Clock::now();
+            draw_direct(1.0f, static_cast<int>(GlarePath::veil));
             std::vector<float> light = m.glare_only.download_floats();
             m.veil_report.outside_frame = m.veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
             m.veil_report.applied = true;
@@ -382,18 +401,15 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
                     if (i % 4 != 3) frame[i] += light[i] * pre;
                 m.hdr.upload(frame.data());
             }
-            m.fbo.bind();
             m.veil_report.cpu_ms = ms_since(veil_started);
             m.cpu_timings.veil_cpu_ms = m.veil_report.cpu_ms;
-        } else if (ldr) {
-            // K2012 §6.2.2: the glare alone, into its own buffer, for the LDR path.
-            m.ensure_glare_target();
-            m.glare_fbo.bind();
-            const float zero[4] = {0, 0, 0, 0};
-            glClearBufferfv(GL_COLOR, 0, zero);
-            m.glare.draw(m.light_count, P, 1.0);  // the glare buffer stays in cd/m²
-            m.fbo.bind();
         }
+        if (ldr && any_billboard) {
+            // K2012 §6.2.2: the billboards' glare alone, into the glare buffer (cd/m²).
+            m.glare_fbo.bind();
+            m.glare.draw(m.light_count, P, 1.0);
+        }
+        m.fbo.bind();
         end(2);
         glDisable(GL_BLEND);
         const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};

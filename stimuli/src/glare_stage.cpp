@@ -43,6 +43,38 @@ std::optional<GlareModel> glare_model_from_name(std::string_view name) {
     return std::nullopt;
 }
 
+GlarePath glare_path(GlareModel m) {
+    switch (m) {
+        case GlareModel::none:
+            return GlarePath::direct;
+        case GlareModel::cie:
+            return GlarePath::veil;
+        case GlareModel::wave_optics:
+        case GlareModel::gaussian_bloom:
+        case GlareModel::spencer:
+        case GlareModel::aperture:
+            break;
+    }
+    return GlarePath::billboard;
+}
+
+GlareModel light_glare_model(const Scene& scene, const Light& light) {
+    return light.glare.value_or(scene.glare.model);
+}
+
+bool any_light_glare(const Scene& scene) {
+    return std::any_of(scene.lights.begin(), scene.lights.end(),
+                       [&](const Light& l) { return light_glare_model(scene, l) != GlareModel::none; });
+}
+
+std::vector<GlareModel> glare_models_used(const Scene& scene) {
+    std::vector<GlareModel> out{scene.glare.model};
+    for (const Light& l : scene.lights)
+        if (const GlareModel m = light_glare_model(scene, l); std::find(out.begin(), out.end(), m) == out.end())
+            out.push_back(m);
+    return out;
+}
+
 std::string_view spectral_path_name(SpectralPath p) {
     switch (p) {
         case SpectralPath::anchored:
@@ -183,6 +215,7 @@ ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_
 
 struct GlareStage::Impl {
     struct Group {
+        GlareModel model = GlareModel::none;
         std::string spd;
         std::string key;
         std::optional<RgbPsf> psf;
@@ -194,7 +227,7 @@ struct GlareStage::Impl {
         GlareGroupReport report;
         std::vector<float> envelope;  // billboard crop table (see envelope_buffer())
     };
-    std::map<std::string, Group> groups;  // by SPD name, kept between frames
+    std::map<std::string, Group> groups;  // by model and SPD name ("wave-optics|D65"), kept between frames
     std::vector<std::string> order;       // this frame's groups, index = group id
     std::vector<GlareGroupReport> reports;
     std::vector<unsigned> light_groups;
@@ -211,10 +244,13 @@ struct GlareStage::Impl {
     }
 
     void build_kernel(Group& g, const Scene& scene, double ppd, double time_s, double pupil_mm) {
-        const GlareSettings& gs = scene.glare;
+        // The eye's settings with the group's model (a light may ask for its own).
+        GlareSettings gs = scene.glare;
+        gs.model = g.model;
         const SpectralSamples samples = spectral_samples(spd_for(g.spd), gs.spectral_samples);
         g.psf.reset();
         g.report = {};
+        g.report.model = g.model;
         g.report.spd = g.spd;
         g.report.pupil_mm = pupil_mm;
         switch (gs.model) {
@@ -336,36 +372,45 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     m.reports.clear();
     m.light_groups.assign(scene.lights.size(), 0u);
     m.envelope_stride = 0;
-    // `cie` has no billboards: the frame renderer convolves the whole frame (veiling_glare.h).
-    if (gs.model == GlareModel::none || gs.model == GlareModel::cie) return 0.0;
 
-    // SPD groups in order of first appearance.
+    // Groups of (model, SPD) in order of first appearance, for the lights whose
+    // model draws a billboard; `none` and `cie` lights have none (the frame
+    // renderer draws their direct images, and convolves the `cie` ones).
+    std::vector<GlareModel> group_models;
+    std::vector<std::string> group_spds;
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const GlareModel model = light_glare_model(scene, scene.lights[i]);
+        if (glare_path(model) != GlarePath::billboard) continue;
         const std::string& spd = scene.lights[i].spd;
-        auto it = std::find(m.order.begin(), m.order.end(), spd);
+        const std::string name = fmt::format("{}|{}", glare_model_name(model), spd);
+        auto it = std::find(m.order.begin(), m.order.end(), name);
         if (it == m.order.end()) {
-            m.order.push_back(spd);
+            m.order.push_back(name);
+            group_models.push_back(model);
+            group_spds.push_back(spd);
             it = m.order.end() - 1;
         }
         m.light_groups[i] = static_cast<unsigned>(it - m.order.begin());
     }
+    if (m.order.empty()) return 0.0;
 
     // The kernel depends on these, and only these: rebuilt when one changes.
     const double ppd = scene.display.pixels_per_degree_at_centre();
     const double pupil = glare_pupil_mm(scene);
-    const double pupil_now = cached_pupil_mm(gs.model == GlareModel::wave_optics ? [&] {
-        EyeModel eye = gs.eye;
-        eye.pupil_diameter_mm = pupil;
-        return pupil_diameter_mm_at(eye, time_s);
-    }() : pupil, gs.pupil_tolerance_mm);
+    auto pupil_for = [&](GlareModel model) {
+        return cached_pupil_mm(model == GlareModel::wave_optics ? [&] {
+            EyeModel eye = gs.eye;
+            eye.pupil_diameter_mm = pupil;
+            return pupil_diameter_mm_at(eye, time_s);
+        }() : pupil, gs.pupil_tolerance_mm);
+    };
     const EyeModel& e = gs.eye;
     std::string common;
     auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
-    add(glare_model_name(gs.model), gs.psf_size, gs.spectral_samples, spectral_path_name(gs.spectral_path),
-        gs.spectral_anchors, glare_window_name(gs.window),
-        gs.radius_deg.value_or(-1), gs.bloom_sigma_deg, static_cast<int>(spencer_vision_for(scene)));
-    // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
-    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd, pupil_now);
+    add(gs.psf_size, gs.spectral_samples, spectral_path_name(gs.spectral_path), gs.spectral_anchors,
+        glare_window_name(gs.window), gs.radius_deg.value_or(-1), gs.bloom_sigma_deg,
+        static_cast<int>(spencer_vision_for(scene)));
+    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd);
     add(e.hippus.enabled, e.hippus.amplitude, e.hippus.max_pupil_mm);
     add(e.gratings.enabled, e.gratings.count, e.gratings.inner_radius_mm, e.gratings.width_um, e.gratings.opacity,
         e.gratings.angle_jitter);
@@ -380,6 +425,7 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     const glm::dmat3 view_from_world = glm::transpose(P.world_from_view);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const Light& L = scene.lights[i];
+        if (glare_path(light_glare_model(scene, L)) != GlarePath::billboard) continue;  // no billboard
         const Footprint fp = light_footprint(view_from_world * (L.position_m - P.eye_position_m), L.radius_m,
                                              P.focal_px, P.width_px, P.height_px);
         if (!fp.visible) continue;
@@ -389,8 +435,11 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     double extent = 0;
     for (std::size_t gi = 0; gi < m.order.size(); ++gi) {
         auto& g = m.groups[m.order[gi]];
-        g.spd = m.order[gi];
-        const std::string key = common + "|" + g.spd;
+        g.model = group_models[gi];
+        g.spd = group_spds[gi];
+        // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
+        const double pupil_now = pupil_for(g.model);
+        const std::string key = fmt::format("{}|{}|{}|{}", glare_model_name(g.model), common, pupil_now, g.spd);
         if (g.key != key) {
             m.build_kernel(g, scene, ppd, time_s, pupil_now);
             g.key = key;

@@ -16,7 +16,7 @@ void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
     frame_.render(scene, time_s);
     const OutputSettings& out = scene.output;
     if (const gl::Texture2D* glare = frame_.glare_texture();
-        glare && out.ldr_glare && scene.glare.model != GlareModel::none) {
+        glare && out.ldr_glare && (scene.glare.model != GlareModel::none || any_light_glare(scene))) {
         // The scene as an LDR renderer shows it: exposure to the linear
         // operator's white (the adaptation luminance at the display's own
         // adaptation level), clipped; the glare is tone-mapped and added.
@@ -32,7 +32,7 @@ void Pipeline::render_ldr(const gl::Texture2D& ldr, const Scene& scene, double t
     validate_output_settings(scene.output);
     Scene glare_scene = scene;
     glare_scene.output.ldr_glare = true;
-    if (glare_scene.glare.model == GlareModel::none)
+    if (glare_scene.glare.model == GlareModel::none && !any_light_glare(glare_scene))
         throw InputError(
             SourceLocation{"", 0, 0, "eye.glare"},
             "the LDR path adds glare to a display-referred frame; choose a glare model other than \"none\".");

@@ -81,7 +81,7 @@ constexpr std::string_view kSectorKeys[] = {"from_deg", "to_deg", "level", "edge
 constexpr std::string_view kLightKeys[] = {
     "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
     "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
-    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s"};
+    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s",   "glare"};
 constexpr std::string_view kDiscKeys[] = {"name",   "position_m", "diameter_deg", "luminance_cd_m2",
                                           "colour", "xy",         "spd"};
 
@@ -639,6 +639,19 @@ Environment read_environment(const Document& doc, const Section& root) {
     return e;
 }
 
+/// The glare key of [eye] or of a [[light]]: one of the models' names.
+std::optional<GlareModel> read_glare_model(const Section& s) {
+    const auto g = s.string("glare");
+    if (!g) return std::nullopt;
+    auto model = glare_model_from_name(*g);
+    if (!model)
+        s.fail(s.get("glare"), "glare",
+               fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
+                           "\"spencer\", \"aperture\" or \"cie\".",
+                           text::echo(*g)));
+    return model;
+}
+
 /// Returns Scene::adaptation_cd_m2; sets the glare model and pupil.
 double read_eye(const Document& doc, const Section& root, const Environment& environment, GlareSettings& glare,
                 AdaptationSettings& adapt) {
@@ -657,15 +670,7 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
     adapt.stride = s.integer("adaptation_stride", 1, 64).value_or(adapt.stride);
     const double adaptation = s.number_or("adaptation_cd_m2", fallback);
     s.greater_than("adaptation_cd_m2", adaptation, 0.0);
-    if (auto g = s.string("glare")) {
-        auto model = glare_model_from_name(*g);
-        if (!model)
-            s.fail(s.get("glare"), "glare",
-                   fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
-                               "\"spencer\", \"aperture\" or \"cie\".",
-                               *g));
-        glare.model = *model;
-    }
+    if (auto model = read_glare_model(s)) glare.model = *model;
     if (auto p = s.number("pupil_mm")) {
         s.greater_than("pupil_mm", *p, 0.0);
         s.within("pupil_mm", *p, 0.5, 12.0);
@@ -995,6 +1000,7 @@ struct SceneBuilder {
                    fmt::format("give only one of colour, xy and spd; this light has {}.", join(given)));
         light.rgb_per_cd = read_colour(s);
         light.spd = s.string("spd").value_or("");
+        light.glare = read_glare_model(s);
 
         light.orientation = orientation_from_yaw_pitch_roll(s.number_or("yaw_deg", 0.0), s.number_or("pitch_deg", 0.0),
                                                             s.number_or("roll_deg", 0.0));
@@ -1114,7 +1120,17 @@ struct SceneBuilder {
 /// the display's pixels per degree, must fit the glare kernel (4097 px). The
 /// sentence names every key the width comes from, with its line (or --set).
 void check_billboard(const Document& doc, const Section& root, const Scene& scene) {
-    const double radius_deg = glare_billboard_radius_deg(scene.glare);
+    // The widest billboard of the models in use: the eye's, and any a light asks for.
+    GlareSettings widest = scene.glare;
+    double radius_deg = 0.0;
+    for (const GlareModel m : glare_models_used(scene)) {
+        GlareSettings g = scene.glare;
+        g.model = m;
+        if (const double r = glare_billboard_radius_deg(g); r > radius_deg) {
+            radius_deg = r;
+            widest = g;
+        }
+    }
     if (!(radius_deg > 0.0)) return;  // no glare: no billboard
     const double ppd = scene.display.pixels_per_degree_at_centre();
     const double width_px = glare_kernel_width_px(ppd, radius_deg);
@@ -1136,8 +1152,8 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
         radius_node != nullptr
             ? fmt::format("glare.radius_deg = {}{}", number_text(radius_deg), at("glare", "radius_deg"))
             : fmt::format("{:.4g}°, the {} model's default radius{}", radius_deg,
-                          glare_model_name(scene.glare.model),
-                          scene.glare.model == GlareModel::wave_optics || scene.glare.model == GlareModel::aperture
+                          glare_model_name(widest.model),
+                          widest.model == GlareModel::wave_optics || widest.model == GlareModel::aperture
                               ? " for its psf_size"
                               : "");
     const std::string message = fmt::format(
@@ -1192,7 +1208,6 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
                                 : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
     read_glare(doc, root, scene.glare, pupil_mm);
     read_output(doc, root, scene.output);
-    check_billboard(doc, root, scene);
     const Profiles profiles = read_profiles(doc, root);
 
     SceneBuilder builder{doc, scene, profiles, {}};
@@ -1205,6 +1220,7 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
         for (std::size_t i = 0; i < a.size(); ++i) builder.read_light(*a.get(i), i);
     }
     read_discs(root, builder);
+    check_billboard(doc, root, scene);  // after the lights: each may ask for its own glare model
     return scene;
 }
 

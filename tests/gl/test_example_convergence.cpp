@@ -229,5 +229,8 @@ TEST(ExampleConvergence, GlareConstantStimuli) { expect_convergence("glare_const
 TEST(ExampleConvergence, FlashDetection) { expect_convergence("flash_detection.toml"); }
 // Side by side, a glared light against a [[disc]] reference (issue 14 item 5).
 TEST(ExampleConvergence, Suzuki2019GlareMatching) { expect_convergence("suzuki2019_glare_matching.toml"); }
+// Issue 14: a glare test light beside a no-glare reference in one frame, at
+// 0.001, 0.03 and 1 cd/m² (each light its own glare model).
+TEST(ExampleConvergence, GlareSideBySide) { expect_convergence("glare_side_by_side.toml"); }
 
 }  // namespace

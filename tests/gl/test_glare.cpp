@@ -6,6 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -176,6 +179,136 @@ TEST_F(GlareFrames, GlareAndNoGlareFramesHoldTheSameEnergy) {
         std::printf("%-14s glare/no-glare energy %.6f, outside the frame %.4f\n", name.c_str(), with_glare / without,
                     1.0 - kept.g);
     }
+}
+
+TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy) {
+    // Issue 14: a glare light ("a", 1.5° left) and a no-glare light ("b", 1.5°
+    // right) in one frame, for each model `a` may ask for (its own key, and once
+    // inherited from the eye while `b` asks for none). Each keeps its
+    // illuminance (Σ L·Ω, minus what `cie` reports outside the frame), and the
+    // frame is exactly the sum of the frames of each light alone: b's pixels
+    // get b's direct image plus a's real glare spill, nothing else (none at
+    // all from a billboard of 1° radius, 3° away).
+    struct Case {
+        GlareModel eye;
+        std::optional<GlareModel> a;
+    };
+    const Case cases[] = {{GlareModel::none, GlareModel::wave_optics}, {GlareModel::none, GlareModel::gaussian_bloom},
+                          {GlareModel::none, GlareModel::spencer},     {GlareModel::none, GlareModel::cie},
+                          {GlareModel::wave_optics, std::nullopt}};
+    const double d = 1000.0, x = std::tan(1.5 * std::numbers::pi / 180.0);
+    for (const Case& k : cases) {
+        Scene scene = black_scene(k.eye);
+        Light a = light_at(glm::dvec3(-x, 0.003, -1.0) * d, 100.0);
+        a.name = "a";
+        a.glare = k.a;
+        Light b = light_at(glm::dvec3(x, 0.003, -1.0) * d, 40.0);
+        b.name = "b";
+        b.glare = GlareModel::none;
+        const GlareModel a_model = light_glare_model(scene, a);
+        const std::string name = fmt::format("a {} (eye {})", glare_model_name(a_model), glare_model_name(k.eye));
+        const double e_a = 100.0 / glm::dot(a.position_m, a.position_m);
+        const double e_b = 40.0 / glm::dot(b.position_m, b.position_m);
+        const double f = 2880.0;
+
+        auto frame = [&](double a_cd, double b_cd, double& kept_a) {
+            scene.lights = {a, b};
+            scene.lights[0].intensity_cd = a_cd;
+            scene.lights[1].intensity_cd = b_cd;
+            renderer->render(scene, 0.0);
+            const VeilReport& v = renderer->veil_report();
+            EXPECT_EQ(v.applied, light_glare_model(scene, scene.lights[0]) == GlareModel::cie) << name;
+            kept_a = v.applied ? luminance_of_linear_rgb(glm::dvec3(1.0) - v.outside_frame) : 1.0;
+            return renderer->read_hdr();
+        };
+        double kept_a = 1, kept_none = 1, kept_both = 1;
+        const ImageRGBA32F only_a = frame(100.0, 0.0, kept_a);
+        const ImageRGBA32F only_b = frame(0.0, 40.0, kept_none);
+        const ImageRGBA32F both = frame(100.0, 40.0, kept_both);
+        const double got_a = image_illuminance_lux(only_a, f), got_b = image_illuminance_lux(only_b, f);
+        const double got_both = image_illuminance_lux(both, f);
+        std::printf("%-34s a: Σ L·Ω / E %.6f (kept %.4f), b: %.6f, both: %.6f\n", name.c_str(), got_a / e_a, kept_a,
+                    got_b / e_b, got_both / (e_a * kept_a + e_b));
+        EXPECT_NEAR(got_a / (e_a * kept_a), 1.0, 1e-3) << name;
+        EXPECT_NEAR(got_b / e_b, 1.0, 1e-3) << name;
+        EXPECT_NEAR(got_both / (e_a * kept_a + e_b), 1.0, 1e-3) << name;
+        EXPECT_NEAR(kept_both, kept_a, 1e-9) << name << ": the veil is a's alone";
+        // a's model is really applied: a alone differs from a drawn without glare.
+        {
+            const std::optional<GlareModel> own = a.glare;
+            a.glare = GlareModel::none;
+            double unused = 1;
+            const ImageRGBA32F plain_a = frame(100.0, 0.0, unused);
+            a.glare = own;
+            float plain_peak = 0.0f, glare_peak = 0.0f;
+            for (std::size_t i = 0; i < plain_a.rgba.size(); ++i)
+                if (i % 4 != 3) {
+                    plain_peak = std::max(plain_peak, plain_a.rgba[i]);
+                    glare_peak = std::max(glare_peak, only_a.rgba[i]);
+                }
+            EXPECT_LT(glare_peak, 0.9f * plain_peak) << name << ": a's glare spreads its light";
+        }
+
+        // The frame is the sum of the two lights' frames, pixel by pixel (RGB; alpha is not light).
+        float peak = 0.0f;
+        double worst = 0.0;
+        for (std::size_t i = 0; i < both.rgba.size(); ++i) {
+            if (i % 4 == 3) continue;
+            peak = std::max(peak, both.rgba[i]);
+            worst = std::max(worst, std::abs(double(both.rgba[i]) - double(only_a.rgba[i]) - double(only_b.rgba[i])));
+        }
+        EXPECT_LE(worst, 1e-5 * peak) << name;
+        // Around b (its centre ± 12 px): b's direct image and a's spill, which a
+        // billboard 1° wide does not have there; b's pixels are b's own.
+        const int bx = 160 + static_cast<int>(std::lround(f * x)), by = 120;
+        double b_sum = 0.0, a_spill = 0.0;
+        for (int yy = by - 12; yy <= by + 12; ++yy)
+            for (int xx = bx - 12; xx <= bx + 12; ++xx) {
+                b_sum += luminance_of_linear_rgb({only_b.pixel(xx, yy)[0], only_b.pixel(xx, yy)[1],
+                                                  only_b.pixel(xx, yy)[2]});
+                a_spill += luminance_of_linear_rgb({only_a.pixel(xx, yy)[0], only_a.pixel(xx, yy)[1],
+                                                    only_a.pixel(xx, yy)[2]});
+                if (glare_path(a_model) == GlarePath::billboard) {
+                    for (int c = 0; c < 3; ++c) {
+                        EXPECT_EQ(both.pixel(xx, yy)[c], only_b.pixel(xx, yy)[c]) << name;
+                    }
+                }
+            }
+        EXPECT_GT(b_sum, 0.0) << name << ": b is drawn within ±12 px of its centre";
+        if (a_model == GlareModel::cie) {
+            EXPECT_GT(a_spill, 0.0) << name << ": the veil reaches b";
+        }
+        if (glare_path(a_model) == GlarePath::billboard) {
+            EXPECT_EQ(a_spill, 0.0) << name;
+        }
+    }
+}
+
+TEST_F(GlareFrames, LdrPathTakesTheGlareOfTheGlareLightsOnly) {
+    // K2012 §6.2.2 with lights of their own models: every direct image in the
+    // HDR frame, and in the glare buffer only the glare of the light that has a
+    // model (a), none of b's.
+    const double d = 1000.0, x = std::tan(1.5 * std::numbers::pi / 180.0), f = 2880.0;
+    Scene scene = black_scene(GlareModel::none);
+    scene.output.ldr_glare = true;
+    Light a = light_at(glm::dvec3(-x, 0.003, -1.0) * d, 100.0);
+    a.glare = GlareModel::gaussian_bloom;
+    Light b = light_at(glm::dvec3(x, 0.003, -1.0) * d, 40.0);
+    scene.lights = {a, b};
+    const double e_a = 100.0 / glm::dot(a.position_m, a.position_m);
+    const double e_b = 40.0 / glm::dot(b.position_m, b.position_m);
+    renderer->render(scene, 0.0);
+    const double direct = image_illuminance_lux(renderer->read_hdr(), f);
+    ASSERT_NE(renderer->glare_texture(), nullptr);
+    ImageRGBA32F glare;
+    glare.width = renderer->glare_texture()->width();
+    glare.height = renderer->glare_texture()->height();
+    glare.rgba = renderer->glare_texture()->download_floats();  // rows bottom-up: Σ L·Ω is the same
+    const double glare_lux = image_illuminance_lux(glare, f);
+    std::printf("ldr path: HDR Σ L·Ω / (E_a + E_b) %.6f, glare buffer / E_a %.6f\n", direct / (e_a + e_b),
+                glare_lux / e_a);
+    EXPECT_NEAR(direct / (e_a + e_b), 1.0, 1e-3);
+    EXPECT_NEAR(glare_lux / e_a, 1.0, 1e-3);
 }
 
 TEST_F(GlareFrames, CieVeilOfOneLightIsTheCie146EquationAndKeepsItsEnergy) {

@@ -39,7 +39,8 @@ fs::path example(std::string_view name) {
 }
 
 const std::vector<std::string> kExamples = {"glare_brightness_2afc.toml", "glare_brightness_adjust.toml",
-                                            "glare_constant_stimuli.toml", "flash_detection.toml"};
+                                            "glare_constant_stimuli.toml", "flash_detection.toml",
+                                            "glare_side_by_side.toml"};
 
 // ---- A toy renderer ---------------------------------------------------------
 //
@@ -60,6 +61,7 @@ struct ToyLight {
     double intensity_cd = 0.0;
     std::array<double, 3> position_m{};
     bool flashing = false;
+    std::string glare;  ///< its own glare model; empty: the eye's
 };
 
 struct ToyScene {
@@ -79,8 +81,13 @@ ToyScene toy_from_scene(const fs::path& scene_file) {
     t.adaptation_cd_m2 = s.adaptation_cd_m2;
     t.glare = std::string(atonlab::stimuli::glare_model_name(s.glare.model));
     for (const auto& l : s.lights)
-        t.lights.push_back(
-            {l.name, l.intensity_cd, {l.position_m.x, l.position_m.y, l.position_m.z}, l.rhythm_period_s > 0.0});
+        t.lights.push_back({l.name,
+                            l.intensity_cd,
+                            {l.position_m.x, l.position_m.y, l.position_m.z},
+                            l.rhythm_period_s > 0.0,
+                            l.glare ? std::string(atonlab::stimuli::glare_model_name(
+                                          l.glare.value_or(atonlab::stimuli::GlareModel::none)))
+                                    : std::string()});
     return t;
 }
 
@@ -130,6 +137,8 @@ void apply(ToyScene& t, const std::string& text) {
             l.position_m = parse_vec3(value);
         else if (field == "rhythm")
             l.flashing = unquote(value) != "F";
+        else if (field == "glare")
+            l.glare = unquote(value);
         else
             throw std::runtime_error("toy renderer: unknown light key " + key);
     } else {
@@ -163,11 +172,12 @@ DisplayedImage toy_render(const ToyScene& t) {
     img.deg_per_px = kToyDegPerPx;
     std::vector<double> l(static_cast<std::size_t>(kToySize * kToySize), t.background_cd_m2);
     const double pupil_mm = 4.9 - 3.0 * std::tanh(0.4 * (std::log10(t.adaptation_cd_m2) + 1.0));  // K2012 eq 3.15
-    const double sigma_deg = t.glare == "none" ? 0.02 : 0.06 * pupil_mm;
-    const double sigma_px = sigma_deg / kToyDegPerPx;
-    const double sigma_rad = sigma_deg * std::numbers::pi / 180.0;
     for (const ToyLight& light : t.lights) {
         if (light.intensity_cd <= 0.0) continue;
+        const std::string& glare = light.glare.empty() ? t.glare : light.glare;
+        const double sigma_deg = glare == "none" ? 0.02 : 0.06 * pupil_mm;
+        const double sigma_px = sigma_deg / kToyDegPerPx;
+        const double sigma_rad = sigma_deg * std::numbers::pi / 180.0;
         const double dx = light.position_m[0] - t.camera_m[0];
         const double dy = light.position_m[1] - t.camera_m[1];
         const double dz = light.position_m[2] - t.camera_m[2];
@@ -647,6 +657,125 @@ procedure = { kind = "staircase", start = 1.0, step_type = "lin", n_reversals = 
               "the condition, its [[block]] or [defaults].");
 }
 
+// ---- Conflicting overrides (docs/protocol-file.md "When two overrides set one key") ----
+
+/// A two-interval or side-by-side 2AFC block with the given condition keys.
+std::string conflict_case(const std::string& presentation, const std::string& defaults, const std::string& block,
+                          const std::string& condition) {
+    return "[defaults]\ntask = \"2afc\"\npresentation = \"" + presentation +
+           "\"\ntest_light = \"t\"\nreference_light = \"r\"\n" +
+           (presentation == "side-by-side"
+                ? "left_position_m = [-10.0, 3.0, -500.0]\nright_position_m = [10.0, 3.0, -500.0]\n"
+                : "\n\n") +  // (the same line numbers either way)
+           std::string("level_key = \"light.r.intensity_cd\"\n"
+           "procedure = { kind = \"staircase\", start = 1.0, step_type = \"lin\", n_reversals = 4 }\n") +
+           defaults + "\n[[block]]\n" + block + "\n[[block.condition]]\nname = \"c\"\n" + condition + "\n";
+}
+
+std::string conflict_error(const std::string& text) {
+    try {
+        (void)parse(text);
+    } catch (const ProtocolError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(ProtocolConflicts, SideBySideTestAndReferenceSetsMustAgree) {
+    // The issue's case: the eye is one for both lights of the frame.
+    const std::string e = conflict_error(conflict_case(
+        "side-by-side", "test_set = ['eye.glare=\"wave-optics\"']\nreference_set = ['eye.glare=\"none\"']", "", ""));
+    EXPECT_NE(e.find("inline.toml:20: key 'defaults.reference_set[0]'"), std::string::npos) << e;
+    EXPECT_NE(e.find("eye.glare is set to \"none\" here and to \"wave-optics\" by defaults.test_set[0] (line 19)"),
+              std::string::npos)
+        << e;
+    // The same lists in a two-interval design switch the eye per interval: fine.
+    EXPECT_EQ(conflict_error(conflict_case("two-interval",
+                                           "test_set = ['eye.glare=\"wave-optics\"']\nreference_set = "
+                                           "['eye.glare=\"none\"']",
+                                           "", "")),
+              "");
+    // Each light its own model: different keys, one frame.
+    const Protocol p = parse(conflict_case(
+        "side-by-side", "test_set = ['light.t.glare=\"wave-optics\"']\nreference_set = ['light.r.glare=\"none\"']", "",
+        ""));
+    const Condition& c = p.blocks[0].conditions[0];
+    Proposal prop;
+    prop.level = 0.5;
+    prop.test_on_left = true;
+    const Stimulus stimulus = make_stimulus(p, c, prop);
+    const auto& o = stimulus.frames[0].overrides;
+    EXPECT_NE(std::find(o.begin(), o.end(), "light.t.glare=\"wave-optics\""), o.end());
+    EXPECT_NE(std::find(o.begin(), o.end(), "light.r.glare=\"none\""), o.end());
+    // Equal values are not a conflict (numbers compare as numbers).
+    EXPECT_EQ(conflict_error(conflict_case("side-by-side", "test_set = ['eye.pupil_mm=4']\nreference_set = "
+                                                           "['eye.pupil_mm=4.0']",
+                                           "", "")),
+              "");
+}
+
+TEST(ProtocolConflicts, ABlockAndItsConditionMustAgree) {
+    const std::string e = conflict_error(
+        conflict_case("two-interval", "", "set = ['tonemap.operator=\"empirical\"']", "set = ['tonemap.operator=\"perceptual\"']"));
+    EXPECT_NE(e.find("key 'block[0].condition[0].set[0]'"), std::string::npos) << e;
+    EXPECT_NE(e.find("tonemap.operator is set to \"perceptual\" here and to \"empirical\" by block[0].set[0]"),
+              std::string::npos)
+        << e;
+    EXPECT_NE(e.find("a condition and its block"), std::string::npos) << e;
+    // One list twice.
+    EXPECT_NE(conflict_error(conflict_case("two-interval", "", "set = ['eye.pupil_mm=3', 'eye.pupil_mm=5']", ""))
+                  .find("one list sets it twice"),
+              std::string::npos);
+}
+
+TEST(ProtocolConflicts, DefaultsAndRoleListsReplaceByDesign) {
+    // A block replaces a default, in any presentation; the default is dropped.
+    for (const std::string presentation : {"two-interval", "side-by-side"}) {
+        SCOPED_TRACE(presentation);
+        const Protocol p = parse(conflict_case(presentation, "test_set = ['eye.pupil_mm=3']", "set = ['eye.pupil_mm=5']", ""));
+        const Condition& c = p.blocks[0].conditions[0];
+        Proposal prop;
+        prop.level = 0.5;
+        prop.test_on_left = true;
+        const Stimulus s = make_stimulus(p, c, prop);
+        // The test's frame (the only frame side by side): the last pupil_mm is the block's in side-by-side; in a
+        // two-interval test frame the role's list replaces `set` (the default's 3).
+        std::string last;
+        for (const std::string& o : s.frames[0].overrides)
+            if (o.starts_with("eye.pupil_mm=")) last = o;
+        if (presentation == "side-by-side") {
+            EXPECT_EQ(last, "eye.pupil_mm=5");
+        } else if (s.frames[0].role == Role::Test) {
+            EXPECT_EQ(last, "eye.pupil_mm=3");
+        }
+    }
+    // Two-interval: a block's set and the defaults' role list (the glare examples'
+    // light.test.intensity_cd) are fine; side by side a block's set and a
+    // block's reference_set on one key are not.
+    EXPECT_EQ(conflict_error(conflict_case("two-interval", "reference_set = ['light.t.intensity_cd=0']",
+                                           "set = ['light.t.intensity_cd=0.002']", "")),
+              "");
+    EXPECT_NE(conflict_error(conflict_case("side-by-side", "", "set = ['light.t.intensity_cd=0.002']",
+                                           "reference_set = ['light.t.intensity_cd=0']"))
+                  .find("a side-by-side frame holds both lights, and set and reference_set both apply"),
+              std::string::npos);
+}
+
+TEST(ProtocolConflicts, TheLevelAndTheSideBySidePositionsAreNotOverridden) {
+    const std::string level = conflict_error(conflict_case("two-interval", "", "reference_set = ['light.r.intensity_cd=5']", ""));
+    EXPECT_NE(level.find("light.r.intensity_cd is set to 5 here, but it is the level_key (defaults.level_key)"),
+              std::string::npos)
+        << level;
+    // In the frame the level is not on, the key is free.
+    EXPECT_EQ(conflict_error(conflict_case("two-interval", "test_set = ['light.r.intensity_cd=0']", "", "")), "");
+    EXPECT_NE(conflict_error(conflict_case("side-by-side", "test_set = ['light.r.intensity_cd=0']", "", ""))
+                  .find("it is the level_key"),
+              std::string::npos);
+    EXPECT_NE(conflict_error(conflict_case("side-by-side", "set = ['light.t.position_m=[0, 3, -500]']", "", ""))
+                  .find("a side-by-side frame places its lights at left_position_m and right_position_m"),
+              std::string::npos);
+}
+
 // ---- Malformed files -------------------------------------------------------------
 
 struct Bad {
@@ -885,6 +1014,10 @@ TEST(ProtocolConvergence, EveryExampleFindsTheModelObserversTruePoint) {
     params.noise_sd_log10 = 0.03;
     params.lapse_rate = 0.02;
     for (const std::string& name : kExamples) {
+        // Its lights stand 5° either side of the centre, outside the toy's
+        // 2.56° field; tests/gl/test_example_convergence.cpp runs it on the
+        // real renderer (GL.ExampleConvergence.GlareSideBySide).
+        if (name == "glare_side_by_side.toml") continue;
         const Protocol p = load_protocol(example(name));
         const ToyScene base = toy_from_scene(p.scene);
         std::map<std::string, double> truths;

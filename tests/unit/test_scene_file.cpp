@@ -433,6 +433,41 @@ TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
         EXPECT_EQ(glare_model_name(*glare_model_from_name(m)), m);
 }
 
+TEST(SceneFileGlare, EachLightMayGiveItsOwnModel) {
+    // Issue 14: [[light]] glare overrides [eye] glare for that light; --set reaches it.
+    const std::string text = std::string(kMinimal) +
+                             "[eye]\nglare = \"wave-optics\"\n"
+                             "[[light]]\nname = \"test\"\nposition_m = [0, 2, -500]\nintensity_cd = 1\n"
+                             "[[light]]\nname = \"reference\"\nposition_m = [0, 2, -500]\nintensity_cd = 1\n"
+                             "glare = \"none\"\n";
+    const Scene s = parse_scene(text, kFile);
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_FALSE(s.lights[0].glare.has_value());
+    EXPECT_EQ(light_glare_model(s, s.lights[0]), GlareModel::wave_optics);  // the eye's
+    EXPECT_EQ(light_glare_model(s, s.lights[1]), GlareModel::none);         // its own
+    EXPECT_TRUE(any_light_glare(s));
+    EXPECT_EQ(glare_models_used(s), (std::vector<GlareModel>{GlareModel::wave_optics, GlareModel::none}));
+    const Scene set = parse_scene(text, kFile, sets({"light.test.glare=\"cie\"", "light.reference.glare=\"spencer\"",
+                                                     "eye.glare=\"none\""}));
+    EXPECT_EQ(light_glare_model(set, set.lights[0]), GlareModel::cie);
+    EXPECT_EQ(light_glare_model(set, set.lights[1]), GlareModel::spencer);
+    EXPECT_EQ(set.glare.model, GlareModel::none);
+    EXPECT_EQ(glare_path(GlareModel::none), GlarePath::direct);
+    EXPECT_EQ(glare_path(GlareModel::cie), GlarePath::veil);
+    EXPECT_EQ(glare_path(GlareModel::spencer), GlarePath::billboard);
+    // An unknown model names the light's key and line.
+    const std::string bad = with_light("position_m = [0, 2, -100]\nintensity_cd = 1\nglare = \"sparkle\"\n");
+    expect_error_at(bad, line_of(bad, "glare = \"sparkle\""), "light[0].glare", "unknown glare model \"sparkle\"");
+    // The billboard's width limit holds for a light's own model too (the eye has none).
+    // (45° at 126 px per degree: over 11 000 px.)
+    const std::string narrow = "[display]\nwidth_px = 800\nheight_px = 600\nwidth_m = 0.1\nviewing_distance_m = 0.9\n"
+                               "[glare]\nradius_deg = 45\n";
+    const std::string wide =
+        narrow + "[[light]]\nposition_m = [0, 2, -100]\nintensity_cd = 1\nglare = \"gaussian-bloom\"\n";
+    EXPECT_NE(std::string(error_of(wide).what()).find("the glare billboard is"), std::string::npos);
+    EXPECT_NO_THROW(parse_scene(narrow, kFile));
+}
+
 TEST(SceneFileGlare, CieModelAndObserverAreRead) {
     const std::string text =
         std::string(kMinimal) + "[eye]\nglare = \"cie\"\ncie_age_years = 62\ncie_pigmentation = 1.0\n";

@@ -87,8 +87,10 @@ struct Trial {
     // --- the stimulus, from the stored overrides (absent where not stated) ------
     std::optional<double> adaptation_cd_m2;   ///< eye.adaptation_cd_m2, cd/m²
     std::string tone_operator;                ///< tonemap.operator
-    std::string glare_test;                   ///< eye.glare in the test's frame
-    std::string glare_reference;              ///< eye.glare in the reference's frame
+    /// The glare model the test light was drawn with (the stored view's, else
+    /// light.NAME.glare or eye.glare in the test's frame)
+    std::string glare_test;
+    std::string glare_reference;              ///< the same for the reference light
     std::optional<double> test_intensity_cd;  ///< the test light's intensity_cd, cd
 
     // --- what the procedure implies -----------------------------------------------

@@ -1,6 +1,6 @@
 #pragma once
 // The glare stage of one frame (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3,
-// §5.3): per SPD, the glare kernel of the scene's model, its area layers up to
+// §5.3): per billboard model and SPD (each light's own model, else the eye's), the glare kernel, its area layers up to
 // the largest projected radius the scene needs, and the billboards that draw
 // each visible light's glare in place of its direct image. Caches everything
 // that did not change since the last frame. Needs a current GL 4.5 context.
@@ -19,6 +19,7 @@ struct CameraProjection;
 
 /// What the glare stage used for one SPD group in the last frame.
 struct GlareGroupReport {
+    GlareModel model = GlareModel::none;  ///< the group's model (the eye's, or its lights' own)
     std::string spd;               ///< "" = D65
     double pupil_mm = 0;           ///< the pupil the PSF was computed for (wave-optics)
     double degrees_per_texel = 0;  ///< the PSF's angular texel (wave-optics, aperture)
@@ -94,7 +95,8 @@ public:
     /// The RGB PSF of group g (wave-optics, aperture), for files and tests.
     const RgbPsf* psf(std::size_t group) const;
     const GlareKernel* kernel(std::size_t group) const;
-    /// The SPD group index each light of the last prepared scene uses.
+    /// The (model, SPD) group index each light of the last prepared scene
+    /// uses; 0 for a light whose model draws no billboard (`none`, `cie`).
     const std::vector<unsigned>& light_groups() const;
 
 private:

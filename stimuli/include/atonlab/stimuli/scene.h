@@ -65,6 +65,8 @@ struct ProfileTables {
 /// One ATON light (K2012 §4.1): an isotropic sphere of radius radius_m shielded
 /// by its profiles, modulated by its rhythm. One colour: a sectored lighthouse is
 /// several lights sharing a position and a horizontal profile table.
+enum class GlareModel : std::uint8_t;
+
 struct Light {
     std::string name;
     glm::dvec3 position_m{0.0};
@@ -80,6 +82,9 @@ struct Light {
     /// The SPD its glare is integrated with (a named_spectrum()); empty: D65,
     /// for lights given by an IALA colour or xy (K2012 §4.2.4, eq 4.10).
     std::string spd;
+    /// Its own glare model ([[light]] glare); nullopt: the eye's ([eye] glare).
+    /// The models' settings ([glare], the eye's PSF) are shared by all lights.
+    std::optional<GlareModel> glare;
 };
 
 /// A uniform disc of luminance: the extended reference of luminance-matching
@@ -120,6 +125,12 @@ enum class SpectralPath : std::uint8_t {
 std::string_view spectral_path_name(SpectralPath p);
 std::optional<SpectralPath> spectral_path_from_name(std::string_view name);
 
+/// How a glare model draws a light: its direct image only (`none`), a glare
+/// billboard in place of the direct image (the PSF models), or its direct
+/// image convolved with the whole-frame veil (`cie`).
+enum class GlarePath : std::uint8_t { direct = 0, billboard = 1, veil = 2 };
+GlarePath glare_path(GlareModel m);
+
 struct GlareSettings {
     GlareModel model = GlareModel::none;
     /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).
@@ -159,5 +170,12 @@ struct Scene {
     /// adaptation_cd_m2.
     OutputSettings output;
 };
+
+/// The glare model a light is drawn with: its own, else the eye's (docs/scene-file.md "[[light]]").
+GlareModel light_glare_model(const Scene& scene, const Light& light);
+/// Whether any light of the scene is drawn with glare (a model other than `none`).
+bool any_light_glare(const Scene& scene);
+/// Every glare model the scene uses: the eye's, then each light's own, each once.
+std::vector<GlareModel> glare_models_used(const Scene& scene);
 
 }  // namespace atonlab::stimuli

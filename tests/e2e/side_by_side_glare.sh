@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# side_by_side_glare.sh ATONLAB PROTOCOL OUTDIR
+# Issue 14, end to end: a side-by-side 2AFC whose test light has its own
+# wave-optics glare and whose reference has none (test_set / reference_set on
+# light.NAME.glare) runs with the model observer; every stored trial names
+# each view's glare model (stimulus_json views[].glare), and `atonlab analyze`
+# reports "wave-optics" on the test and "none" on the reference (trials.csv
+# and report.html). Exit 77 (a skip) where no GL 4.5 context exists.
+set -uo pipefail
+atonlab=$1 protocol=$2 outdir=$3
+rm -rf "$outdir" && mkdir -p "$outdir"
+"$atonlab" run "$protocol" --db "$outdir/study.db" --model-observer --headless --no-true-pse >"$outdir/run.out" 2>"$outdir/run.err"
+status=$?
+if [ "$status" -eq 3 ]; then echo "skipped: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
+if [ "$status" -ne 0 ]; then echo "atonlab run failed ($status):"; cat "$outdir/run.err"; exit 1; fi
+fail=0
+# The stored views (read with the sqlite3 shell where it is installed).
+if command -v sqlite3 >/dev/null; then
+  n=$(sqlite3 "$outdir/study.db" "SELECT count(*) FROM trials")
+  both=$(sqlite3 "$outdir/study.db" "SELECT count(*) FROM trials WHERE stimulus_json LIKE '%\"role\":\"test\",\"glare\":\"wave-optics\"%' AND stimulus_json LIKE '%\"role\":\"reference\",\"glare\":\"none\"%'")
+  if [ "$n" -lt 2 ] || [ "$both" -ne "$n" ]; then echo "$both of $n stored trials name both views' glare"; fail=1; fi
+else
+  echo "(sqlite3 shell not installed: the stored views are checked through the analysis only)"
+fi
+"$atonlab" analyze "$outdir/study.db" --out "$outdir/report" --bootstrap 50 >"$outdir/analyze.out" 2>"$outdir/analyze.err"
+status=$?
+if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "skipped: gnuplot is not installed"; exit 77; fi
+if [ "$status" -ne 0 ]; then echo "atonlab analyze failed ($status):"; cat "$outdir/analyze.err"; exit 1; fi
+# trials.csv: glare_test and glare_reference columns.
+header=$(head -1 "$outdir/report/trials.csv")
+col() { echo "$header" | tr ',' '\n' | grep -nx "$1" | cut -d: -f1; }
+gt=$(col glare_test) gr=$(col glare_reference)
+pairs=$(tail -n +2 "$outdir/report/trials.csv" | cut -d, -f"$gt,$gr" | sort -u)
+if [ "$pairs" != "wave-optics,none" ]; then echo "trials.csv glare_test,glare_reference: $pairs"; fail=1; fi
+if ! grep -q "glare wave-optics on the test and none on the reference" "$outdir/report/report.html"; then
+  echo "report.html does not name each side's glare model"; fail=1
+fi
+echo "glare test/reference: $pairs"
+exit $fail
