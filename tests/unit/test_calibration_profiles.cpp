@@ -84,7 +84,11 @@ CheckOutcome check(store::Store& file, const store::Calibration& cal, const stim
                    const std::string& date, const CheckTolerances& tol = {}) {
     std::vector<PhotometerReading> readings;
     for (const Patch& p : check_patches())
-        readings.push_back({scale * stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8), std::nullopt, std::nullopt});
+        {
+        PhotometerReading r;
+        r.luminance_cd_m2 = scale * stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8);
+        readings.push_back(r);
+    }
     const CheckOutcome o = evaluate_check(display_model_of(cal), check_patches(), readings, tol);
     store::CalibrationCheck k;
     k.calibration = cal.id;
