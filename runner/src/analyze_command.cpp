@@ -9,6 +9,7 @@
 // PNGs for the report with the CPU references of the tone mapper and the
 // sRGB curve.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -167,21 +168,59 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
         tiles.push_back({x0, y0, w, h});
     }
-    const int gap = 8;
-    int width = 0, height = 0;
+    // Each frame tone-mapped (display-relative linear values, 0..1), then drawn
+    // twice: as is (top row) and, beneath it, stretched about its background
+    // (the tile's median) by a power of two that brings its brightest pixel
+    // near white, so that a dim light and its glare can be seen (docs/analysis.md,
+    // "Stimulus pictures"). The factors are stated in the caption.
+    struct Mapped {
+        std::vector<glm::dvec3> v;
+        double background = 0.0, peak = 0.0;
+        double stretch = 1.0;
+    };
+    std::vector<Mapped> mapped;
     for (const Tile& t : tiles) {
-        width += t.w + (width ? gap : 0);
-        height = std::max(height, t.h);
-    }
-    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
-    int left = 0;
-    for (const Tile& t : tiles) {
-        for (int y = 0; y < t.h; ++y) {
+        Mapped m;
+        std::vector<double> luma;
+        for (int y = 0; y < t.h; ++y)
             for (int x = 0; x < t.w; ++x) {
                 const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
-                const glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                for (int k = 0; k < 3; ++k) d[k] = std::clamp(d[k], 0.0, 1.0);
+                m.v.push_back(d);
+                luma.push_back(0.2126 * d.r + 0.7152 * d.g + 0.0722 * d.b);
+            }
+        m.peak = luma.empty() ? 0.0 : *std::max_element(luma.begin(), luma.end());
+        std::nth_element(luma.begin(), luma.begin() + static_cast<std::ptrdiff_t>(luma.size() / 2), luma.end());
+        m.background = luma.empty() ? 0.0 : luma[luma.size() / 2];
+        // The largest power of two (1 to 4096) that keeps the peak at or below 90% of white.
+        if (m.peak > m.background)
+            m.stretch = std::clamp(std::exp2(std::floor(std::log2((0.9 - m.background) / (m.peak - m.background)))),
+                                   1.0, 4096.0);
+        mapped.push_back(std::move(m));
+    }
+    const int gap = 8;
+    int width = 0, row = 0;
+    for (const Tile& t : tiles) {
+        width += t.w + (width ? gap : 0);
+        row = std::max(row, t.h);
+    }
+    const int height = 2 * row + gap;
+    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
+    int left = 0;
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+        const Tile& t = tiles[i];
+        const Mapped& m = mapped[i];
+        for (int y = 0; y < t.h; ++y) {
+            for (int x = 0; x < t.w; ++x) {
+                const glm::dvec3& d = m.v[static_cast<std::size_t>(y) * t.w + x];
                 float* q = &rgb[(static_cast<std::size_t>(y) * width + left + x) * 3];
-                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(d[k], 0.0, 1.0)));
+                float* r = &rgb[(static_cast<std::size_t>(y + row + gap) * width + left + x) * 3];
+                for (int k = 0; k < 3; ++k) {
+                    q[k] = static_cast<float>(stimuli::srgb_encode(d[k]));
+                    const double stretched = m.background + m.stretch * (d[k] - m.background);
+                    r[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(stretched, 0.0, 1.0)));
+                }
             }
         }
         left += t.w + gap;
@@ -191,12 +230,17 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     } catch (const std::exception& e) {
         return e.what();
     }
+    std::string factors;
+    for (const Mapped& m : mapped) factors += fmt::format("{}×{:g}", factors.empty() ? "" : ", ", m.stretch);
     caption = fmt::format(
         "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames left to right in "
         "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
-        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).",
+        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding). Top row: "
+        "as displayed. Bottom row: the same frames stretched about their background (each tile's median) by {} "
+        "(left to right), so that a dim light and its glare can be seen; the stretch is for the reader, not what "
+        "the observer saw.",
         c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
-        stimuli::tone_operator_name(tm.tone_operator), adaptation);
+        stimuli::tone_operator_name(tm.tone_operator), adaptation, factors);
     return {};
 }
 
@@ -346,6 +390,10 @@ int run_analyze(const AnalyzeOptions& o) {
             if (!h.reliable && !h.reason.empty()) line += "; unreliable: " + h.reason;
             std::printf("%s\n", line.c_str());
         }
+        for (const an::SessionInfo& s : data.sessions)
+            if (s.displayable == false)
+                std::printf("  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
+                            s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
         const std::size_t notes = results.warnings.size() + plots.problems.size() + ctx.problems.size();
         if (notes) std::printf("%zu note(s) and warning(s): see the report\n", notes);
         std::printf("report: %s\n", (out_dir / "report.html").string().c_str());

@@ -194,9 +194,18 @@ CREATE TRIGGER calibration_checks_append_only_delete BEFORE DELETE ON calibratio
 BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be deleted'); END;
 )sql";
 
-constexpr std::array<Migration, 2> migrations = {
+// Version 3: what the display showed of each condition's stimuli, worked out
+// before the first trial (docs/running.md, "Displayability"), and whether the
+// session ran with --allow-undisplayable. NULL for sessions from before.
+constexpr std::string_view schema_v3 = R"sql(
+ALTER TABLE sessions ADD COLUMN displayability_json TEXT
+    CHECK (displayability_json IS NULL OR json_valid(displayability_json));
+)sql";
+
+constexpr std::array<Migration, 3> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
     Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
+    Migration{3, "sessions.displayability_json", schema_v3},
 };
 
 }  // namespace
