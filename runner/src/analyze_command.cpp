@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -175,28 +176,41 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     // "Stimulus pictures"). The factors are stated in the caption.
     struct Mapped {
         std::vector<glm::dvec3> v;
-        double background = 0.0, peak = 0.0;
+        glm::dvec3 background{0.0};  ///< per channel: the tile's median (a dim light leaves it the background)
         double stretch = 1.0;
     };
     std::vector<Mapped> mapped;
     for (const Tile& t : tiles) {
         Mapped m;
-        std::vector<double> luma;
+        std::array<std::vector<double>, 3> channel;
         for (int y = 0; y < t.h; ++y)
             for (int x = 0; x < t.w; ++x) {
                 const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
                 glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
-                for (int k = 0; k < 3; ++k) d[k] = std::clamp(d[k], 0.0, 1.0);
+                for (int k = 0; k < 3; ++k) {
+                    d[k] = std::clamp(d[k], 0.0, 1.0);
+                    channel[static_cast<std::size_t>(k)].push_back(d[k]);
+                }
                 m.v.push_back(d);
-                luma.push_back(0.2126 * d.r + 0.7152 * d.g + 0.0722 * d.b);
             }
-        m.peak = luma.empty() ? 0.0 : *std::max_element(luma.begin(), luma.end());
-        std::nth_element(luma.begin(), luma.begin() + static_cast<std::ptrdiff_t>(luma.size() / 2), luma.end());
-        m.background = luma.empty() ? 0.0 : luma[luma.size() / 2];
-        // The largest power of two (1 to 4096) that keeps the peak at or below 90% of white.
-        if (m.peak > m.background)
-            m.stretch = std::clamp(std::exp2(std::floor(std::log2((0.9 - m.background) / (m.peak - m.background)))),
-                                   1.0, 4096.0);
+        for (int k = 0; k < 3; ++k) {
+            std::vector<double>& values = channel[static_cast<std::size_t>(k)];
+            if (values.empty()) continue;
+            std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
+                             values.end());
+            m.background[k] = values[values.size() / 2];
+        }
+        // The largest power of two (1 to 4096) that keeps every channel's rise
+        // above the background at or below 90% of white.
+        double rise = 0.0, room = 1.0;
+        for (const glm::dvec3& d : m.v)
+            for (int k = 0; k < 3; ++k)
+                if (d[k] - m.background[k] > rise) {
+                    rise = d[k] - m.background[k];
+                    room = 0.9 - m.background[k];
+                }
+        if (rise > 0.0 && room > 0.0)
+            m.stretch = std::clamp(std::exp2(std::floor(std::log2(room / rise))), 1.0, 4096.0);
         mapped.push_back(std::move(m));
     }
     const int gap = 8;
@@ -205,7 +219,9 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         width += t.w + (width ? gap : 0);
         row = std::max(row, t.h);
     }
-    const int height = 2 * row + gap;
+    // Nothing dim enough to need it: one row.
+    const bool stretched_row = std::any_of(mapped.begin(), mapped.end(), [](const Mapped& m) { return m.stretch > 1.0; });
+    const int height = stretched_row ? 2 * row + gap : row;
     std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
     int left = 0;
     for (std::size_t i = 0; i < tiles.size(); ++i) {
@@ -215,10 +231,11 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
             for (int x = 0; x < t.w; ++x) {
                 const glm::dvec3& d = m.v[static_cast<std::size_t>(y) * t.w + x];
                 float* q = &rgb[(static_cast<std::size_t>(y) * width + left + x) * 3];
+                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(d[k]));
+                if (!stretched_row) continue;
                 float* r = &rgb[(static_cast<std::size_t>(y + row + gap) * width + left + x) * 3];
                 for (int k = 0; k < 3; ++k) {
-                    q[k] = static_cast<float>(stimuli::srgb_encode(d[k]));
-                    const double stretched = m.background + m.stretch * (d[k] - m.background);
+                    const double stretched = m.background[k] + m.stretch * (d[k] - m.background[k]);
                     r[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(stretched, 0.0, 1.0)));
                 }
             }
@@ -235,12 +252,15 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     caption = fmt::format(
         "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames left to right in "
         "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
-        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding). Top row: "
-        "as displayed. Bottom row: the same frames stretched about their background (each tile's median) by {} "
-        "(left to right), so that a dim light and its glare can be seen; the stretch is for the reader, not what "
-        "the observer saw.",
+        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).{}",
         c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
-        stimuli::tone_operator_name(tm.tone_operator), adaptation, factors);
+        stimuli::tone_operator_name(tm.tone_operator), adaptation,
+        stretched_row
+            ? fmt::format(" Top row: as displayed. Bottom row: the same frames, each channel stretched about its "
+                          "background (the tile's median) by {} (left to right), so that a dim light and its glare "
+                          "can be seen; the stretch is for the reader, not what the observer saw.",
+                          factors)
+            : std::string(" No frame is dim enough to need a stretched copy."));
     return {};
 }
 

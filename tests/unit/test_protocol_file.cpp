@@ -274,8 +274,8 @@ TEST(ProtocolExamples, ParseWithTheDocumentedShape) {
     EXPECT_EQ(sp.step_sizes, (std::vector<double>{0.2, 0.1, 0.05}));
     EXPECT_EQ(sp.step_type, StepType::Lin);
     EXPECT_EQ(sp.max_trials, 24);
-    EXPECT_EQ(sp.min_level, -3.7);
-    EXPECT_EQ(sp.max_level, -1.7);
+    EXPECT_EQ(sp.min_level, -4.3);
+    EXPECT_EQ(sp.max_level, -2.3);
     EXPECT_EQ(p.responses.keys_of(Action::Left), (std::vector<std::string>{"left", "1"}));
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "2"), Action::Right);
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "escape"), Action::Quit);
