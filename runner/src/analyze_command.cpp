@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -200,17 +201,31 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
                              values.end());
             m.background[k] = values[values.size() / 2];
         }
-        // The largest power of two (1 to 4096) that keeps every channel's rise
-        // above the background at or below 90% of white.
-        double rise = 0.0, room = 1.0;
-        for (const glm::dvec3& d : m.v)
+        // A power of two, 1 to 4096: the largest that keeps every channel's
+        // rise above the background at or below 90% of white, or, where a glare
+        // halo covers more than 1% of the tile, the one that brings the halo's
+        // edge there (the rise of the pixel ranked at 1%) to half of that,
+        // letting the core clip: what the reader needs to see is the halo.
+        std::vector<double> rises;
+        double room = 1.0, top = 0.0;
+        for (const glm::dvec3& d : m.v) {
+            double r = 0.0;
             for (int k = 0; k < 3; ++k)
-                if (d[k] - m.background[k] > rise) {
-                    rise = d[k] - m.background[k];
-                    room = 0.9 - m.background[k];
-                }
-        if (rise > 0.0 && room > 0.0)
-            m.stretch = std::clamp(std::exp2(std::floor(std::log2(room / rise))), 1.0, 4096.0);
+                if (d[k] - m.background[k] > r) r = d[k] - m.background[k];
+            rises.push_back(r);
+            if (r > top) {
+                top = r;
+                room = 0.9 - std::max({m.background.r, m.background.g, m.background.b});
+            }
+        }
+        if (top > 0.0 && room > 0.0) {
+            double factor = room / top;
+            const std::size_t rank = rises.size() / 100;
+            std::nth_element(rises.begin(), rises.begin() + static_cast<std::ptrdiff_t>(rank), rises.end(),
+                             std::greater<>());
+            if (rises[rank] > 0.0) factor = std::max(factor, 0.5 * room / rises[rank]);
+            m.stretch = std::clamp(std::exp2(std::floor(std::log2(factor))), 1.0, 4096.0);
+        }
         mapped.push_back(std::move(m));
     }
     const int gap = 8;
@@ -258,7 +273,8 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         stretched_row
             ? fmt::format(" Top row: as displayed. Bottom row: the same frames, each channel stretched about its "
                           "background (the tile's median) by {} (left to right), so that a dim light and its glare "
-                          "can be seen; the stretch is for the reader, not what the observer saw.",
+                          "can be seen (a glare core may clip there); the stretch is for the reader, not what the "
+                          "observer saw.",
                           factors)
             : std::string(" No frame is dim enough to need a stretched copy."));
     return {};

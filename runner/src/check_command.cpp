@@ -37,6 +37,11 @@ void apply_display_set(p::Display& display, const std::string& set) {
         throw InputError(where, "a --set is KEY=VALUE, e.g. display.width_px=3840.");
     const std::string key = set.substr(0, eq);
     const std::string value = set.substr(eq + 1);
+    if (key != "display.width_px" && key != "display.height_px" && key != "display.width_m" &&
+        key != "display.viewing_distance_m")
+        throw InputError(SourceLocation{"--set", 0, 0, key},
+                         "check sets only the display: display.width_px, display.height_px, display.width_m or "
+                         "display.viewing_distance_m.");
     double v = 0.0;
     const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
     if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(v) || !(v > 0))
@@ -50,12 +55,8 @@ void apply_display_set(p::Display& display, const std::string& set) {
         (key == "display.width_px" ? display.width_px : display.height_px) = static_cast<int>(v);
     } else if (key == "display.width_m") {
         display.width_m = v;
-    } else if (key == "display.viewing_distance_m") {
-        display.viewing_distance_m = v;
     } else {
-        throw InputError(SourceLocation{"--set", 0, 0, key},
-                         "check sets only the display: display.width_px, display.height_px, display.width_m or "
-                         "display.viewing_distance_m.");
+        display.viewing_distance_m = v;
     }
 }
 
