@@ -16,7 +16,8 @@
 //      range: the level changes nothing on the screen);
 //  R3  (2AFC and adjust) at the top of the range the level stimulus is clipped
 //      at the display's white and still puts less light into the eye than the
-//      other stimulus: no level in the range can make it the brighter of the two.
+//      other stimulus (by more than 1%): no level in the range can make it the
+//      brighter of the two.
 // `atonlab run` refuses such a protocol (exit 2) unless --allow-undisplayable;
 // `atonlab check` prints the same table and exits 0 or 2.
 #include <string>
