@@ -19,6 +19,7 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,11 @@ struct ExampleAtDisplay {
     fs::path protocol;
     DisplayCase display;
 };
+
+/// What CTest's name shows after "# GetParam() = " (gtest_discover_tests appends it).
+void PrintTo(const ExampleAtDisplay& e, std::ostream* os) {
+    *os << e.protocol.filename().string() << " at " << e.display.width_px << "x" << e.display.height_px;
+}
 
 std::vector<ExampleAtDisplay> examples_at_displays() {
     std::vector<ExampleAtDisplay> out;
