@@ -219,7 +219,14 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
         j.field("observer", s.observer).field("protocol_name", s.protocol_name);
         j.field("protocol_sha256", s.protocol_sha256).field("software_version", s.software_version);
         j.field("seed", std::to_string(s.seed)).field("status", s.status).field("started_at", s.started_at);
-        j.field("ended_at", s.ended_at).field("trials", s.trial_count).end_object();
+        j.field("ended_at", s.ended_at).field("trials", s.trial_count);
+        if (s.displayable) {
+            j.field("displayable", *s.displayable).field("allowed_undisplayable", s.allowed_undisplayable);
+            j.key("undisplayable_conditions").begin_array();
+            for (const std::string& c : s.undisplayable) j.value(c);
+            j.end_array();
+        }
+        j.end_object();
     }
     j.end_array();
     j.key("conditions").begin_array();

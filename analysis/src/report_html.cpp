@@ -3,6 +3,7 @@
 // to the report), and nothing is loaded from anywhere else: the page reads
 // the same offline, from a USB stick or an e-mail attachment.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <fstream>
 #include <cmath>
@@ -349,16 +350,20 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     // --- sessions and timing
     h += "<h2>Sessions and frame timing</h2>\n<table>\n<tr><th>session</th><th>observer</th><th>protocol</th>"
          "<th>status</th><th>started</th><th>trials</th><th>dropped frames</th><th>trials with drops</th>"
-         "<th>missed deadlines</th></tr>\n";
+         "<th>missed deadlines</th><th>display check</th></tr>\n";
     for (const SessionInfo& s : d.sessions) {
         const SessionTiming* t = nullptr;
         for (const SessionTiming& x : r.timing)
             if (x.session == s.key) t = &x;
         h += fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
-            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
             esc(s.key), esc(s.observer), esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0,
-            t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0);
+            t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
+            !s.displayable   ? std::string("not recorded")
+            : *s.displayable ? std::string("displayable")
+                             : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",
+                                               fmt::join(s.undisplayable, ", "))));
     }
     h += "</table>\n";
     if (by_kind.count("timing")) h += figure_html(out_dir, *by_kind["timing"]);

@@ -3,6 +3,7 @@
 // stimulus parameters taken from each trial's stimulus_json and the
 // procedures' per-trial state replayed from the stored protocol text.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <charconv>
 #include <cmath>
@@ -213,6 +214,19 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
     if (s.calibration) {
         info.calibration_id = s.calibration->value;
         calibrations.insert(s.calibration->value);
+    }
+    if (s.displayability_json) {
+        const store::JsonReader j(*s.displayability_json, fmt::format("displayability_json of session {}", s.id.value));
+        info.displayable = j.boolean("$.displayable");
+        info.allowed_undisplayable = j.boolean("$.allowed_undisplayable").value_or(false);
+        for (std::size_t i = 0; i < j.array_length("$.conditions"); ++i)
+            if (!j.boolean(fmt::format("$.conditions[{}].displayable", i)).value_or(true))
+                info.undisplayable.push_back(j.string(fmt::format("$.conditions[{}].name", i)).value_or("?"));
+        if (info.displayable == false)
+            d.notes.push_back(fmt::format(
+                "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "
+                "display (docs/running.md, \"Displayability\"); their estimates say little about the observer",
+                file, s.id.value, fmt::join(info.undisplayable, ", ")));
     }
     std::string protocol_text;
     try {

@@ -9,10 +9,13 @@
 // PNGs for the report with the CPU references of the tone mapper and the
 // sRGB curve.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -167,21 +170,89 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
         tiles.push_back({x0, y0, w, h});
     }
-    const int gap = 8;
-    int width = 0, height = 0;
+    // Each frame tone-mapped (display-relative linear values, 0..1), then drawn
+    // twice: as is (top row) and, beneath it, stretched about its background
+    // (the tile's median) by a power of two that brings its brightest pixel
+    // near white, so that a dim light and its glare can be seen (docs/analysis.md,
+    // "Stimulus pictures"). The factors are stated in the caption.
+    struct Mapped {
+        std::vector<glm::dvec3> v;
+        glm::dvec3 background{0.0};  ///< per channel: the tile's median (a dim light leaves it the background)
+        double stretch = 1.0;
+    };
+    std::vector<Mapped> mapped;
     for (const Tile& t : tiles) {
-        width += t.w + (width ? gap : 0);
-        height = std::max(height, t.h);
-    }
-    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
-    int left = 0;
-    for (const Tile& t : tiles) {
-        for (int y = 0; y < t.h; ++y) {
+        Mapped m;
+        std::array<std::vector<double>, 3> channel;
+        for (int y = 0; y < t.h; ++y)
             for (int x = 0; x < t.w; ++x) {
                 const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
-                const glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                for (int k = 0; k < 3; ++k) {
+                    d[k] = std::clamp(d[k], 0.0, 1.0);
+                    channel[static_cast<std::size_t>(k)].push_back(d[k]);
+                }
+                m.v.push_back(d);
+            }
+        for (int k = 0; k < 3; ++k) {
+            std::vector<double>& values = channel[static_cast<std::size_t>(k)];
+            if (values.empty()) continue;
+            std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
+                             values.end());
+            m.background[k] = values[values.size() / 2];
+        }
+        // A power of two, 1 to 4096: the largest that keeps every channel's
+        // rise above the background at or below 90% of white, or, where a glare
+        // halo covers more than 1% of the tile, the one that brings the halo's
+        // edge there (the rise of the pixel ranked at 1%) to half of that,
+        // letting the core clip: what the reader needs to see is the halo.
+        std::vector<double> rises;
+        double room = 1.0, top = 0.0;
+        for (const glm::dvec3& d : m.v) {
+            double r = 0.0;
+            for (int k = 0; k < 3; ++k)
+                if (d[k] - m.background[k] > r) r = d[k] - m.background[k];
+            rises.push_back(r);
+            if (r > top) {
+                top = r;
+                room = 0.9 - std::max({m.background.r, m.background.g, m.background.b});
+            }
+        }
+        if (top > 0.0 && room > 0.0) {
+            double factor = room / top;
+            const std::size_t rank = rises.size() / 100;
+            std::nth_element(rises.begin(), rises.begin() + static_cast<std::ptrdiff_t>(rank), rises.end(),
+                             std::greater<>());
+            if (rises[rank] > 0.0) factor = std::max(factor, 0.5 * room / rises[rank]);
+            m.stretch = std::clamp(std::exp2(std::floor(std::log2(factor))), 1.0, 4096.0);
+        }
+        mapped.push_back(std::move(m));
+    }
+    const int gap = 8;
+    int width = 0, row = 0;
+    for (const Tile& t : tiles) {
+        width += t.w + (width ? gap : 0);
+        row = std::max(row, t.h);
+    }
+    // Nothing dim enough to need it: one row.
+    const bool stretched_row = std::any_of(mapped.begin(), mapped.end(), [](const Mapped& m) { return m.stretch > 1.0; });
+    const int height = stretched_row ? 2 * row + gap : row;
+    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
+    int left = 0;
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+        const Tile& t = tiles[i];
+        const Mapped& m = mapped[i];
+        for (int y = 0; y < t.h; ++y) {
+            for (int x = 0; x < t.w; ++x) {
+                const glm::dvec3& d = m.v[static_cast<std::size_t>(y) * t.w + x];
                 float* q = &rgb[(static_cast<std::size_t>(y) * width + left + x) * 3];
-                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(d[k], 0.0, 1.0)));
+                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(d[k]));
+                if (!stretched_row) continue;
+                float* r = &rgb[(static_cast<std::size_t>(y + row + gap) * width + left + x) * 3];
+                for (int k = 0; k < 3; ++k) {
+                    const double stretched = m.background[k] + m.stretch * (d[k] - m.background[k]);
+                    r[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(stretched, 0.0, 1.0)));
+                }
             }
         }
         left += t.w + gap;
@@ -191,12 +262,21 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     } catch (const std::exception& e) {
         return e.what();
     }
+    std::string factors;
+    for (const Mapped& m : mapped) factors += fmt::format("{}×{:g}", factors.empty() ? "" : ", ", m.stretch);
     caption = fmt::format(
         "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames left to right in "
         "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
-        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).",
+        "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).{}",
         c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
-        stimuli::tone_operator_name(tm.tone_operator), adaptation);
+        stimuli::tone_operator_name(tm.tone_operator), adaptation,
+        stretched_row
+            ? fmt::format(" Top row: as displayed. Bottom row: the same frames, each channel stretched about its "
+                          "background (the tile's median) by {} (left to right), so that a dim light and its glare "
+                          "can be seen (a glare core may clip there); the stretch is for the reader, not what the "
+                          "observer saw.",
+                          factors)
+            : std::string(" No frame is dim enough to need a stretched copy."));
     return {};
 }
 
@@ -346,6 +426,10 @@ int run_analyze(const AnalyzeOptions& o) {
             if (!h.reliable && !h.reason.empty()) line += "; unreliable: " + h.reason;
             std::printf("%s\n", line.c_str());
         }
+        for (const an::SessionInfo& s : data.sessions)
+            if (s.displayable == false)
+                std::printf("  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
+                            s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
         const std::size_t notes = results.warnings.size() + plots.problems.size() + ctx.problems.size();
         if (notes) std::printf("%zu note(s) and warning(s): see the report\n", notes);
         std::printf("report: %s\n", (out_dir / "report.html").string().c_str());

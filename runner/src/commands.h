@@ -63,6 +63,7 @@ struct RunOptions {
     int progress_every = 0;         ///< 0: 25 when stdout is not a terminal (a terminal gets one updating line)
     bool true_pse = true;           ///< model observer: compute the true PSE / threshold for the summary
     std::int64_t db_max_bytes = 0;  ///< > 0: the study file may not grow past this (StoreOptions::max_size_bytes)
+    bool allow_undisplayable = false;  ///< run a protocol the displayability check refuses (recorded with the session)
 
     // On screen (without --headless; docs/running.md "On screen").
     int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary
@@ -84,6 +85,18 @@ struct RunOptions {
 
 void add_run_command(CLI::App& app, RunOptions& options);
 int run_run(const RunOptions& options);
+
+/// `atonlab check` (docs/running.md, "Displayability"): what a display shows of
+/// a protocol's stimuli. Exit status: 0 displayable, 2 not (or bad input), 3 no
+/// GL, 4 the study file (--db) could not be read.
+struct CheckOptions {
+    std::string protocol;
+    std::vector<std::string> sets;  ///< --set display.KEY=VALUE
+    std::string db;                 ///< --db: the study file whose calibration encodes the frames
+};
+
+void add_check_command(CLI::App& app, CheckOptions& options);
+int run_check(const CheckOptions& options);
 
 /// `atonlab analyze` (docs/analysis.md). Exit status: 0 done, 2 bad input, 4 a
 /// study file could not be read, 5 the report was written without some figures.

@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
     atonlab::runner::add_psf_command(app, psf);
     atonlab::runner::RunOptions run;
     atonlab::runner::add_run_command(app, run);
+    atonlab::runner::CheckOptions check;
+    atonlab::runner::add_check_command(app, check);
     atonlab::runner::AnalyzeOptions analyze;
     atonlab::runner::add_analyze_command(app, analyze);
     atonlab::runner::CalibrateOptions calibrate;
@@ -51,6 +53,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);
         if (app.got_subcommand("psf")) return atonlab::runner::run_psf(psf);
         if (app.got_subcommand("run")) return atonlab::runner::run_run(run);
+        if (app.got_subcommand("check")) return atonlab::runner::run_check(check);
         if (app.got_subcommand("analyze")) return atonlab::runner::run_analyze(analyze);
         if (app.got_subcommand("calibrate")) return atonlab::runner::run_calibrate(calibrate);
         if (app.got_subcommand("view")) return atonlab::runner::run_view(view);

@@ -70,6 +70,9 @@ void add_run_command(CLI::App& app, RunOptions& o) {
                     "Let the study file grow to at most this many bytes; beyond, the run stops as on a full disk "
                     "(default 0: no limit)")
         ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--allow-undisplayable", o.allow_undisplayable,
+                  "Run even when a condition cannot produce a match on this display (docs/running.md, "
+                  "\"Displayability\"); recorded with the session");
     cmd->add_flag_callback(
         "--no-true-pse", [&o] { o.true_pse = false; },
         "Model observer: skip computing its true PSE / threshold for the summary");

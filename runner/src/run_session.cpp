@@ -40,6 +40,7 @@
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
 #include "calibration_policy.h"
+#include "displayability.h"
 #include "profile_location.h"
 #include "session_display.h"
 
@@ -382,6 +383,26 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const s::Display
     return out;
 }
 
+/// The codes of window `w` (n x n pixels from (x0, y0), row 0 at the top)
+/// against the same pixels of `off` (the judged lights off; null: none).
+void summarise_codes(const s::EncodedImage& codes, const s::EncodedImage* off, int x0, int y0, int n, LightWindow& w) {
+    w.white_code = (1 << codes.bits) - 1;
+    for (int y = std::max(y0, 0); y < std::min(y0 + n, codes.height); ++y)
+        for (int x = std::max(x0, 0); x < std::min(x0 + n, codes.width); ++x)
+            for (int ch = 0; ch < 3; ++ch) {
+                const std::size_t i =
+                    (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
+                        3 +
+                    static_cast<std::size_t>(ch);
+                const int on = codes.rgb[i];
+                const int bg = off ? off->rgb[i] : 0;
+                w.peak_code = std::max(w.peak_code, on);
+                w.background_code = std::max(w.background_code, bg);
+                w.rise_codes = std::max(w.rise_codes, on - bg);
+                w.clipped = w.clipped || (on == w.white_code && bg < w.white_code);
+            }
+}
+
 }  // namespace
 
 std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
@@ -452,11 +473,18 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
     for (const std::string& name : lights) any_named = any_named || !name.empty();
     if (any_named) {
         const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
-        for (std::size_t i = 0; i < out->windows.size(); ++i)
+        for (std::size_t i = 0; i < out->windows.size(); ++i) {
             out->windows[i].image.background_cd_m2 =
                 placed[i].on_screen
                     ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
                     : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+            if (placed[i].on_screen)
+                summarise_codes(codes, &off, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
+        }
+    } else {
+        for (std::size_t i = 0; i < out->windows.size(); ++i)
+            if (placed[i].on_screen)
+                summarise_codes(codes, nullptr, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
     }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
     remember(cache_key(frame, lights), out);
@@ -1269,6 +1297,24 @@ int run_session(const RunOptions& o) {
     }
     StimulusRenderer renderer(scene_text, scene_file, observer.params().window_radius_deg, interval_s);
     if (calibration.display) renderer.use_display_model(*calibration.display);
+    // --- What this display will show of every condition (displayability.h):
+    // a level range that cannot produce a match is refused, before anything is written.
+    const Displayability displayability = check_displayability(renderer, protocol);
+    if (!o.quiet) {
+        std::printf("%s", displayability_table(displayability).c_str());
+        std::fflush(stdout);
+    }
+    if (!displayability.displayable()) {
+        std::fprintf(stderr, "atonlab: %s\n", displayability_refusal(displayability, o.protocol).c_str());
+        if (!o.allow_undisplayable) {
+            std::fprintf(stderr,
+                         "atonlab: nothing was written; change the protocol as said, try it with `atonlab check %s`, "
+                         "or run anyway with --allow-undisplayable (recorded with the session).\n",
+                         o.protocol.c_str());
+            return 2;
+        }
+        std::fprintf(stderr, "atonlab: warning: running anyway (--allow-undisplayable; recorded with the session)\n");
+    }
 
     // --- Every check has passed: open the study file for writing (creating it
     // if it does not exist), then begin or reopen the session.
@@ -1287,6 +1333,7 @@ int run_session(const RunOptions& o) {
         start.protocol_text = protocol_text;
         start.protocol_name = std::filesystem::path(o.protocol).filename().string();
         start.seed = seed;
+        start.displayability_json = displayability_json(displayability, o.allow_undisplayable);
         start.calibration = calibration.calibration     ? *calibration.calibration
                             : calibration.from_profiles ? copy_into_study(store, *calibration.from_profiles)
                                                         : record_display(store, display_scene, scene_file);

@@ -40,6 +40,12 @@ namespace atonlab::runner {
 struct LightWindow {
     protocols::DisplayedImage image;
     glm::dvec2 light_px{0.0};
+    /// The code values sent to the screen in the same window (displayability.h):
+    int peak_code = 0;        ///< the highest code of any channel of any pixel
+    int background_code = 0;  ///< the same with the judged lights off
+    int rise_codes = 0;       ///< the most any channel of a pixel lies above that pixel with the lights off
+    bool clipped = false;     ///< a channel of a pixel is at the display's white where the lights-off frame is not
+    int white_code = 255;     ///< the display's white, 2^bits − 1
 };
 
 /// One rendered frame, as the observer sees it: a window per judged light.

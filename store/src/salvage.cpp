@@ -33,7 +33,8 @@ Salvage Store::salvage() const {
     if (const auto last = largest_id(db, "SELECT max(id) FROM sessions", out.problems, "sessions")) {
         sql::Statement s(db,
                          "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, "
-                         "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0 "
+                         // displayability_json NULL: a damaged file may be of a schema before it (v3).
+                         "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL "
                          "FROM sessions s JOIN observers o ON o.id = s.observer_id "
                          "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1");
         for (std::int64_t id = 1; id <= *last; ++id) {

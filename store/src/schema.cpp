@@ -200,10 +200,19 @@ constexpr std::string_view schema_v3 = R"sql(
 ALTER TABLE calibration_readings ADD COLUMN transcript TEXT;  -- what the instrument said; NULL when typed or imported
 )sql";
 
-constexpr std::array<Migration, 3> migrations = {
+// Version 4: what the display showed of each condition's stimuli, worked out
+// before the first trial (docs/running.md, "Displayability"), and whether the
+// session ran with --allow-undisplayable. NULL for sessions from before.
+constexpr std::string_view schema_v4 = R"sql(
+ALTER TABLE sessions ADD COLUMN displayability_json TEXT
+    CHECK (displayability_json IS NULL OR json_valid(displayability_json));
+)sql";
+
+constexpr std::array<Migration, 4> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
     Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
     Migration{3, "instrument transcripts of calibration readings", schema_v3},
+    Migration{4, "sessions.displayability_json", schema_v4},
 };
 
 }  // namespace

@@ -13,14 +13,14 @@ namespace {
 constexpr const char* select_sessions =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id) "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
     "ORDER BY s.id";
 
 constexpr const char* select_one_session =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id) "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
     "WHERE s.id = ?1";
 
@@ -54,6 +54,7 @@ SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::p
     r.status = *parsed;
     r.resume_count = s.int32(11);
     r.trial_count = s.int64(12);
+    r.displayability_json = s.optional_text(13);
     return r;
 }
 
@@ -143,7 +144,7 @@ SessionId Store::begin_session(const SessionStart& start) {
 
     sql::Use ins(
         db.cached("INSERT INTO sessions (observer_id, protocol_id, calibration_id, software_version, seed, "
-                  "started_at) VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ")"));
+                  "started_at, displayability_json) VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ", ?6)"));
     ins->bind(1, observer_id);
     ins->bind(2, protocol_id);
     if (start.calibration) {
@@ -153,6 +154,11 @@ SessionId Store::begin_session(const SessionStart& start) {
     }
     ins->bind(4, version);
     ins->bind(5, static_cast<std::int64_t>(start.seed));  // uint64 bits kept exactly (modular conversion)
+    if (start.displayability_json.empty()) {
+        ins->bind_null(6);
+    } else {
+        ins->bind(6, start.displayability_json);
+    }
     ins->run(doing);
     const SessionId id{sqlite3_last_insert_rowid(db.get())};
     ins->reset();

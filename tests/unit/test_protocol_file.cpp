@@ -275,17 +275,17 @@ TEST(ProtocolExamples, ParseWithTheDocumentedShape) {
     // set: the block's, then the condition's.
     ASSERT_EQ(c.set.size(), 4u);
     EXPECT_EQ(c.set[0].text(), "eye.adaptation_cd_m2=0.001");
-    EXPECT_EQ(c.set[2].text(), "light.test.intensity_cd=0.002");
+    EXPECT_EQ(c.set[2].text(), "light.test.intensity_cd=0.0005");
     EXPECT_EQ(c.set[3].text(), "tonemap.operator=\"perceptual\"");
     ASSERT_EQ(c.procedure.kind, ProcedureKind::Staircase);
     // The block's inline procedure table merges key by key into [defaults.procedure].
-    EXPECT_EQ(c.procedure.track_starts, (std::vector<double>{-2.2, -3.2}));
+    EXPECT_EQ(c.procedure.track_starts, (std::vector<double>{-2.8, -3.8}));
     const auto& sp = std::get<StaircaseParams>(c.procedure.params);
     EXPECT_EQ(sp.step_sizes, (std::vector<double>{0.2, 0.1, 0.05}));
     EXPECT_EQ(sp.step_type, StepType::Lin);
     EXPECT_EQ(sp.max_trials, 24);
-    EXPECT_EQ(sp.min_level, -3.7);
-    EXPECT_EQ(sp.max_level, -1.7);
+    EXPECT_EQ(sp.min_level, -4.3);
+    EXPECT_EQ(sp.max_level, -2.3);
     EXPECT_EQ(p.responses.keys_of(Action::Left), (std::vector<std::string>{"left", "1"}));
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "2"), Action::Right);
     EXPECT_EQ(p.responses.key_action(Task::TwoAfc, "escape"), Action::Quit);
@@ -501,7 +501,7 @@ TEST(ProtocolSchedule, MakeProcedureBuildsTheSameTracksAsTheSchedule) {
     EXPECT_EQ(proc->kind(), "interleaved");  // two tracks
     const auto track = make_track(c, 1, derive_seed(11, 1));
     EXPECT_EQ(track->kind(), "2afc");
-    EXPECT_EQ(track->next()->level, -3.2);
+    EXPECT_EQ(track->next()->level, -3.8);
     EXPECT_TRUE(track->next()->test_on_left.has_value());
     EXPECT_THROW((void)make_track(c, 2, 0), std::out_of_range);
 }

@@ -120,6 +120,11 @@ struct SessionInfo {
     std::string status;  ///< running, quit, completed, crashed ("" for a CSV)
     std::int64_t trial_count = 0;
     std::optional<std::int64_t> calibration_id;
+    /// The displayability check before the first trial (docs/running.md,
+    /// "Displayability"): none for a session from before it (or a CSV).
+    std::optional<bool> displayable;
+    bool allowed_undisplayable = false;         ///< the session ran with --allow-undisplayable
+    std::vector<std::string> undisplayable;     ///< the conditions that could not produce a match on its display
     /// Every condition the session's protocol defines, in file order (so a
     /// condition without trials is still reported); empty for a CSV.
     std::vector<std::string> protocol_conditions;

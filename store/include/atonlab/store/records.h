@@ -99,6 +99,9 @@ struct SessionStart {
     std::string protocol_name;                 ///< e.g. the file name, for people reading the file
     std::uint64_t seed = 0;                    ///< the session's random seed
     std::optional<CalibrationId> calibration;  ///< the calibration the runner used, if any
+    /// What the display showed of the stimuli before the first trial, JSON
+    /// (docs/running.md, "Displayability"); empty: not worked out (stored NULL).
+    std::string displayability_json;
     /// The software that ran the session; empty means this library's own version
     /// (software_version()).
     std::string software_version;
@@ -119,6 +122,7 @@ struct SessionRecord {
     SessionStatus status = SessionStatus::running;
     int resume_count = 0;  ///< how many times resume_session() reopened it
     std::int64_t trial_count = 0;
+    std::optional<std::string> displayability_json;  ///< SessionStart's; none for a session from before schema v3
 };
 
 /// One trial: what was shown, what the observer answered, how well the frames

@@ -1,0 +1,118 @@
+// `atonlab check PROTOCOL.toml [--set display.KEY=VALUE ...] [--db STUDY.db]`:
+// the displayability check of `atonlab run` (displayability.h) on its own, so
+// that a protocol can be tried against a display before a session. Prints the
+// table; exit 0 when every condition can produce a match, 2 when one cannot
+// (one sentence each on stderr) or the input is bad, 3 without GL. Writes nothing.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <system_error>
+
+#include "atonlab/common/input_text.h"
+#include "atonlab/protocols/protocol_file.h"
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/gl/context.h"
+#include "atonlab/store/error.h"
+#include "atonlab/store/store.h"
+#include "calibration_policy.h"
+#include "commands.h"
+#include "displayability.h"
+#include "run_session.h"
+
+namespace atonlab::runner {
+
+namespace p = atonlab::protocols;
+
+namespace {
+
+/// `--set display.KEY=VALUE`: the protocol's [display] for this check.
+void apply_display_set(p::Display& display, const std::string& set) {
+    const SourceLocation where{"--set", 0, 0, set};
+    const auto eq = set.find('=');
+    if (eq == std::string::npos)
+        throw InputError(where, "a --set is KEY=VALUE, e.g. display.width_px=3840.");
+    const std::string key = set.substr(0, eq);
+    const std::string value = set.substr(eq + 1);
+    if (key != "display.width_px" && key != "display.height_px" && key != "display.width_m" &&
+        key != "display.viewing_distance_m")
+        throw InputError(SourceLocation{"--set", 0, 0, key},
+                         "check sets only the display: display.width_px, display.height_px, display.width_m or "
+                         "display.viewing_distance_m.");
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+    if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(v) || !(v > 0))
+        throw InputError(SourceLocation{"--set", 0, 0, key},
+                         fmt::format("\"{}\" is not a positive number.", text::echo(value)));
+    const bool whole = v == std::floor(v) && v <= 65536;
+    if (key == "display.width_px" || key == "display.height_px") {
+        if (!whole)
+            throw InputError(SourceLocation{"--set", 0, 0, key},
+                             fmt::format("{} is a whole number of pixels from 1 to 65536.", text::echo(value)));
+        (key == "display.width_px" ? display.width_px : display.height_px) = static_cast<int>(v);
+    } else if (key == "display.width_m") {
+        display.width_m = v;
+    } else {
+        display.viewing_distance_m = v;
+    }
+}
+
+}  // namespace
+
+void add_check_command(CLI::App& app, CheckOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "check",
+        "Work out what a display will show of a protocol's stimuli at both ends of each level range, and whether a "
+        "match can be made (exit 0) or not (exit 2); writes nothing");
+    cmd->add_option("protocol", o.protocol, "Protocol file (TOML; see docs/protocol-file.md)")->required();
+    cmd->add_option("--set", o.sets,
+                    "Another display: display.width_px=N, display.height_px=N, display.width_m=X, "
+                    "display.viewing_distance_m=X (repeatable)");
+    cmd->add_option("--db", o.db,
+                    "Study file whose latest calibration of the protocol's display.name encodes the frames, as "
+                    "`atonlab run --db` would (read only)");
+}
+
+int run_check(const CheckOptions& o) {
+    p::Protocol protocol;
+    try {
+        protocol = p::load_protocol(o.protocol);
+    } catch (const p::ProtocolError& e) {
+        throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
+    }
+    for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
+    const text::FileText scene = text::read_text_file(protocol.scene, text::kMaxInputFileBytes);
+    if (!scene.ok())
+        throw InputError(SourceLocation{protocol.scene.string(), 0, 0, ""},
+                         fmt::format("cannot read the scene template: {}.", scene.error));
+
+    std::optional<stimuli::DisplayModel> model;
+    if (!o.db.empty()) {
+        try {
+            const store::Store study = store::Store::open_read_only(o.db);
+            const SessionCalibration cal = session_calibration(&study, protocol.display, std::nullopt, utc_today(), o.db);
+            for (const std::string& w : cal.warnings) std::fprintf(stderr, "atonlab: warning: %s\n", w.c_str());
+            model = cal.display;
+        } catch (const store::StoreError& e) {
+            std::fprintf(stderr, "atonlab: %s\n", e.what());
+            return 4;
+        }
+    }
+    auto context = gl::create_headless_context();
+    const p::ModelObserverParams params{};
+    StimulusRenderer renderer(scene.text, protocol.scene, params.window_radius_deg, protocol.timing.stimulus_s);
+    if (model) renderer.use_display_model(*model);
+    const Displayability d = check_displayability(renderer, protocol);
+    std::printf("%s", displayability_table(d).c_str());
+    if (d.displayable()) {
+        std::printf("every condition can produce a match on this display\n");
+        return 0;
+    }
+    std::fprintf(stderr, "atonlab: %s\n", displayability_refusal(d, o.protocol).c_str());
+    return 2;
+}
+
+}  // namespace atonlab::runner
