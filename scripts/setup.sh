@@ -18,6 +18,7 @@ packages=(
   xvfb xauth
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
+  chromium  # the report's layout test renders report.html headless (tests/e2e/report_chromium.sh)
 )
 
 missing=()

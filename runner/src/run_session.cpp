@@ -101,7 +101,7 @@ std::string read_text(const std::filesystem::path& file, std::string_view what,
 }
 
 InputError input_error(const p::ProtocolError& e) {
-    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
+    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message(), e.further());
 }
 
 /// The response codes of trials the procedure never saw (docs/running.md,
