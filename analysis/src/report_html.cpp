@@ -4,6 +4,7 @@
 // the same offline, from a USB stick or an e-mail attachment.
 #include <fmt/format.h>
 
+#include <charconv>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -291,24 +292,26 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
          "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
          "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
-    h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th><th>adaptation (cd/m²)</th><th>tone mapper</th>"
-         "<th>glare test / reference</th><th>test (cd)</th><th>observer</th><th>trials</th><th>estimate</th>"
-         "<th>interval</th><th>unit</th><th>enhancement [interval]</th><th>reliable</th></tr>\n";
+    // Each number over its interval in one cell, so that the table fits 1280 px.
+    h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th>"
+         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>glare test / reference</th><th>test (cd)</th>"
+         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>enhancement [interval]</th>"
+         "<th>reliable</th></tr>\n";
     for (const ConditionInfo& c : r.conditions) {
         const GroupResult* g = r.main_group(c.condition);
         if (!g) continue;
         const HeadlineEstimate& e = g->headline;
         std::string enh = "&ndash;";
         if (g->match_ratio && g->match_ratio->value)
-            enh = f3(g->match_ratio->value) + " " + ci_text(g->match_ratio->ci);
+            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci);
         h += fmt::format(
             "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
-            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))), esc(c.procedure),
-            g3(c.adaptation_cd_m2), esc(c.tone_operator), esc(c.glare_test), esc(c.glare_reference),
-            g3(c.test_intensity_cd), esc(g->observer), g->n_scored, f3(e.value), ci_text(e.ci), esc(c.level_unit()),
-            enh, yes_no(e.reliable, e.reason, notes));
+            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}<br>{}</td>"
+            "<td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))),
+            esc(c.procedure.empty() ? "(not stated)" : c.procedure), g3(c.adaptation_cd_m2), esc(c.tone_operator),
+            esc(c.glare_test), esc(c.glare_reference), g3(c.test_intensity_cd), esc(g->observer), g->n_scored,
+            f3(e.value), ci_text(e.ci), esc(c.level_unit()), enh, yes_no(e.reliable, e.reason, notes));
     }
     h += "</table></div>\n" + notes.flush();
     for (const char* kind : {"pse", "enhancement"})
@@ -469,8 +472,14 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             h += fmt::format("<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
                              esc(c.display_name), c.id, esc(c.source));
             h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
-            for (const auto& [key, value] : JsonFlattener(c.fit_json).run())
-                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key), esc(value));
+            for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
+                // Numbers to 6 significant digits (summary.json keeps them whole).
+                double x = 0.0;
+                const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
+                const bool number = ec == std::errc() && end == value.data() + value.size();
+                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key),
+                                 number ? fmt::format("{:.6g}", x) : esc(value));
+            }
             h += "</table></div>\n";
         }
         if (ctx.plots)
