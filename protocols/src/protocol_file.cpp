@@ -442,6 +442,7 @@ public:
                                 static_cast<int>(e.source().begin.column), "",
                                 fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
         }
+        text_ = std::string(text);
         step([&] { expand_conditions_files(); });
         // Every table is read even after an error in another (and every
         // condition after an error in one): all the errors, in file order, in
@@ -530,6 +531,21 @@ private:
         return s;
     }
 
+    /// The CSV text stored after "#@conditions_file NAME" in the protocol text, if any.
+    std::optional<std::string> embedded_csv(const std::string& name) const {
+        const std::string tag = "\n#@conditions_file " + name + "\n";
+        std::size_t at = text_.find(tag);
+        if (at == std::string::npos) return std::nullopt;
+        at += tag.size();
+        std::string out;
+        while (at < text_.size() && text_.compare(at, 3, "#@|") == 0) {
+            const std::size_t end = std::min(text_.find('\n', at), text_.size());
+            out += text_.substr(at + 3, end - at - 3) + "\n";
+            at = end + 1;
+        }
+        return out;
+    }
+
     /// Each [[block]] with conditions_file = "FILE.csv" gets one
     /// [[block.condition]] per row of the file (after those written in the
     /// block; rows with a `block` column only where it names this block). The
@@ -555,9 +571,18 @@ private:
         const std::filesystem::path csv =
             std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel)
                                                      : std::filesystem::path(doc_.file()).parent_path() / rel;
-        const text::FileText read = text::read_text_file(csv);
-        if (!read.ok()) doc_.fail(&f, key, fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
-        const std::string file = csv.string();
+        text::FileText read = text::read_text_file(csv);
+        std::string file = csv.string();
+        if (!read.ok()) {
+            // A stored protocol text carries its conditions files (with_conditions_files).
+            if (auto embedded = embedded_csv(rel)) {
+                read.text = std::move(*embedded);
+                read.error.clear();
+                file = rel;
+            } else {
+                doc_.fail(&f, key, fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
+            }
+        }
         std::vector<std::string> lines;
         for (std::size_t at = 0; at <= read.text.size();) {
             const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
@@ -1218,6 +1243,7 @@ private:
     toml::table root_;
     double adaptation_s_ = 0.0;
     text::ErrorList errors_;  // every error found, reported together at the end of parse()
+    std::string text_;        // the protocol text (conditions files stored in it: embedded_csv)
 };
 
 std::string read_text(const std::filesystem::path& file) {
@@ -1238,6 +1264,41 @@ Protocol load_protocol(const std::filesystem::path& file) {
 
 Protocol parse_protocol(std::string_view toml_text, std::string_view file_name) {
     return Parser(std::string(file_name)).parse(toml_text, false);
+}
+
+std::string with_conditions_files(std::string_view text, const std::filesystem::path& protocol_file) {
+    std::string out(text);
+    toml::table root;
+    try {
+        root = toml::parse(text);
+    } catch (const toml::parse_error&) {
+        return out;
+    }
+    const toml::array* blocks = root["block"].as_array();
+    if (blocks == nullptr) return out;
+    std::set<std::string> done;
+    for (const toml::node& b : *blocks) {
+        const toml::table* t = b.as_table();
+        if (t == nullptr) continue;
+        const auto name = (*t)["conditions_file"].value<std::string>();
+        if (!name || !done.insert(*name).second) continue;
+        const std::filesystem::path csv = std::filesystem::path(*name).is_absolute()
+                                              ? std::filesystem::path(*name)
+                                              : protocol_file.parent_path() / *name;
+        const text::FileText read = text::read_text_file(csv);
+        if (!read.ok()) continue;
+        if (!out.empty() && out.back() != '\n') out += '\n';
+        out += "\n# atonlab: the conditions file below, as it was when the session ran (docs/protocol-file.md)\n";
+        out += "#@conditions_file " + *name + "\n";
+        for (std::size_t at = 0; at < read.text.size();) {
+            const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
+            std::string line = read.text.substr(at, end - at);
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            out += "#@|" + line + "\n";
+            at = end + 1;
+        }
+    }
+    return out;
 }
 
 }  // namespace atonlab::protocols

@@ -1074,3 +1074,36 @@ conditions_file = "c.csv"
     }
     fs::remove_all(dir);
 }
+
+TEST(ConditionsFile, TheStoredTextCarriesTheCsvSoThatItParsesWithoutIt) {
+    const fs::path file = example("glare_brightness_2afc_csv.toml");
+    std::ifstream in(file);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string stored = with_conditions_files(text, file);
+    EXPECT_NE(stored.find("\n#@conditions_file glare_brightness_2afc.conditions.csv\n#@|block,name,"),
+              std::string::npos);
+    // Parsed from the text alone (no such folder: the CSV cannot be opened), as analyze does.
+    const Protocol p = parse_protocol(stored, "/nonexistent/glare_brightness_2afc_csv.toml");
+    const Protocol twin = load_protocol(example("glare_brightness_2afc.toml"));
+    ASSERT_EQ(p.blocks.size(), twin.blocks.size());
+    for (std::size_t b = 0; b < p.blocks.size(); ++b) {
+        ASSERT_EQ(p.blocks[b].conditions.size(), twin.blocks[b].conditions.size());
+        for (std::size_t c = 0; c < p.blocks[b].conditions.size(); ++c) {
+            std::vector<std::string> a, t;
+            for (const Override& o : p.blocks[b].conditions[c].set) a.push_back(o.text());
+            for (const Override& o : twin.blocks[b].conditions[c].set) t.push_back(o.text());
+            EXPECT_EQ(a, t);
+        }
+    }
+    // A protocol without a conditions file is stored as it is.
+    const std::string plain = "[protocol]\nscene = \"s.toml\"\n";
+    EXPECT_EQ(with_conditions_files(plain, "p.toml"), plain);
+    // Without the CSV and without the stored copy, the error names the key.
+    try {
+        (void)parse_protocol(text, "/nonexistent/glare_brightness_2afc_csv.toml");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(e.key(), "block[0].conditions_file") << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot read the conditions file"), std::string::npos) << e.what();
+    }
+}
