@@ -334,6 +334,20 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             : c.level_on == "test"   ? "chose the test"
                                      : "chose the reference",
             c.guess_rate, c.target_p, c.n_trials);
+        if (!r.factor_columns.empty()) {
+            // The design's other factors (fits.csv's factor columns), as the protocol set them.
+            std::string list;
+            for (const std::string& key : r.factor_columns) {
+                const auto it = c.settings.find(key);
+                const SettingValue v = setting_value(it == c.settings.end() ? std::string() : it->second);
+                const std::string shown = it == c.settings.end() ? std::string("(not set)")
+                                          : v.number             ? fmt::format("{:.6g}", *v.number)
+                                          : v.boolean            ? std::string(*v.boolean ? "true" : "false")
+                                                                 : v.text;
+                list += fmt::format("{}<code>{}</code> = {}", list.empty() ? "" : ", ", esc(key), esc(shown));
+            }
+            h += "<p>Other factors of the design: " + list + ".</p>\n";
+        }
         h += "<div class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</th><th>how</th>"
              "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
              "<th>reliable</th></tr>\n";

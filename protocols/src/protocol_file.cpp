@@ -715,6 +715,13 @@ private:
             throw ProtocolError(file, static_cast<int>(e.source().begin.line), 0, "",
                                 fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
         }
+        if (rows.empty())
+            doc_.fail(&f, key,
+                      fmt::format("the conditions file \"{}\" has no rows for block \"{}\" (one row per condition{}).",
+                                  file, block_name,
+                                  std::find(kinds.begin(), kinds.end(), Kind::block) != kinds.end()
+                                      ? "; its block column names the block each row belongs to"
+                                      : ""));
         if (!bt.contains("condition")) bt.insert("condition", toml::array{});
         toml::node* conds = bt.get("condition");
         if (!conds->is_array_of_tables() && !(conds->is_array() && conds->as_array()->empty()))
@@ -1065,6 +1072,8 @@ private:
     const toml::array* block_conditions(const Section& bs, const Block& b) {
         {
             const toml::node* conds = bs.get("condition");
+            // A conditions file that gave no rows has said so at its own key.
+            if (conds == nullptr && bs.get("conditions_file") != nullptr) return nullptr;
             if (conds == nullptr)
                 doc_.fail_at_line(b.line, bs.key_path("condition"),
                                   fmt::format("block \"{}\" (line {}) has no [[block.condition]], which is required "
