@@ -196,8 +196,7 @@ private:
             out_.emplace_back(path, string());
         } else {
             const std::size_t start = i_;
-            while (i_ < s_.size() && s_[i_] != ',' && s_[i_] != '}' && s_[i_] != ']' && s_[i_] != ' ' &&
-                   s_[i_] != '\n')
+            while (i_ < s_.size() && s_[i_] != ',' && s_[i_] != '}' && s_[i_] != ']' && s_[i_] != ' ' && s_[i_] != '\n')
                 ++i_;
             out_.emplace_back(path, std::string(s_.substr(start, i_ - start)));
         }
@@ -348,7 +347,9 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             }
             h += "<p>Other factors of the design: " + list + ".</p>\n";
         }
-        h += "<div class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</th><th>how</th>"
+        h += "<div "
+             "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</"
+             "th><th>how</th>"
              "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
              "<th>reliable</th></tr>\n";
         for (const GroupResult& g : r.groups) {
@@ -408,7 +409,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             }
         }
         if (!tracks.empty()) {
-            h += "<p>The procedures' own estimates:</p>\n<div class=\"table-wrap\"><table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
+            h += "<p>The procedures' own estimates:</p>\n<div "
+                 "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
                  "<th>trials</th><th>estimate</th><th>how</th><th>interval</th><th>reliable</th></tr>\n" +
                  tracks + "</table></div>\n" + notes.flush();
         }
@@ -430,7 +432,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         h += "<p>Conditions that differ in one stimulus parameter, compared within observers: the mean of each "
              "observer's difference A &minus; B of the headline estimates, its bootstrap interval over observers, "
              "and Student's paired t test.</p>\n";
-        h += "<div class=\"table-wrap\"><table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean A &minus; B</th>"
+        h += "<div class=\"table-wrap\"><table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean "
+             "A &minus; B</th>"
              "<th>interval</th><th>t (dof)</th><th>p</th><th>reliable</th></tr>\n";
         for (const PairedResult& p : r.paired) {
             const PairedComparison& c = p.comparison;
@@ -483,8 +486,9 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         h += "</table></div>\n" + notes.flush();
         // The fitted model's parameters (fit_json, docs/calibration.md), one row each.
         for (const CalibrationInfo& c : d.calibrations) {
-            h += fmt::format("<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
-                             esc(c.display_name), c.id, esc(c.source));
+            h += fmt::format(
+                "<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
+                esc(c.display_name), c.id, esc(c.source));
             h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
             for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
                 // Numbers to 6 significant digits (summary.json keeps them whole).

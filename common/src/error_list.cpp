@@ -30,8 +30,8 @@ std::vector<std::string> ErrorList::further_lines() const {
     const std::vector<Problem> all = in_file_order();
     for (std::size_t i = 1; i < all.size(); ++i) out.push_back(all[i].text);
     if (dropped_ > 0)
-        out.push_back(fmt::format("... and {} more error{} (the first {} are shown)", dropped_, dropped_ == 1 ? "" : "s",
-                                  kLimit));
+        out.push_back(fmt::format("... and {} more error{} (the first {} are shown)", dropped_,
+                                  dropped_ == 1 ? "" : "s", kLimit));
     return out;
 }
 

@@ -51,7 +51,7 @@ constexpr std::string_view kConditionKeys[] = {
     "task",        "presentation", "prompt", "set",        "test_set",        "reference_set",   "level_key",
     "level_scale", "level_on",     "choice", "test_light", "reference_light", "left_position_m", "right_position_m",
     "procedure"};
-constexpr std::string_view kBlockOwnKeys[] = {"name",         "adaptation_s", "repetitions", "interleave",
+constexpr std::string_view kBlockOwnKeys[] = {"name",         "adaptation_s", "repetitions",    "interleave",
                                               "instructions", "condition",    "conditions_file"};
 
 constexpr std::string_view kStaircaseKeys[] = {
@@ -238,11 +238,11 @@ public:
                         kind_ ? fmt::format("a {} procedure", to_string(*kind_)) : std::string("a procedure");
                     if (std::find(std::begin(kConditionKeys), std::end(kConditionKeys), key.str()) !=
                         std::end(kConditionKeys))
-                        doc_.fail_at_key(key, f.key + "." + std::string(key.str()),
-                                         cond_.context() +
-                                             fmt::format("'{}' is not a key of {}: it belongs beside the procedure, "
-                                                         "in [defaults], a [[block]] or a [[block.condition]].",
-                                                         key.str(), what));
+                        doc_.fail_at_key(
+                            key, f.key + "." + std::string(key.str()),
+                            cond_.context() + fmt::format("'{}' is not a key of {}: it belongs beside the procedure, "
+                                                          "in [defaults], a [[block]] or a [[block.condition]].",
+                                                          key.str(), what));
                     doc_.fail_at_key(
                         key, f.key + "." + std::string(key.str()),
                         cond_.context() + fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", key.str(), what,
@@ -568,9 +568,9 @@ private:
         const std::string key = fmt::format("block[{}].conditions_file", bi);
         const std::string rel = doc_.string(&f, key);
         if (rel.empty()) doc_.fail(&f, key, "conditions_file must name a CSV file, got an empty string.");
-        const std::filesystem::path csv =
-            std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel)
-                                                     : std::filesystem::path(doc_.file()).parent_path() / rel;
+        const std::filesystem::path csv = std::filesystem::path(rel).is_absolute()
+                                              ? std::filesystem::path(rel)
+                                              : std::filesystem::path(doc_.file()).parent_path() / rel;
         text::FileText read = text::read_text_file(csv);
         std::string file = csv.string();
         if (!read.ok()) {
@@ -580,7 +580,8 @@ private:
                 read.error.clear();
                 file = rel;
             } else {
-                doc_.fail(&f, key, fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
+                doc_.fail(&f, key,
+                          fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
             }
         }
         std::vector<std::string> lines;
@@ -596,15 +597,17 @@ private:
             throw ProtocolError(file, 1, 0, "", error.empty() ? "the conditions file has no header row." : error);
         // What each column is.
         enum class Kind { name, block, string_key, other_key, procedure, set, test_set, reference_set };
-        constexpr std::string_view kStringKeys[] = {"task",     "presentation", "prompt",     "level_key",
-                                                    "level_scale", "level_on",  "choice",     "test_light",
-                                                    "reference_light"};
+        constexpr std::string_view kStringKeys[] = {"task",      "presentation", "prompt",
+                                                    "level_key", "level_scale",  "level_on",
+                                                    "choice",    "test_light",   "reference_light"};
         std::vector<Kind> kinds;
         std::set<std::string> seen;
         for (std::size_t c = 0; c < header->size(); ++c) {
             const std::string& h = (*header)[c];
             const int col = static_cast<int>(c) + 1;
-            auto fail = [&](const std::string& m) { throw ProtocolError(file, 1, col, "", fmt::format("column {} '{}': {}", col, h, m)); };
+            auto fail = [&](const std::string& m) {
+                throw ProtocolError(file, 1, col, "", fmt::format("column {} '{}': {}", col, h, m));
+            };
             if (h.empty()) fail("the column has no name.");
             if (!seen.insert(h).second) fail("the column appears twice in the header.");
             if (h == "name")
@@ -624,12 +627,12 @@ private:
             else if (h.find('.') != std::string::npos && h.find_first_of(" =\"'") == std::string::npos)
                 kinds.push_back(Kind::set);
             else
-                fail(fmt::format("not a column of a conditions file: give name, a condition key ({}, "
-                                 "left_position_m, right_position_m), procedure.PARAMETER, a scene key "
-                                 "(section.key, a `set` override), test:KEY or reference:KEY (test_set, "
-                                 "reference_set), or block.{}",
-                                 detail::join_quoted(kStringKeys),
-                                 text::did_you_mean(h, kStringKeys)));
+                fail(
+                    fmt::format("not a column of a conditions file: give name, a condition key ({}, "
+                                "left_position_m, right_position_m), procedure.PARAMETER, a scene key "
+                                "(section.key, a `set` override), test:KEY or reference:KEY (test_set, "
+                                "reference_set), or block.{}",
+                                detail::join_quoted(kStringKeys), text::did_you_mean(h, kStringKeys)));
         }
         // One TOML line per CSV line: row N of the file is line N of the text.
         std::string toml_text = "\n";
@@ -646,9 +649,9 @@ private:
             const auto cells = csv_fields(lines[li], error);
             if (!cells) throw ProtocolError(file, line, 0, "", error);
             if (cells->size() != header->size())
-                throw ProtocolError(file, line, 0, "",
-                                    fmt::format("the row has {} fields where the header has {}.", cells->size(),
-                                                header->size()));
+                throw ProtocolError(
+                    file, line, 0, "",
+                    fmt::format("the row has {} fields where the header has {}.", cells->size(), header->size()));
             Document::CsvRow row;
             row.file = file;
             row.line = line;
@@ -712,8 +715,9 @@ private:
         try {
             parsed = toml::parse(toml_text, file);
         } catch (const toml::parse_error& e) {
-            throw ProtocolError(file, static_cast<int>(e.source().begin.line), 0, "",
-                                fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
+            throw ProtocolError(
+                file, static_cast<int>(e.source().begin.line), 0, "",
+                fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
         }
         if (rows.empty())
             doc_.fail(&f, key,
@@ -750,13 +754,14 @@ private:
             return fmt::format("'{}' belongs in [defaults] (or in a [[block]] or [[block.condition]]).", key);
         if (!in(kConditionKeys) && in(all_procedure_keys())) {
             if (here.empty() || here == "defaults")
-                return fmt::format("'{}' belongs in [defaults.procedure] (or a block's or condition's procedure "
-                                   "table).",
-                                   key);
-            return fmt::format("'{}' belongs in the {}'s procedure table: procedure = {{ {} = ... }}.", key, here,
-                               key);
+                return fmt::format(
+                    "'{}' belongs in [defaults.procedure] (or a block's or condition's procedure "
+                    "table).",
+                    key);
+            return fmt::format("'{}' belongs in the {}'s procedure table: procedure = {{ {} = ... }}.", key, here, key);
         }
-        if (in(kProtocolKeys) && key != "adaptation_s" && key != "name") return fmt::format("'{}' belongs in [protocol].", key);
+        if (in(kProtocolKeys) && key != "adaptation_s" && key != "name")
+            return fmt::format("'{}' belongs in [protocol].", key);
         if (in(kDisplayKeys) && key != "name") return fmt::format("'{}' belongs in [display].", key);
         if (in(kTimingKeys)) return fmt::format("'{}' belongs in [timing].", key);
         if (in(kScreenKeys)) return fmt::format("'{}' belongs in [screens].", key);
@@ -1027,9 +1032,8 @@ private:
                     Section cs(doc_, ct, cpath, fmt::format("[[block.condition]] {} of block \"{}\"", ci, b.name));
                     std::vector<std::string_view> ckeys(std::begin(kConditionKeys), std::end(kConditionKeys));
                     ckeys.push_back("name");
-                    step([&] {
-                        cs.allow(ckeys, [](std::string_view k) { return belongs_elsewhere(k, "condition"); });
-                    });
+                    step(
+                        [&] { cs.allow(ckeys, [](std::string_view k) { return belongs_elsewhere(k, "condition"); }); });
                     std::string name = cs.string("name").value_or(fmt::format("{}-c{}", b.name, ci));
                     if (name.empty()) cs.fail("name", "name must not be empty.");
                     if (auto [it, inserted] = condition_lines.emplace(name, cs.line()); !inserted)
@@ -1037,8 +1041,8 @@ private:
                                 fmt::format("a condition called \"{}\" already exists (line {}); condition names are "
                                             "unique in the protocol.",
                                             name, it->second));
-                    ConditionReader cr(doc_, {Layer{defaults, "defaults"}, Layer{&bt, bpath}, Layer{&ct, cpath}},
-                                       name, cs.line());
+                    ConditionReader cr(doc_, {Layer{defaults, "defaults"}, Layer{&bt, bpath}, Layer{&ct, cpath}}, name,
+                                       cs.line());
                     b.conditions.push_back(read_condition(cr, name, cs.line()));
                 });
             }
@@ -1216,7 +1220,8 @@ private:
                    c.level_key.compare(c.level_key.size() - suffix.size(), suffix.size(), suffix) == 0;
         };
         const bool photometric = ends_with("_cd") || ends_with("_cd_m2") || ends_with("_lux");
-        for (std::string_view key : {"start", "levels", "min_level", "max_level", "t_guess", "start_min", "start_max"}) {
+        for (std::string_view key :
+             {"start", "levels", "min_level", "max_level", "t_guess", "start_min", "start_max"}) {
             const Found* f = pr.entry(key);
             if (f == nullptr) continue;
             std::vector<double> v;

@@ -1,15 +1,15 @@
 // Strict TOML reading for the protocol file (protocol_reader.h).
 #include "protocol_reader.h"
 
-#include "atonlab/common/input_limits.h"
-#include "atonlab/common/toml_text.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+
+#include "atonlab/common/input_limits.h"
+#include "atonlab/common/toml_text.h"
 
 namespace atonlab::protocols::detail {
 
@@ -266,10 +266,10 @@ void Section::allow(KeyList allowed, const std::function<std::string(std::string
     for (auto&& [k, v] : table_) {
         if (std::find(allowed.begin(), allowed.end(), k.str()) != allowed.end()) continue;
         const std::string elsewhere = belongs ? belongs(k.str()) : std::string();
-        const std::string message =
-            elsewhere.empty() ? fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
-                                            suggestion(k.str(), allowed), join_quoted(allowed))
-                              : fmt::format("'{}' is not a key of {}: {}", k.str(), title_, elsewhere);
+        const std::string message = elsewhere.empty()
+                                        ? fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
+                                                      suggestion(k.str(), allowed), join_quoted(allowed))
+                                        : fmt::format("'{}' is not a key of {}: {}", k.str(), title_, elsewhere);
         unknown.emplace_back(doc_.file(), static_cast<int>(k.source().begin.line),
                              static_cast<int>(k.source().begin.column), key_path(k.str()), message);
     }

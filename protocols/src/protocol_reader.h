@@ -45,7 +45,7 @@ public:
     /// the CSV file, the row's line and the column instead of the TOML path.
     struct CsvRow {
         std::string file;
-        int line = 0;  ///< 1-based line of the row in the CSV file
+        int line = 0;                                      ///< 1-based line of the row in the CSV file
         std::vector<std::pair<std::string, int>> columns;  ///< (column name, 1-based column) of the row's cells
         std::vector<int> set, test_set, reference_set;     ///< the column of each override, in order
     };

@@ -27,8 +27,8 @@
 #include <utility>
 
 #include "atonlab/stimuli/atmosphere.h"
-#include "atonlab/common/input_limits.h"
 #include "atonlab/common/error_list.h"
+#include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
 #include "atonlab/stimuli/calibration.h"
@@ -1140,9 +1140,8 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     step([&] { scene.display = read_display(doc, root); });
     step([&] { scene.camera = read_camera(doc, root); });
     step([&] { scene.environment = read_environment(doc, root); });
-    step([&] {
-        scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation);
-    });
+    step(
+        [&] { scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation); });
     scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
     // The pupil the glare stage will use (glare_stage.h glare_pupil_mm): given,
     // or eq 3.15 from the fixed adaptation, or the dark-adapted 7.9 mm when the

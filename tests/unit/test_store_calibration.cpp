@@ -140,9 +140,9 @@ TEST(StoreSchemaV2, NewerFileIsRefusedUntouched) {
     { Store::create_or_open(path).put_calibration(make_calibration()); }
     {
         RawDb raw(path);
-        ASSERT_EQ(raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = " +
-                           std::to_string(schema_version() + 1)),
-                  "");
+        ASSERT_EQ(
+            raw.exec("PRAGMA wal_checkpoint(TRUNCATE); PRAGMA user_version = " + std::to_string(schema_version() + 1)),
+            "");
     }
     const std::string before = file_bytes(path);
     const std::string msg = expect_store_error(StoreErrc::newer_schema, [&] { Store::create_or_open(path); });

@@ -15,8 +15,8 @@
 // gives the staircase reversals and QUEST's posterior after every trial.
 #include <cstdint>
 #include <filesystem>
-#include <memory>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
