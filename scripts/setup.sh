@@ -20,6 +20,7 @@ packages=(
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
   python3 sqlite3  # tests only: the README quick-start walk, the fake spotread's transcripts, reading study files from shell tests
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
+  chromium  # the report's layout test renders report.html headless (tests/e2e/report_chromium.sh)
 )
 
 missing=()

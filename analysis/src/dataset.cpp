@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "atonlab/analysis/study_analysis.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/protocols/procedure.h"
 #include "csv.h"
@@ -88,6 +89,7 @@ const std::vector<std::string>& trials_csv_columns() {
                                                "glare_test",
                                                "glare_reference",
                                                "test_intensity_cd",
+                                               "chose_reference",
                                                "guess_rate",
                                                "target_p",
                                                "reversal",
@@ -179,6 +181,19 @@ bool is_adjust_word(std::string_view word) {
     if (word == "match") return true;
     const std::optional<p::Response> r = p::parse_response_word(word);
     return r && *r != p::Response::Yes && *r != p::Response::No && *r != p::Response::Left && *r != p::Response::Right;
+}
+
+/// A trials.csv setting field back as TOML value text (Trial::settings): a
+/// number or boolean as written, anything else as a TOML string.
+std::string toml_of_field(const std::string& field) {
+    const SettingValue v = setting_value(field);
+    if (v.number || v.boolean) return field;
+    std::string q = "\"";
+    for (const char ch : field) {
+        if (ch == '"' || ch == '\\') q += '\\';
+        q += ch;
+    }
+    return q + "\"";
 }
 
 Trial trial_from_row(const RowReader& row, const std::string& file) {
@@ -311,9 +326,15 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     Dataset d;
     d.sources.push_back(file);
     std::vector<std::string> unknown;
+    std::vector<std::pair<std::string, std::size_t>> setting_columns;  // Trial::settings: scene keys, with a dot
     const auto& known = trials_csv_columns();
-    for (const auto& [name, i] : index)
-        if (std::find(known.begin(), known.end(), name) == known.end()) unknown.push_back(name);
+    for (const auto& [name, i] : index) {
+        if (std::find(known.begin(), known.end(), name) != known.end()) continue;
+        if (name.find('.') != std::string::npos)
+            setting_columns.emplace_back(name, i);
+        else
+            unknown.push_back(name);
+    }
     if (!unknown.empty()) {
         std::string list;
         for (const std::string& u : unknown) list += (list.empty() ? "" : ", ") + u;
@@ -333,7 +354,10 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
                                          header->fields.size()));
         const RowReader row(file, rec->line, index, rec->fields);
         Trial t = trial_from_row(row, file);
-        if (t.session.empty()) t.session = fmt::format("{}:{}", file, t.observer);
+        for (const auto& [name, i] : setting_columns)
+            if (const std::string v = RowReader::trim(rec->fields[i]); !v.empty()) t.settings[name] = toml_of_field(v);
+        if (t.session.empty())
+            t.session = fmt::format("{}:{}", std::filesystem::path(file).filename().string(), t.observer);
         if (!index.count("trial_index")) t.trial_index = next_index[t.session]++;
         d.trials.push_back(std::move(t));
     }
@@ -361,11 +385,37 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
 // ---------------------------------------------------------------------------
 // Writing trials.csv
 
+namespace {
+
+/// 2AFC: 1 when the observer chose the reference stimulus, 0 the test; "" for
+/// other tasks and for answers that chose neither (a timeout).
+std::string chose_reference(const Trial& t) {
+    if (t.task != Task::TwoAfc || !t.test_on_left || (t.response != "left" && t.response != "right")) return {};
+    const bool chose_test = (t.response == "left") == *t.test_on_left;
+    return chose_test ? "0" : "1";
+}
+
+/// A setting's TOML value text as a typed CSV field: numbers and booleans as
+/// written, a string's contents without its quotes.
+std::string setting_field(const std::string& toml_value) {
+    const SettingValue v = setting_value(toml_value);
+    if (v.number) return detail::number_text(*v.number);
+    if (v.boolean) return *v.boolean ? "true" : "false";
+    return detail::csv_field(v.text);
+}
+
+}  // namespace
+
 void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data) {
     std::ofstream out(csv_file, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot be written", csv_file.string()));
     const auto& cols = trials_csv_columns();
     for (std::size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << cols[i];
+    // Then every setting any trial has (Trial::settings), typed, in name order.
+    std::set<std::string> setting_keys;
+    for (const Trial& t : data.trials)
+        for (const auto& kv : t.settings) setting_keys.insert(kv.first);
+    for (const std::string& k : setting_keys) out << ',' << detail::csv_field(k);
     out << '\n';
     auto num = [](const std::optional<double>& v) { return v ? detail::number_text(*v) : std::string(); };
     auto flag = [](const std::optional<bool>& v) { return v ? std::string(*v ? "1" : "0") : std::string(); };
@@ -396,6 +446,7 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
                                          csv_field(t.glare_test),
                                          csv_field(t.glare_reference),
                                          num(t.test_intensity_cd),
+                                         chose_reference(t),
                                          detail::number_text(t.guess_rate),
                                          detail::number_text(t.target_p),
                                          flag(t.reversal),
@@ -405,6 +456,10 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
                                          num(t.quest_upper),
                                          csv_field(t.source)};
         for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
+        for (const std::string& k : setting_keys) {
+            const auto it = t.settings.find(k);
+            out << ',' << (it == t.settings.end() ? std::string() : setting_field(it->second));
+        }
         out << '\n';
     }
     out.flush();
@@ -415,7 +470,39 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
 
 void merge(Dataset& into, Dataset&& more) {
     std::set<std::string, std::less<>> keys;
-    for (const SessionInfo& s : into.sessions) keys.insert(s.key);
+    std::map<std::string, std::string> source_of;  // session key -> its input
+    for (const SessionInfo& s : into.sessions) {
+        keys.insert(s.key);
+        source_of[s.key] = s.source;
+    }
+    auto same_file = [](const std::string& a, const std::string& b) {
+        std::error_code ec1, ec2;
+        const auto ca = std::filesystem::weakly_canonical(a, ec1);
+        const auto cb = std::filesystem::weakly_canonical(b, ec2);
+        return ec1 || ec2 ? a == b : ca == cb;
+    };
+    // Two different study files with the same name (a/study.db, b/study.db):
+    // the second one's sessions are named with the file's folder too.
+    bool rename = false;
+    for (const SessionInfo& s : more.sessions)
+        if (keys.count(s.key) && !s.source.empty() && !same_file(source_of[s.key], s.source) && s.id != 0)
+            rename = true;
+    if (rename) {
+        std::map<std::string, std::string> renamed;
+        for (SessionInfo& s : more.sessions) {
+            const std::filesystem::path p(s.source);
+            std::error_code ec;
+            const std::filesystem::path full = std::filesystem::weakly_canonical(p, ec);
+            const std::string folder = (ec ? p : full).parent_path().filename().string();
+            const std::string key = fmt::format("{}/{}#{}", folder, p.filename().string(), s.id);
+            renamed[s.key] = key;
+            s.key = key;
+        }
+        for (Trial& t : more.trials)
+            if (const auto it = renamed.find(t.session); it != renamed.end()) t.session = it->second;
+        for (SnapshotRef& r : more.snapshots)
+            if (const auto it = renamed.find(r.session); it != renamed.end()) r.session = it->second;
+    }
     for (const SessionInfo& s : more.sessions)
         if (keys.count(s.key))
             throw InputError(s.source, 0, "",

@@ -501,7 +501,7 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
 // --- frame timing ------------------------------------------------------------------------
 
 void timing_figure(Drawer& d, const Dataset& data, const StudyResults& r) {
-    if (r.timing.empty()) return;
+    if (!has_display_timing(data, r)) return;
     std::map<std::string, std::vector<const Trial*>> per;
     for (const Trial& t : data.trials) per[t.session].push_back(&t);
     int max_drop = 0;
@@ -545,6 +545,19 @@ void timing_figure(Drawer& d, const Dataset& data, const StudyResults& r) {
         "per session. Headless sessions (model or scripted observer) have no display and record none.";
     d.draw(std::move(f), body);
 }
+
+}  // namespace
+
+bool has_display_timing(const Dataset& data, const StudyResults& results) {
+    if (results.timing.empty()) return false;
+    for (const SessionTiming& s : results.timing)
+        if (s.dropped_frames > 0 || s.missed_deadlines > 0) return true;
+    for (const SessionInfo& s : data.sessions)
+        if (s.answered_by != "model" && s.answered_by != "script") return true;
+    return false;
+}
+
+namespace {
 
 double srgb_decode(double v) {
     // IEC 61966-2-1 (K2012 eq 3.13), as docs/display-calibration.md's srgb channel.

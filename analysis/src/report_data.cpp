@@ -147,6 +147,25 @@ std::string opt(const std::optional<double>& v) {
     return v ? detail::number_text(*v) : std::string();
 }
 
+/// A setting's TOML value as a typed CSV field: a number, true / false, or text.
+std::string setting_csv(const std::string& toml_value) {
+    const SettingValue v = setting_value(toml_value);
+    if (v.number) return detail::number_text(*v.number);
+    if (v.boolean) return *v.boolean ? "true" : "false";
+    return detail::csv_field(v.text);
+}
+
+/// The same as a JSON member.
+void setting_json(JsonWriter& j, const std::string& key, const std::string& toml_value) {
+    const SettingValue v = setting_value(toml_value);
+    if (v.number)
+        j.field(key, *v.number);
+    else if (v.boolean)
+        j.field(key, *v.boolean);
+    else
+        j.field(key, v.text);
+}
+
 }  // namespace
 
 const std::vector<std::string>& fits_csv_columns() {
@@ -182,7 +201,12 @@ const std::vector<std::string>& fits_csv_columns() {
                                                "bootstrap_n",
                                                "reliable",
                                                "reason",
-                                               "method"};
+                                               "method",
+                                               "adaptation_cd_m2",
+                                               "tone_operator",
+                                               "glare_test",
+                                               "glare_reference",
+                                               "test_intensity_cd"};
     return cols;
 }
 
@@ -210,6 +234,9 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
     j.field("bootstrap", r.options.bootstrap).field("seed", std::to_string(r.options.seed));
     j.field("family", std::string(to_string(r.options.family))).field("ci_level", r.options.ci_level);
     j.field("last_reversals", r.options.last_reversals).end_object();
+    j.key("factor_columns").begin_array();
+    for (const std::string& k : r.factor_columns) j.value(k);
+    j.end_array();
     j.key("observers").begin_array();
     for (const std::string& o : r.observers) j.value(o);
     j.end_array();
@@ -239,6 +266,16 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
         j.field("glare_test", c.glare_test).field("glare_reference", c.glare_reference);
         j.field("test_intensity_cd", c.test_intensity_cd).field("guess_rate", c.guess_rate);
         j.field("target_p", c.target_p).field("n_trials", c.n_trials);
+        // The design's other factors (StudyResults::factor_columns), typed; null where the condition has none.
+        j.key("factors").begin_object();
+        for (const std::string& key : r.factor_columns) {
+            const auto it = c.settings.find(key);
+            if (it == c.settings.end())
+                j.field_null(key);
+            else
+                setting_json(j, key, it->second);
+        }
+        j.end_object();
         j.key("mixed").begin_array();
         for (const std::string& m : c.mixed) j.value(m);
         j.end_array();
@@ -321,8 +358,10 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
 
 void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
     std::string out;
-    const auto& cols = fits_csv_columns();
-    for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + cols[i];
+    // The fixed columns, then one per factor of the design (StudyResults::factor_columns).
+    std::vector<std::string> cols = fits_csv_columns();
+    cols.insert(cols.end(), r.factor_columns.begin(), r.factor_columns.end());
+    for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + detail::csv_field(cols[i]);
     out += "\n";
     using detail::csv_field;
     for (const GroupResult& g : r.groups) {
@@ -337,6 +376,15 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
             m["task"] = std::string(to_string(c->task));
             m["procedure"] = csv_field(c->procedure);
             m["level_unit"] = csv_field(c->level_unit());
+            m["adaptation_cd_m2"] = opt(c->adaptation_cd_m2);
+            m["tone_operator"] = csv_field(c->tone_operator);
+            m["glare_test"] = csv_field(c->glare_test);
+            m["glare_reference"] = csv_field(c->glare_reference);
+            m["test_intensity_cd"] = opt(c->test_intensity_cd);
+            for (const std::string& key : r.factor_columns) {
+                const auto it = c->settings.find(key);
+                m[key] = it == c->settings.end() ? std::string() : setting_csv(it->second);
+            }
             for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + m[cols[i]];
             out += "\n";
         };

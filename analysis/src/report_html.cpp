@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <charconv>
 #include <fstream>
 #include <cmath>
 #include <map>
@@ -57,9 +58,36 @@ std::string ci_text(const std::optional<Interval>& ci) {
     return ci ? fmt::format("[{:.3f}, {:.3f}]", ci->lower, ci->upper) : std::string("&ndash;");
 }
 
-std::string yes_no(bool reliable, const std::string& reason) {
+/// Footnotes of one table: a reason longer than kInlineReason characters is
+/// numbered in its cell and written out in full under the table, so that one
+/// long sentence does not widen the whole table.
+class Footnotes {
+public:
+    static constexpr std::size_t kInlineReason = 48;
+
+    /// `reason` itself when short, else a numbered reference to it.
+    std::string cite(const std::string& reason) {
+        if (reason.size() <= kInlineReason) return esc(reason);
+        ++next_;
+        notes_ += fmt::format("<li id=\"note-{0}\" value=\"{0}\">{1}</li>\n", next_, esc(reason));
+        return fmt::format("see note <a href=\"#note-{0}\">{0}</a>", next_);
+    }
+    /// The notes cited since the last flush, as a list ("" when none).
+    std::string flush() {
+        if (notes_.empty()) return {};
+        std::string h = "<ol class=\"notes\">\n" + notes_ + "</ol>\n";
+        notes_.clear();
+        return h;
+    }
+
+private:
+    int next_ = 0;
+    std::string notes_;
+};
+
+std::string yes_no(bool reliable, const std::string& reason, Footnotes& notes) {
     if (reliable) return "<span class=\"ok\">yes</span>";
-    return "<span class=\"bad\">no</span>" + (reason.empty() ? std::string() : ": " + esc(reason));
+    return "<span class=\"bad\">no</span>" + (reason.empty() ? std::string() : ": " + notes.cite(reason));
 }
 
 /// "12.3 (12.1 ± 5%)": a measured value, the calibration's prediction and the tolerance.
@@ -117,17 +145,106 @@ std::string figure_html(const std::filesystem::path& out_dir, const Figure& f) {
 }
 
 const char* kStyle =
-    R"(body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 2em auto; max-width: 72em; color: #222; line-height: 1.4; }
+    R"(body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 2em auto; max-width: 72em; padding: 0 1em; color: #222; line-height: 1.4; overflow-wrap: anywhere; }
 h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
-table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: left; vertical-align: top; }
+.table-wrap { max-width: 100%; overflow-x: auto; margin: 0.8em 0; }
+table { border-collapse: collapse; font-size: 0.9em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: left; vertical-align: top; overflow-wrap: normal; }
 th { background: #f2f2f2; }
 td.num { text-align: right; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
+ol.notes { font-size: 0.85em; color: #444; margin-top: 0; }
 .ok { color: #1a7f37; font-weight: bold; } .bad { color: #b3261e; font-weight: bold; }
 .warn { background: #fff4e5; border-left: 4px solid #f0a020; padding: 0.5em 1em; }
-figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
+figure { margin: 1em 0; } figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: 0.9em; color: #444; max-width: 60em; } .files { color: #777; }
-code { background: #f4f4f4; padding: 0 0.2em; })";
+code { background: #f4f4f4; padding: 0 0.2em; }
+@media print {
+  body { margin: 0; max-width: none; padding: 0; font-size: 10pt; }
+  .table-wrap { overflow: visible; }
+  table { font-size: 8pt; width: 100%; }
+  th, td { overflow-wrap: anywhere; padding: 0.15em 0.3em; }
+  td.num { white-space: normal; }
+  tr, figure, .warn { break-inside: avoid; }
+  h2 { break-after: avoid; }
+  a { color: inherit; text-decoration: none; }
+  .files { display: none; }
+})";
+
+/// A JSON text (valid: the store's CHECK has seen to that) as (path, value)
+/// pairs in document order, for the calibration's parameter table: objects
+/// give "a.b", arrays "a[0]"; strings are unquoted, numbers as written.
+class JsonFlattener {
+public:
+    explicit JsonFlattener(std::string_view text) : s_(text) {}
+
+    std::vector<std::pair<std::string, std::string>> run() {
+        value("");
+        return out_;
+    }
+
+private:
+    void ws() {
+        while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\n' || s_[i_] == '\r' || s_[i_] == '\t')) ++i_;
+    }
+    std::string string() {
+        std::string v;
+        ++i_;  // the opening quote
+        while (i_ < s_.size() && s_[i_] != '"') {
+            if (s_[i_] == '\\' && i_ + 1 < s_.size()) {
+                ++i_;
+                const char e = s_[i_];
+                v += e == 'n' ? '\n' : e == 't' ? '\t' : e == 'u' ? '?' : e;
+                if (e == 'u') i_ += 4;
+            } else {
+                v += s_[i_];
+            }
+            ++i_;
+        }
+        ++i_;  // the closing quote
+        return v;
+    }
+    void value(const std::string& path) {
+        ws();
+        if (i_ >= s_.size()) return;
+        const char c = s_[i_];
+        if (c == '{') {
+            ++i_;
+            ws();
+            while (i_ < s_.size() && s_[i_] != '}') {
+                ws();
+                const std::string k = string();
+                ws();
+                ++i_;  // ':'
+                value(path.empty() ? k : path + "." + k);
+                ws();
+                if (i_ < s_.size() && s_[i_] == ',') ++i_;
+                ws();
+            }
+            ++i_;
+        } else if (c == '[') {
+            ++i_;
+            ws();
+            for (int n = 0; i_ < s_.size() && s_[i_] != ']'; ++n) {
+                value(fmt::format("{}[{}]", path, n));
+                ws();
+                if (i_ < s_.size() && s_[i_] == ',') ++i_;
+                ws();
+            }
+            ++i_;
+        } else if (c == '"') {
+            out_.emplace_back(path, string());
+        } else {
+            const std::size_t start = i_;
+            while (i_ < s_.size() && s_[i_] != ',' && s_[i_] != '}' && s_[i_] != ']' && s_[i_] != ' ' && s_[i_] != '\n')
+                ++i_;
+            out_.emplace_back(path, std::string(s_.substr(start, i_ - start)));
+        }
+    }
+
+    std::string_view s_;
+    std::size_t i_ = 0;
+    std::vector<std::pair<std::string, std::string>> out_;
+};
 
 }  // namespace
 
@@ -176,6 +293,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         }
     }
     std::string h;
+    Footnotes notes;  // long reasons, numbered under each table
     h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += "<title>atonlab analysis</title>\n<style>\n" + std::string(kStyle) + "\n</style>\n</head>\n<body>\n";
     h += "<h1>atonlab analysis</h1>\n";
@@ -212,26 +330,28 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
          "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
          "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
-    h += "<table>\n<tr><th>condition</th><th>task / procedure</th><th>adaptation (cd/m²)</th><th>tone mapper</th>"
-         "<th>glare test / reference</th><th>test (cd)</th><th>observer</th><th>trials</th><th>estimate</th>"
-         "<th>interval</th><th>unit</th><th>enhancement [interval]</th><th>reliable</th></tr>\n";
+    // Each number over its interval in one cell, so that the table fits 1280 px.
+    h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th>"
+         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>glare test / reference</th><th>test (cd)</th>"
+         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>enhancement [interval]</th>"
+         "<th>reliable</th></tr>\n";
     for (const ConditionInfo& c : r.conditions) {
         const GroupResult* g = r.main_group(c.condition);
         if (!g) continue;
         const HeadlineEstimate& e = g->headline;
         std::string enh = "&ndash;";
         if (g->match_ratio && g->match_ratio->value)
-            enh = f3(g->match_ratio->value) + " " + ci_text(g->match_ratio->ci);
+            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci);
         h += fmt::format(
             "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
-            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))), esc(c.procedure),
-            g3(c.adaptation_cd_m2), esc(c.tone_operator), esc(c.glare_test), esc(c.glare_reference),
-            g3(c.test_intensity_cd), esc(g->observer), g->n_scored, f3(e.value), ci_text(e.ci), esc(c.level_unit()),
-            enh, yes_no(e.reliable, e.reason));
+            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}<br>{}</td>"
+            "<td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))),
+            esc(c.procedure.empty() ? "(not stated)" : c.procedure), g3(c.adaptation_cd_m2), esc(c.tone_operator),
+            esc(c.glare_test), esc(c.glare_reference), g3(c.test_intensity_cd), esc(g->observer), g->n_scored,
+            f3(e.value), ci_text(e.ci), esc(c.level_unit()), enh, yes_no(e.reliable, e.reason, notes));
     }
-    h += "</table>\n";
+    h += "</table></div>\n" + notes.flush();
     for (const char* kind : {"pse", "enhancement"})
         if (by_kind.count(kind)) h += figure_html(out_dir, *by_kind[kind]);
 
@@ -252,7 +372,23 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
             : c.level_on == "test"   ? "chose the test"
                                      : "chose the reference",
             c.guess_rate, c.target_p, c.n_trials);
-        h += "<table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</th><th>how</th>"
+        if (!r.factor_columns.empty()) {
+            // The design's other factors (fits.csv's factor columns), as the protocol set them.
+            std::string list;
+            for (const std::string& key : r.factor_columns) {
+                const auto it = c.settings.find(key);
+                const SettingValue v = setting_value(it == c.settings.end() ? std::string() : it->second);
+                const std::string shown = it == c.settings.end() ? std::string("(not set)")
+                                          : v.number             ? fmt::format("{:.6g}", *v.number)
+                                          : v.boolean            ? std::string(*v.boolean ? "true" : "false")
+                                                                 : v.text;
+                list += fmt::format("{}<code>{}</code> = {}", list.empty() ? "" : ", ", esc(key), esc(shown));
+            }
+            h += "<p>Other factors of the design: " + list + ".</p>\n";
+        }
+        h += "<div "
+             "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</"
+             "th><th>how</th>"
              "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
              "<th>reliable</th></tr>\n";
         for (const GroupResult& g : r.groups) {
@@ -276,9 +412,9 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                 "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                 "<td>{}</td></tr>\n",
                 esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method),
-                slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason));
+                slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason, notes));
         }
-        h += "</table>\n";
+        h += "</table></div>\n" + notes.flush();
         // The procedures' own estimates.
         std::string tracks;
         for (const GroupResult& g : r.groups) {
@@ -290,7 +426,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                         "<tr><td>{}</td><td>{}</td><td>staircase</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                         "<td>mean of the last {} of {} reversals, sd {}</td><td>{}</td><td>{}</td></tr>\n",
                         esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(s.mean), s.n_used,
-                        s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason));
+                        s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason, notes));
                 }
                 if (t.quest) {
                     const QuestSummary& q = *t.quest;
@@ -298,7 +434,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                         "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                         "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
                         esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(q.mean), g3(q.sd),
-                        ci_text(q.interval), yes_no(q.reliable, q.reason));
+                        ci_text(q.interval), yes_no(q.reliable, q.reason, notes));
                 }
             }
             if (g.matches) {
@@ -308,13 +444,14 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                     "<td class=\"num\">{}</td><td>mean match; median {} {}, sd {}</td><td class=\"num\">{}</td>"
                     "<td>{}</td></tr>\n",
                     esc(g.observer), m.n, f3(m.mean_log10_ratio), f3(m.median_log10_ratio), ci_text(m.median_ci),
-                    g3(m.sd_log10_ratio), ci_text(m.mean_ci), yes_no(m.reliable, m.reason));
+                    g3(m.sd_log10_ratio), ci_text(m.mean_ci), yes_no(m.reliable, m.reason, notes));
             }
         }
         if (!tracks.empty()) {
-            h += "<p>The procedures' own estimates:</p>\n<table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
+            h += "<p>The procedures' own estimates:</p>\n<div "
+                 "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
                  "<th>trials</th><th>estimate</th><th>how</th><th>interval</th><th>reliable</th></tr>\n" +
-                 tracks + "</table>\n";
+                 tracks + "</table></div>\n" + notes.flush();
         }
         if (const auto it = by_condition.find(c.condition); it != by_condition.end())
             for (const Figure* f : it->second) h += figure_html(out_dir, *f);
@@ -334,7 +471,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         h += "<p>Conditions that differ in one stimulus parameter, compared within observers: the mean of each "
              "observer's difference A &minus; B of the headline estimates, its bootstrap interval over observers, "
              "and Student's paired t test.</p>\n";
-        h += "<table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean A &minus; B</th>"
+        h += "<div class=\"table-wrap\"><table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean "
+             "A &minus; B</th>"
              "<th>interval</th><th>t (dof)</th><th>p</th><th>reliable</th></tr>\n";
         for (const PairedResult& p : r.paired) {
             const PairedComparison& c = p.comparison;
@@ -342,47 +480,69 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                 "<td class=\"num\">{}</td><td class=\"num\">{} ({})</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
                 esc(p.condition_a), esc(p.condition_b), esc(p.factor), c.n, f3(c.mean_difference), ci_text(c.ci),
-                g3(c.t), c.dof, g3(c.p_value), yes_no(c.reliable, c.reason));
+                g3(c.t), c.dof, g3(c.p_value), yes_no(c.reliable, c.reason, notes));
         }
-        h += "</table>\n";
+        h += "</table></div>\n" + notes.flush();
     }
 
     // --- sessions and timing
-    h += "<h2>Sessions and frame timing</h2>\n<table>\n<tr><th>session</th><th>observer</th><th>protocol</th>"
-         "<th>status</th><th>started</th><th>trials</th><th>dropped frames</th><th>trials with drops</th>"
-         "<th>missed deadlines</th><th>display check</th></tr>\n";
+    h += "<h2>Sessions and frame timing</h2>\n<div class=\"table-wrap\"><table>\n<tr><th>session</th>"
+         "<th>observer</th><th>answered by</th><th>protocol</th><th>status</th><th>started</th><th>trials</th>"
+         "<th>dropped frames</th><th>trials with drops</th><th>missed deadlines</th><th>display check</th></tr>\n";
     for (const SessionInfo& s : d.sessions) {
         const SessionTiming* t = nullptr;
         for (const SessionTiming& x : r.timing)
             if (x.session == s.key) t = &x;
         h += fmt::format(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(s.key), esc(s.observer), esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0,
-            t ? t->dropped_frames : 0, t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
+            esc(s.key), esc(s.observer), esc(s.answered_by.empty() ? "(not recorded)" : s.answered_by),
+            esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0, t ? t->dropped_frames : 0,
+            t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
             !s.displayable   ? std::string("not recorded")
             : *s.displayable ? std::string("displayable")
                              : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",
                                                fmt::join(s.undisplayable, ", "))));
     }
-    h += "</table>\n";
-    if (by_kind.count("timing")) h += figure_html(out_dir, *by_kind["timing"]);
+    h += "</table></div>\n" + notes.flush();
+    if (by_kind.count("timing"))
+        h += figure_html(out_dir, *by_kind["timing"]);
+    else if (!r.timing.empty() && !has_display_timing(d, r))
+        h += "<p>Every session was answered by the model or a scripted observer and dropped no frame: their "
+             "frame times are the virtual clock's (headless) or a simulated observer's, not a person's view of a "
+             "display, so no timing figure is drawn.</p>\n";
 
     // --- calibration
     h += "<h2>Display calibration</h2>\n";
     if (d.calibrations.empty()) {
         h += "<p>No calibration is recorded for these sessions (a CSV input has none).</p>\n";
     } else {
-        h += "<table>\n<tr><th>display</th><th>file</th><th>measured</th><th>how</th><th>geometry</th>"
-             "<th>readings</th><th>model (fit_json)</th></tr>\n";
+        h += "<div class=\"table-wrap\"><table>\n<tr><th>display</th><th>file</th><th>measured</th><th>how</th>"
+             "<th>geometry</th><th>readings</th></tr>\n";
         for (const CalibrationInfo& c : d.calibrations) {
             h += fmt::format(
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} × {} px, {:.3f} × {:.3f} m at {:.3f} m</td>"
-                "<td class=\"num\">{}</td><td><code>{}</code></td></tr>\n",
+                "<td class=\"num\">{}</td></tr>\n",
                 esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px, c.width_m,
-                c.height_m, c.viewing_distance_m, c.readings.size(), esc(c.fit_json));
+                c.height_m, c.viewing_distance_m, c.readings.size());
         }
-        h += "</table>\n";
+        h += "</table></div>\n" + notes.flush();
+        // The fitted model's parameters (fit_json, docs/calibration.md), one row each.
+        for (const CalibrationInfo& c : d.calibrations) {
+            h += fmt::format(
+                "<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
+                esc(c.display_name), c.id, esc(c.source));
+            h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
+            for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
+                // Numbers to 6 significant digits (summary.json keeps them whole).
+                double x = 0.0;
+                const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
+                const bool number = ec == std::errc() && end == value.data() + value.size();
+                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key),
+                                 number ? fmt::format("{:.6g}", x) : esc(value));
+            }
+            h += "</table></div>\n";
+        }
         if (ctx.plots)
             for (const Figure& f : ctx.plots->figures)
                 if (f.kind == "calibration") h += figure_html(out_dir, f);

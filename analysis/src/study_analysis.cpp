@@ -1,6 +1,7 @@
 #include "atonlab/analysis/study_analysis.h"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -66,6 +67,18 @@ ConditionInfo condition_info(const std::string& name, const std::vector<const Tr
     if (c.level_on == "test") c.test_intensity_cd.reset();
     check("guess_rate", [](const Trial& t) { return t.guess_rate; });
     check("target_p", [](const Trial& t) { return t.target_p; });
+    // A setting that changes within the condition is not one of its factors.
+    for (const auto& [key, value] : f.settings) {
+        bool same = true;
+        for (const Trial* t : trials) {
+            const auto it = t->settings.find(key);
+            if (it == t->settings.end() || it->second != value) {
+                same = false;
+                break;
+            }
+        }
+        if (same) c.settings[key] = value;
+    }
     return c;
 }
 
@@ -362,6 +375,26 @@ const GroupResult* StudyResults::main_group(const std::string& name) const {
     return first;
 }
 
+SettingValue setting_value(std::string_view toml_value) {
+    SettingValue v;
+    v.text = std::string(toml_value);
+    toml::table doc;
+    try {
+        doc = toml::parse("v = " + v.text);
+    } catch (const toml::parse_error&) {
+        return v;
+    }
+    const toml::node* n = doc.get("v");
+    if (!n) return v;
+    if (const auto x = n->value<double>(); x && (n->is_integer() || n->is_floating_point()))
+        v.number = *x;
+    else if (const auto b = n->value<bool>(); b && n->is_boolean())
+        v.boolean = *b;
+    else if (const auto t = n->value<std::string>(); t && n->is_string())
+        v.text = *t;
+    return v;
+}
+
 StudyResults analyze_study(const Dataset& data, const AnalysisOptions& options) {
     if (options.bootstrap < 0) throw std::invalid_argument("bootstrap must be >= 0");
     if (!(options.ci_level > 0.0 && options.ci_level < 1.0)) throw std::invalid_argument("ci_level must be in (0, 1)");
@@ -410,6 +443,22 @@ StudyResults analyze_study(const Dataset& data, const AnalysisOptions& options) 
                 out.groups.push_back(analyse_group(info, kPooled, trials, options, out.warnings));
         }
         out.conditions.push_back(std::move(info));
+    }
+
+    // Factor columns: settings whose value (or absence) is not the same in every condition.
+    {
+        std::set<std::string> keys;
+        for (const ConditionInfo& c : out.conditions)
+            for (const auto& kv : c.settings) keys.insert(kv.first);
+        for (const std::string& key : keys) {
+            std::set<std::string> values;
+            for (const ConditionInfo& c : out.conditions) {
+                if (c.n_trials == 0) continue;
+                const auto it = c.settings.find(key);
+                values.insert(it == c.settings.end() ? std::string() : it->second);  // a TOML value is never ""
+            }
+            if (values.size() > 1) out.factor_columns.push_back(key);
+        }
     }
 
     // Paired comparisons across observers.

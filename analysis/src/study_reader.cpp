@@ -129,6 +129,25 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
     }
     if (test_glare) t.glare_test = *test_glare;
     if (reference_glare) t.glare_reference = *reference_glare;
+    // The other overrides, as factor columns (Trial::settings).
+    std::set<std::string> keys;
+    for (const Frame& f : frames)
+        for (const auto& kv : f.overrides) keys.insert(kv.first);
+    const std::set<std::string> covered{t.level_key, "eye.adaptation_cd_m2", "tonemap.operator", "eye.glare",
+                                        test_light.empty() ? std::string() : "light." + test_light + ".intensity_cd",
+                                        test_light.empty() ? std::string() : "light." + test_light + ".glare",
+                                        reference_light.empty() ? std::string() : "light." + reference_light + ".glare"};
+    for (const std::string& key : keys) {
+        if (covered.count(key)) continue;
+        const std::optional<std::string> tv = test ? test->value(key) : std::nullopt;
+        const std::optional<std::string> rv = reference ? reference->value(key) : std::nullopt;
+        if (tv == rv) {
+            if (tv) t.settings[key] = *tv;
+            continue;
+        }
+        if (tv) t.settings["test." + key] = *tv;
+        if (rv) t.settings["reference." + key] = *rv;
+    }
 }
 
 /// The binary outcome of a trial (Trial::outcome).
@@ -199,7 +218,9 @@ namespace {
 void add_session(Dataset& d, const store::Store& db, const std::string& file, const store::SessionRecord& s,
                  const std::vector<store::TrialRecord>& records, std::set<std::int64_t>& calibrations, bool salvage) {
     SessionInfo info;
-    info.key = fmt::format("{}#{}", file, s.id.value);
+    // The file's name and the session's id: the same however the path to the
+    // file was written (merge() qualifies it when two inputs share a name).
+    info.key = fmt::format("{}#{}", std::filesystem::path(file).filename().string(), s.id.value);
     info.source = file;
     info.id = s.id.value;
     info.observer = s.observer_code;
@@ -211,6 +232,14 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
     info.ended_at = s.ended_at.value_or("");
     info.status = store::to_string(s.status);
     info.trial_count = s.trial_count;
+    if (!records.empty()) {
+        try {
+            const store::JsonReader state(records.front().procedure_state_json, "procedure_state_json");
+            info.answered_by = state.string("$.observer").value_or("");
+        } catch (const store::StoreError&) {
+            // Unknown: the report then treats the session's timing as real.
+        }
+    }
     if (s.calibration) {
         info.calibration_id = s.calibration->value;
         calibrations.insert(s.calibration->value);

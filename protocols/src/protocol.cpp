@@ -108,6 +108,23 @@ ProtocolError::ProtocolError(std::string file, int line, int column, std::string
       key_(std::move(key)),
       message_(text::one_line(message)) {}
 
+namespace {
+std::string with_further(std::string first, const std::vector<std::string>& further) {
+    for (const std::string& f : further) first += "\n" + f;
+    return first;
+}
+}  // namespace
+
+ProtocolError::ProtocolError(std::string file, int line, int column, std::string key, const std::string& message,
+                             std::vector<std::string> further)
+    : std::runtime_error(with_further(format_error(file, line, key, message), further)),
+      further_(std::move(further)),
+      file_(std::move(file)),
+      line_(line),
+      column_(column),
+      key_(std::move(key)),
+      message_(text::one_line(message)) {}
+
 std::string_view to_string(Task t) noexcept {
     return name_of(kTasks, t);
 }

@@ -11,7 +11,9 @@
 #include <cerrno>
 #include <charconv>
 #include <cstdint>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <optional>
@@ -20,6 +22,7 @@
 
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
+#include "atonlab/common/toml_text.h"
 #include "protocol_reader.h"
 
 namespace atonlab::protocols {
@@ -50,8 +53,8 @@ constexpr std::string_view kConditionKeys[] = {
     "task",        "presentation", "prompt", "set",        "test_set",        "reference_set",   "level_key",
     "level_scale", "level_on",     "choice", "test_light", "reference_light", "left_position_m", "right_position_m",
     "procedure",   "reference_disc"};
-constexpr std::string_view kBlockOwnKeys[] = {"name",       "adaptation_s", "repetitions",
-                                              "interleave", "instructions", "condition"};
+constexpr std::string_view kBlockOwnKeys[] = {"name",         "adaptation_s", "repetitions",    "interleave",
+                                              "instructions", "condition",    "conditions_file"};
 
 constexpr std::string_view kStaircaseKeys[] = {
     "kind",        "start",    "step_sizes", "step_type", "n_up",      "n_down",        "apply_initial_rule",
@@ -235,6 +238,13 @@ public:
                 if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
                     const std::string what =
                         kind_ ? fmt::format("a {} procedure", to_string(*kind_)) : std::string("a procedure");
+                    if (std::find(std::begin(kConditionKeys), std::end(kConditionKeys), key.str()) !=
+                        std::end(kConditionKeys))
+                        doc_.fail_at_key(
+                            key, f.key + "." + std::string(key.str()),
+                            cond_.context() + fmt::format("'{}' is not a key of {}: it belongs beside the procedure, "
+                                                          "in [defaults], a [[block]] or a [[block.condition]].",
+                                                          key.str(), what));
                     doc_.fail_at_key(
                         key, f.key + "." + std::string(key.str()),
                         cond_.context() + fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", key.str(), what,
@@ -434,21 +444,332 @@ public:
                                 static_cast<int>(e.source().begin.column), "",
                                 fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
         }
+        text_ = std::string(text);
+        step([&] { expand_conditions_files(); });
+        // Every table is read even after an error in another (and every
+        // condition after an error in one): all the errors, in file order, in
+        // one run (text::ErrorList; docs/protocol-file.md "Errors").
+        doc_.collect_into(&errors_);
         Section root(doc_, root_, "", "the protocol file");
-        root.allow(kRootKeys);
+        step([&] { root.allow(kRootKeys, [](std::string_view k) { return belongs_elsewhere(k, ""); }); });
 
         Protocol p;
         p.file = doc_.file();
-        read_header(root, p, check_scene_exists);
-        read_display(root, p);
-        read_timing(root, p);
-        read_screens(root, p);
-        read_blocks(root, p);
-        read_responses(root, p);
+        step([&] { read_header(root, p, check_scene_exists); });
+        step([&] { read_display(root, p); });
+        step([&] { read_timing(root, p); });
+        step([&] { read_screens(root, p); });
+        step([&] { read_blocks(root, p); });
+        step([&] { read_responses(root, p); });
+        doc_.collect_into(nullptr);
+        if (!errors_.empty()) {
+            const text::Problem first = errors_.in_file_order().front();
+            throw ProtocolError(first.file, first.line, first.column, first.key, first.message,
+                                errors_.further_lines());
+        }
         return p;
     }
 
 private:
+    // --- Conditions files -------------------------------------------------------------
+
+    /// A CSV cell as TOML: the text itself when it is one TOML value (a number,
+    /// true / false, an array), else a TOML string of it.
+    static std::string toml_value(const std::string& cell, bool always_string) {
+        if (!always_string) {
+            try {
+                (void)toml::parse("v = " + cell);
+                return cell;
+            } catch (const toml::parse_error&) {
+            }
+        }
+        return toml_string(cell);
+    }
+    static std::string toml_string(std::string_view text) {
+        std::string q = "\"";
+        for (const char ch : text) {
+            if (ch == '"' || ch == '\\') q += '\\';
+            q += ch;
+        }
+        return q + "\"";
+    }
+
+    /// One CSV line split into fields (RFC 4180 quoting; a field may not span lines).
+    static std::optional<std::vector<std::string>> csv_fields(std::string_view line, std::string& error) {
+        std::vector<std::string> out;
+        std::string field;
+        bool quoted = false, was_quoted = false;
+        for (std::size_t i = 0; i < line.size(); ++i) {
+            const char ch = line[i];
+            if (quoted) {
+                if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                    field += '"';
+                    ++i;
+                } else if (ch == '"') {
+                    quoted = false;
+                } else {
+                    field += ch;
+                }
+            } else if (ch == '"' && field.empty() && !was_quoted) {
+                quoted = was_quoted = true;
+            } else if (ch == ',') {
+                out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
+                field.clear();
+                was_quoted = false;
+            } else {
+                field += ch;
+            }
+        }
+        if (quoted) {
+            error = "a quoted field is not closed on its line (a field may not span lines).";
+            return std::nullopt;
+        }
+        out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
+        return out;
+    }
+    static std::string_view trim_blanks(std::string_view s) {
+        while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+        while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+        return s;
+    }
+
+    /// The CSV text stored after "#@conditions_file NAME" in the protocol text, if any.
+    std::optional<std::string> embedded_csv(const std::string& name) const {
+        const std::string tag = "\n#@conditions_file " + name + "\n";
+        std::size_t at = text_.find(tag);
+        if (at == std::string::npos) return std::nullopt;
+        at += tag.size();
+        std::string out;
+        while (at < text_.size() && text_.compare(at, 3, "#@|") == 0) {
+            const std::size_t end = std::min(text_.find('\n', at), text_.size());
+            out += text_.substr(at + 3, end - at - 3) + "\n";
+            at = end + 1;
+        }
+        return out;
+    }
+
+    /// Each [[block]] with conditions_file = "FILE.csv" gets one
+    /// [[block.condition]] per row of the file (after those written in the
+    /// block; rows with a `block` column only where it names this block). The
+    /// rows are turned into TOML inline tables, one per line at the row's own
+    /// line, so that every later check reports the CSV file's row and column
+    /// (Document::add_csv_row).
+    void expand_conditions_files() {
+        toml::node* blocks = root_.get("block");
+        if (blocks == nullptr || !blocks->is_array_of_tables()) return;
+        toml::array& arr = *blocks->as_array();
+        for (std::size_t bi = 0; bi < arr.size(); ++bi) {
+            toml::table& bt = *arr.get(bi)->as_table();
+            const toml::node* f = bt.get("conditions_file");
+            if (f == nullptr) continue;
+            step([&] { expand_conditions_file(bt, bi, *f); });
+        }
+    }
+
+    void expand_conditions_file(toml::table& bt, std::size_t bi, const toml::node& f) {
+        const std::string key = fmt::format("block[{}].conditions_file", bi);
+        const std::string rel = doc_.string(&f, key);
+        if (rel.empty()) doc_.fail(&f, key, "conditions_file must name a CSV file, got an empty string.");
+        const std::filesystem::path csv = std::filesystem::path(rel).is_absolute()
+                                              ? std::filesystem::path(rel)
+                                              : std::filesystem::path(doc_.file()).parent_path() / rel;
+        text::FileText read = text::read_text_file(csv);
+        std::string file = csv.string();
+        if (!read.ok()) {
+            // A stored protocol text carries its conditions files (with_conditions_files).
+            if (auto embedded = embedded_csv(rel)) {
+                read.text = std::move(*embedded);
+                read.error.clear();
+                file = rel;
+            } else {
+                doc_.fail(&f, key,
+                          fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
+            }
+        }
+        std::vector<std::string> lines;
+        for (std::size_t at = 0; at <= read.text.size();) {
+            const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
+            lines.push_back(read.text.substr(at, end - at));
+            at = end + 1;
+        }
+        if (!lines.empty() && lines.front().rfind("\xEF\xBB\xBF", 0) == 0) lines.front().erase(0, 3);
+        std::string error;
+        const auto header = csv_fields(lines.empty() ? std::string_view() : std::string_view(lines.front()), error);
+        if (!header || header->empty() || (header->size() == 1 && header->front().empty()))
+            throw ProtocolError(file, 1, 0, "", error.empty() ? "the conditions file has no header row." : error);
+        // What each column is.
+        enum class Kind { name, block, string_key, other_key, procedure, set, test_set, reference_set };
+        constexpr std::string_view kStringKeys[] = {"task",      "presentation", "prompt",
+                                                    "level_key", "level_scale",  "level_on",
+                                                    "choice",    "test_light",   "reference_light"};
+        std::vector<Kind> kinds;
+        std::set<std::string> seen;
+        for (std::size_t c = 0; c < header->size(); ++c) {
+            const std::string& h = (*header)[c];
+            const int col = static_cast<int>(c) + 1;
+            auto fail = [&](const std::string& m) {
+                throw ProtocolError(file, 1, col, "", fmt::format("column {} '{}': {}", col, h, m));
+            };
+            if (h.empty()) fail("the column has no name.");
+            if (!seen.insert(h).second) fail("the column appears twice in the header.");
+            if (h == "name")
+                kinds.push_back(Kind::name);
+            else if (h == "block")
+                kinds.push_back(Kind::block);
+            else if (std::find(std::begin(kStringKeys), std::end(kStringKeys), h) != std::end(kStringKeys))
+                kinds.push_back(Kind::string_key);
+            else if (h == "left_position_m" || h == "right_position_m")
+                kinds.push_back(Kind::other_key);
+            else if (h.rfind("procedure.", 0) == 0 && h.size() > 10)
+                kinds.push_back(Kind::procedure);
+            else if (h.rfind("test:", 0) == 0 && h.find('.') != std::string::npos)
+                kinds.push_back(Kind::test_set);
+            else if (h.rfind("reference:", 0) == 0 && h.find('.') != std::string::npos)
+                kinds.push_back(Kind::reference_set);
+            else if (h.find('.') != std::string::npos && h.find_first_of(" =\"'") == std::string::npos)
+                kinds.push_back(Kind::set);
+            else
+                fail(
+                    fmt::format("not a column of a conditions file: give name, a condition key ({}, "
+                                "left_position_m, right_position_m), procedure.PARAMETER, a scene key "
+                                "(section.key, a `set` override), test:KEY or reference:KEY (test_set, "
+                                "reference_set), or block.{}",
+                                detail::join_quoted(kStringKeys), text::did_you_mean(h, kStringKeys)));
+        }
+        // One TOML line per CSV line: row N of the file is line N of the text.
+        std::string toml_text = "\n";
+        std::vector<std::pair<std::string, Document::CsvRow>> rows;
+        const std::string block_name = bt.get("name") && bt.get("name")->is_string()
+                                           ? *bt.get("name")->value<std::string>()
+                                           : fmt::format("block{}", bi);
+        for (std::size_t li = 1; li < lines.size(); ++li) {
+            const int line = static_cast<int>(li) + 1;
+            if (trim_blanks(lines[li]).empty()) {
+                toml_text += "\n";
+                continue;
+            }
+            const auto cells = csv_fields(lines[li], error);
+            if (!cells) throw ProtocolError(file, line, 0, "", error);
+            if (cells->size() != header->size())
+                throw ProtocolError(
+                    file, line, 0, "",
+                    fmt::format("the row has {} fields where the header has {}.", cells->size(), header->size()));
+            Document::CsvRow row;
+            row.file = file;
+            row.line = line;
+            std::string fields, procedure;
+            std::vector<std::string> set, test_set, reference_set;
+            bool take = true;
+            for (std::size_t c = 0; c < cells->size(); ++c) {
+                const std::string& cell = (*cells)[c];
+                const std::string& h = (*header)[c];
+                const int col = static_cast<int>(c) + 1;
+                if (cell.empty()) continue;  // not given for this row
+                row.columns.emplace_back(h, col);
+                switch (kinds[c]) {
+                    case Kind::block:
+                        take = cell == block_name;
+                        break;
+                    case Kind::name:
+                    case Kind::string_key:
+                        fields += fmt::format("{} = {}, ", h, toml_string(cell));
+                        break;
+                    case Kind::other_key:
+                        fields += fmt::format("{} = {}, ", h, toml_value(cell, false));
+                        break;
+                    case Kind::procedure:
+                        procedure += fmt::format("{}{} = {}", procedure.empty() ? "" : ", ", h.substr(10),
+                                                 toml_value(cell, false));
+                        break;
+                    case Kind::set:
+                        set.push_back(toml_string(h + "=" + toml_value(cell, false)));
+                        row.set.push_back(col);
+                        break;
+                    case Kind::test_set:
+                        test_set.push_back(toml_string(h.substr(5) + "=" + toml_value(cell, false)));
+                        row.test_set.push_back(col);
+                        break;
+                    case Kind::reference_set:
+                        reference_set.push_back(toml_string(h.substr(10) + "=" + toml_value(cell, false)));
+                        row.reference_set.push_back(col);
+                        break;
+                }
+            }
+            if (!take) {
+                toml_text += "\n";
+                continue;
+            }
+            auto list = [](const std::vector<std::string>& v) {
+                std::string out = "[";
+                for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + v[i];
+                return out + "]";
+            };
+            if (!set.empty()) fields += "set = " + list(set) + ", ";
+            if (!test_set.empty()) fields += "test_set = " + list(test_set) + ", ";
+            if (!reference_set.empty()) fields += "reference_set = " + list(reference_set) + ", ";
+            if (!procedure.empty()) fields += "procedure = { " + procedure + " }, ";
+            if (fields.size() >= 2) fields.resize(fields.size() - 2);
+            const std::string row_key = fmt::format("row{}", line);
+            toml_text += fmt::format("{} = {{ {} }}\n", row_key, fields);
+            rows.emplace_back(row_key, std::move(row));
+        }
+        toml::table parsed;
+        try {
+            parsed = toml::parse(toml_text, file);
+        } catch (const toml::parse_error& e) {
+            throw ProtocolError(
+                file, static_cast<int>(e.source().begin.line), 0, "",
+                fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
+        }
+        if (rows.empty())
+            doc_.fail(&f, key,
+                      fmt::format("the conditions file \"{}\" has no rows for block \"{}\" (one row per condition{}).",
+                                  file, block_name,
+                                  std::find(kinds.begin(), kinds.end(), Kind::block) != kinds.end()
+                                      ? "; its block column names the block each row belongs to"
+                                      : ""));
+        if (!bt.contains("condition")) bt.insert("condition", toml::array{});
+        toml::node* conds = bt.get("condition");
+        if (!conds->is_array_of_tables() && !(conds->is_array() && conds->as_array()->empty()))
+            return;  // reported where the block's conditions are read
+        toml::array& carr = *conds->as_array();
+        for (auto& [row_key, row] : rows) {
+            toml::node* t = parsed.get(row_key);
+            if (t == nullptr || !t->is_table()) continue;
+            doc_.add_csv_row(fmt::format("block[{}].condition[{}]", bi, carr.size()), std::move(row));
+            carr.push_back(std::move(*t->as_table()));
+        }
+    }
+
+    /// Runs one part of the reading; its error is kept and the reading goes on.
+    template <class F>
+    bool step(F&& f) {
+        return errors_.attempt<ProtocolError>(f, Document::problem);
+    }
+
+    /// Where a key written in the wrong table belongs (Section::allow's
+    /// `belongs`), "" when it is known nowhere else. `here`: "" for the
+    /// top level, "defaults", "block" or "condition".
+    static std::string belongs_elsewhere(std::string_view key, std::string_view here) {
+        auto in = [&](KeyList list) { return std::find(list.begin(), list.end(), key) != list.end(); };
+        if (here.empty() && in(kConditionKeys))
+            return fmt::format("'{}' belongs in [defaults] (or in a [[block]] or [[block.condition]]).", key);
+        if (!in(kConditionKeys) && in(all_procedure_keys())) {
+            if (here.empty() || here == "defaults")
+                return fmt::format(
+                    "'{}' belongs in [defaults.procedure] (or a block's or condition's procedure "
+                    "table).",
+                    key);
+            return fmt::format("'{}' belongs in the {}'s procedure table: procedure = {{ {} = ... }}.", key, here, key);
+        }
+        if (in(kProtocolKeys) && key != "adaptation_s" && key != "name")
+            return fmt::format("'{}' belongs in [protocol].", key);
+        if (in(kDisplayKeys) && key != "name") return fmt::format("'{}' belongs in [display].", key);
+        if (in(kTimingKeys)) return fmt::format("'{}' belongs in [timing].", key);
+        if (in(kScreenKeys)) return fmt::format("'{}' belongs in [screens].", key);
+        return {};
+    }
+
     void read_header(const Section& root, Protocol& p, bool check_scene_exists) {
         const toml::table* t = root.table("protocol");
         if (t == nullptr)
@@ -673,7 +994,7 @@ private:
         const toml::table* defaults = root.table("defaults");
         if (defaults != nullptr) {
             Section d(doc_, *defaults, "defaults", "the [defaults] table");
-            d.allow(kConditionKeys);
+            step([&] { d.allow(kConditionKeys, [](std::string_view k) { return belongs_elsewhere(k, "defaults"); }); });
         }
         const toml::node* blocks = root.get("block");
         if (blocks == nullptr)
@@ -694,10 +1015,47 @@ private:
             const toml::table& bt = *arr.get(bi)->as_table();
             const std::string bpath = fmt::format("block[{}]", bi);
             Section bs(doc_, bt, bpath, fmt::format("[[block]] {}", bi));
-            bs.allow(block_keys);
+            step([&] { bs.allow(block_keys, [](std::string_view k) { return belongs_elsewhere(k, "block"); }); });
             Block b;
             b.line = bs.line();
-            b.name = bs.string("name").value_or(fmt::format("block{}", bi));
+            b.name = fmt::format("block{}", bi);
+            step([&] { read_block_own(bs, b, block_lines); });
+            const toml::array* carr_ptr = nullptr;
+            step([&] { carr_ptr = block_conditions(bs, b); });
+            if (carr_ptr == nullptr) {
+                p.blocks.push_back(std::move(b));
+                continue;
+            }
+            const toml::array& carr = *carr_ptr;
+            for (std::size_t ci = 0; ci < carr.size(); ++ci) {
+                step([&] {
+                    const toml::table& ct = *carr.get(ci)->as_table();
+                    const std::string cpath = fmt::format("{}.condition[{}]", bpath, ci);
+                    Section cs(doc_, ct, cpath, fmt::format("[[block.condition]] {} of block \"{}\"", ci, b.name));
+                    std::vector<std::string_view> ckeys(std::begin(kConditionKeys), std::end(kConditionKeys));
+                    ckeys.push_back("name");
+                    step(
+                        [&] { cs.allow(ckeys, [](std::string_view k) { return belongs_elsewhere(k, "condition"); }); });
+                    std::string name = cs.string("name").value_or(fmt::format("{}-c{}", b.name, ci));
+                    if (name.empty()) cs.fail("name", "name must not be empty.");
+                    if (auto [it, inserted] = condition_lines.emplace(name, cs.line()); !inserted)
+                        cs.fail("name",
+                                fmt::format("a condition called \"{}\" already exists (line {}); condition names are "
+                                            "unique in the protocol.",
+                                            name, it->second));
+                    ConditionReader cr(doc_, {Layer{defaults, "defaults"}, Layer{&bt, bpath}, Layer{&ct, cpath}}, name,
+                                       cs.line());
+                    b.conditions.push_back(read_condition(cr, name, cs.line()));
+                });
+            }
+            p.blocks.push_back(std::move(b));
+        }
+    }
+
+    /// A block's own keys (not its conditions').
+    void read_block_own(const Section& bs, Block& b, std::map<std::string, int>& block_lines) {
+        {
+            b.name = bs.string("name").value_or(b.name);
             if (b.name.empty()) bs.fail("name", "name must not be empty.");
             if (auto [it, inserted] = block_lines.emplace(b.name, b.line); !inserted)
                 bs.fail("name", fmt::format("a block called \"{}\" already exists (line {}).", b.name, it->second));
@@ -713,8 +1071,15 @@ private:
                 }
             }
             b.instructions = bs.string("instructions").value_or("");
+        }
+    }
 
+    /// A block's [[block.condition]] array.
+    const toml::array* block_conditions(const Section& bs, const Block& b) {
+        {
             const toml::node* conds = bs.get("condition");
+            // A conditions file that gave no rows has said so at its own key.
+            if (conds == nullptr && bs.get("conditions_file") != nullptr) return nullptr;
             if (conds == nullptr)
                 doc_.fail_at_line(b.line, bs.key_path("condition"),
                                   fmt::format("block \"{}\" (line {}) has no [[block.condition]], which is required "
@@ -724,26 +1089,7 @@ private:
                 doc_.fail(conds, bs.key_path("condition"),
                           fmt::format("expected an array of tables [[block.condition]], got {}.",
                                       detail::type_phrase(conds->type())));
-            const toml::array& carr = *conds->as_array();
-            for (std::size_t ci = 0; ci < carr.size(); ++ci) {
-                const toml::table& ct = *carr.get(ci)->as_table();
-                const std::string cpath = fmt::format("{}.condition[{}]", bpath, ci);
-                Section cs(doc_, ct, cpath, fmt::format("[[block.condition]] {} of block \"{}\"", ci, b.name));
-                std::vector<std::string_view> ckeys(std::begin(kConditionKeys), std::end(kConditionKeys));
-                ckeys.push_back("name");
-                cs.allow(ckeys);
-                std::string name = cs.string("name").value_or(fmt::format("{}-c{}", b.name, ci));
-                if (name.empty()) cs.fail("name", "name must not be empty.");
-                if (auto [it, inserted] = condition_lines.emplace(name, cs.line()); !inserted)
-                    cs.fail("name",
-                            fmt::format("a condition called \"{}\" already exists (line {}); condition names are "
-                                        "unique in the protocol.",
-                                        name, it->second));
-                ConditionReader cr(doc_, {Layer{defaults, "defaults"}, Layer{&bt, bpath}, Layer{&ct, cpath}}, name,
-                                   cs.line());
-                b.conditions.push_back(read_condition(cr, name, cs.line()));
-            }
-            p.blocks.push_back(std::move(b));
+            return conds->as_array();
         }
     }
 
@@ -879,6 +1225,7 @@ private:
         } catch (const ProcedureError& e) {
             pr.fail(e.parameter(), fmt::format("{} {}.", e.parameter(), strip_period(e.message())));
         }
+        check_level_scale(pr, c);
         return c;
     }
 
@@ -1026,6 +1373,42 @@ private:
         }
     }
 
+    /// Levels that look written for the other scale: on log10 a level above
+    /// kMaxLog10Level is 10^9 or more of the key's unit (no light, luminance or
+    /// distance in a study is that large: these are linear values); on a linear
+    /// scale a negative level of a photometric key (cd, cd/m², lux) cannot be
+    /// (these are log10 values).
+    void check_level_scale(const ProcedureReader& pr, const Condition& c) const {
+        static constexpr double kMaxLog10Level = 9.0;
+        const auto ends_with = [&](std::string_view suffix) {
+            return c.level_key.size() >= suffix.size() &&
+                   c.level_key.compare(c.level_key.size() - suffix.size(), suffix.size(), suffix) == 0;
+        };
+        const bool photometric = ends_with("_cd") || ends_with("_cd_m2") || ends_with("_lux");
+        for (std::string_view key :
+             {"start", "levels", "min_level", "max_level", "t_guess", "start_min", "start_max"}) {
+            const Found* f = pr.entry(key);
+            if (f == nullptr) continue;
+            std::vector<double> v;
+            if (f->node->is_number())
+                v.push_back(f->node->value<double>().value_or(0.0));
+            else if (const toml::array* a = f->node->as_array())
+                for (const toml::node& x : *a) v.push_back(x.value<double>().value_or(0.0));
+            for (const double x : v) {
+                if (c.level_scale == LevelScale::Log10 && x > kMaxLog10Level)
+                    pr.fail(key, fmt::format("{} has {} on the log10 scale: 10^{} of {}'s unit. These look like linear "
+                                             "values: give their log10 (e.g. {} for {}) or set level_scale = "
+                                             "\"linear\".",
+                                             key, x, x, c.level_key, fmt::format("{:.3g}", std::log10(x)), x));
+                if (c.level_scale == LevelScale::Linear && photometric && x < 0.0)
+                    pr.fail(key, fmt::format("{} has {} on the linear scale, a negative {}. These look like log10 "
+                                             "values: set level_scale = \"log10\" or give the values themselves "
+                                             "(e.g. {:.3g} for {}).",
+                                             key, x, c.level_key, std::pow(10.0, x), x));
+            }
+        }
+    }
+
     static void append(std::vector<Override>& to, std::vector<Override> from) {
         to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
     }
@@ -1038,6 +1421,8 @@ private:
     Document doc_;
     toml::table root_;
     double adaptation_s_ = 0.0;
+    text::ErrorList errors_;  // every error found, reported together at the end of parse()
+    std::string text_;        // the protocol text (conditions files stored in it: embedded_csv)
 };
 
 std::string read_text(const std::filesystem::path& file) {
@@ -1058,6 +1443,41 @@ Protocol load_protocol(const std::filesystem::path& file) {
 
 Protocol parse_protocol(std::string_view toml_text, std::string_view file_name) {
     return Parser(std::string(file_name)).parse(toml_text, false);
+}
+
+std::string with_conditions_files(std::string_view text, const std::filesystem::path& protocol_file) {
+    std::string out(text);
+    toml::table root;
+    try {
+        root = toml::parse(text);
+    } catch (const toml::parse_error&) {
+        return out;
+    }
+    const toml::array* blocks = root["block"].as_array();
+    if (blocks == nullptr) return out;
+    std::set<std::string> done;
+    for (const toml::node& b : *blocks) {
+        const toml::table* t = b.as_table();
+        if (t == nullptr) continue;
+        const auto name = (*t)["conditions_file"].value<std::string>();
+        if (!name || !done.insert(*name).second) continue;
+        const std::filesystem::path csv = std::filesystem::path(*name).is_absolute()
+                                              ? std::filesystem::path(*name)
+                                              : protocol_file.parent_path() / *name;
+        const text::FileText read = text::read_text_file(csv);
+        if (!read.ok()) continue;
+        if (!out.empty() && out.back() != '\n') out += '\n';
+        out += "\n# atonlab: the conditions file below, as it was when the session ran (docs/protocol-file.md)\n";
+        out += "#@conditions_file " + *name + "\n";
+        for (std::size_t at = 0; at < read.text.size();) {
+            const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
+            std::string line = read.text.substr(at, end - at);
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            out += "#@|" + line + "\n";
+            at = end + 1;
+        }
+    }
+    return out;
 }
 
 }  // namespace atonlab::protocols

@@ -1,14 +1,15 @@
 // Strict TOML reading for the protocol file (protocol_reader.h).
 #include "protocol_reader.h"
 
-#include "atonlab/common/input_limits.h"
-#include "atonlab/common/toml_text.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+
+#include "atonlab/common/input_limits.h"
+#include "atonlab/common/toml_text.h"
 
 namespace atonlab::protocols::detail {
 
@@ -57,17 +58,60 @@ int Document::column_of(const toml::node* node) noexcept {
     return node != nullptr ? static_cast<int>(node->source().begin.column) : 0;
 }
 
+void Document::note(const ProtocolError& e) const {
+    if (errors_ != nullptr) errors_->add(problem(e));
+}
+
+text::Problem Document::problem(const ProtocolError& e) {
+    return text::Problem{e.file(), e.line(), e.column(), e.key(), e.message(), e.what()};
+}
+
+void Document::throw_at(int line, int column, const std::string& key, const std::string& message) const {
+    for (const auto& [path, row] : csv_rows_) {
+        if (key != path && key.rfind(path + ".", 0) != 0) continue;
+        const std::string rest = key.size() > path.size() ? key.substr(path.size() + 1) : std::string();
+        // The column: an override's by its index, a procedure parameter's by
+        // "procedure.NAME", any other key's by its name.
+        int col = 0;
+        std::string name;
+        auto by_name = [&](const std::string& n) {
+            for (const auto& [cn, c] : row.columns)
+                if (cn == n) {
+                    name = cn;
+                    col = c;
+                }
+        };
+        auto by_index = [&](const std::string& list_name, const std::vector<int>& cols) {
+            if (rest.rfind(list_name + "[", 0) != 0) return false;
+            const std::size_t i = static_cast<std::size_t>(std::atoi(rest.c_str() + list_name.size() + 1));
+            if (i < cols.size()) {
+                col = cols[i];
+                for (const auto& [cn, c] : row.columns)
+                    if (c == col) name = cn;
+            }
+            return true;
+        };
+        if (!by_index("set", row.set) && !by_index("test_set", row.test_set) &&
+            !by_index("reference_set", row.reference_set)) {
+            const std::size_t dot = rest.find('.', rest.rfind("procedure.", 0) == 0 ? 10 : 0);
+            by_name(rest.substr(0, dot));
+        }
+        const std::string where = col > 0 ? fmt::format("column {} '{}': ", col, name) : std::string();
+        throw ProtocolError(row.file, row.line, col, "", where + message);
+    }
+    throw ProtocolError(file_, line, column, key, message);
+}
+
 void Document::fail(const toml::node* node, const std::string& key, const std::string& message) const {
-    throw ProtocolError(file_, line_of(node), column_of(node), key, message);
+    throw_at(line_of(node), column_of(node), key, message);
 }
 
 void Document::fail_at_key(const toml::key& k, const std::string& key, const std::string& message) const {
-    throw ProtocolError(file_, static_cast<int>(k.source().begin.line), static_cast<int>(k.source().begin.column), key,
-                        message);
+    throw_at(static_cast<int>(k.source().begin.line), static_cast<int>(k.source().begin.column), key, message);
 }
 
 void Document::fail_at_line(int line, const std::string& key, const std::string& message) const {
-    throw ProtocolError(file_, line, 0, key, message);
+    throw_at(line, 0, key, message);
 }
 
 double Document::number(const toml::node* n, const std::string& key, std::string_view name,
@@ -217,13 +261,21 @@ std::string Section::key_path(std::string_view key) const {
     return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
 }
 
-void Section::allow(KeyList allowed) const {
+void Section::allow(KeyList allowed, const std::function<std::string(std::string_view)>& belongs) const {
+    std::vector<ProtocolError> unknown;
     for (auto&& [k, v] : table_) {
         if (std::find(allowed.begin(), allowed.end(), k.str()) != allowed.end()) continue;
-        doc_.fail_at_key(k, key_path(k.str()),
-                         fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
-                                     suggestion(k.str(), allowed), join_quoted(allowed)));
+        const std::string elsewhere = belongs ? belongs(k.str()) : std::string();
+        const std::string message = elsewhere.empty()
+                                        ? fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
+                                                      suggestion(k.str(), allowed), join_quoted(allowed))
+                                        : fmt::format("'{}' is not a key of {}: {}", k.str(), title_, elsewhere);
+        unknown.emplace_back(doc_.file(), static_cast<int>(k.source().begin.line),
+                             static_cast<int>(k.source().begin.column), key_path(k.str()), message);
     }
+    if (unknown.empty()) return;
+    for (std::size_t i = 1; i < unknown.size(); ++i) doc_.note(unknown[i]);
+    throw unknown.front();
 }
 
 void Section::missing(std::string_view key, std::string_view what) const {

@@ -6,12 +6,14 @@
 #include <toml++/toml.h>
 
 #include <array>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "atonlab/common/error_list.h"
 #include "atonlab/protocols/protocol.h"
 
 namespace atonlab::protocols::detail {
@@ -31,6 +33,24 @@ class Document {
 public:
     explicit Document(std::string file) : file_(std::move(file)) {}
     const std::string& file() const noexcept { return file_; }
+
+    /// Where errors found past the first one of a table go (Section::allow
+    /// reports every unknown key of a table); none: only the first is thrown.
+    void collect_into(text::ErrorList* errors) noexcept { errors_ = errors; }
+    /// Adds `e` to the error list (when there is one).
+    void note(const ProtocolError& e) const;
+    static text::Problem problem(const ProtocolError& e);
+
+    /// A condition read from a row of a conditions file (CSV): its errors name
+    /// the CSV file, the row's line and the column instead of the TOML path.
+    struct CsvRow {
+        std::string file;
+        int line = 0;                                      ///< 1-based line of the row in the CSV file
+        std::vector<std::pair<std::string, int>> columns;  ///< (column name, 1-based column) of the row's cells
+        std::vector<int> set, test_set, reference_set;     ///< the column of each override, in order
+    };
+    /// Registers the condition at `path` ("block[0].condition[2]") as `row`.
+    void add_csv_row(std::string path, CsvRow row) { csv_rows_.emplace_back(std::move(path), std::move(row)); }
 
     [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& message) const;
     [[noreturn]] void fail_at_key(const toml::key& k, const std::string& key, const std::string& message) const;
@@ -64,7 +84,12 @@ public:
     std::string scene_key(const toml::node* n, const std::string& key, const std::string& context = {}) const;
 
 private:
+    /// The error at `key`: in the CSV file when the key is a conditions-file row's.
+    [[noreturn]] void throw_at(int line, int column, const std::string& key, const std::string& message) const;
+
     std::string file_;
+    text::ErrorList* errors_ = nullptr;
+    std::vector<std::pair<std::string, CsvRow>> csv_rows_;
 };
 
 /// One table of the schema, named by its dotted path ("timing",
@@ -80,8 +105,11 @@ public:
     std::string key_path(std::string_view key) const;
     int line() const noexcept { return Document::line_of(&table_); }
 
-    /// Every key must be in `allowed`.
-    void allow(KeyList allowed) const;
+    /// Every key must be in `allowed`. Every unknown key is an error (the
+    /// first thrown, the others noted in the document's error list);
+    /// `belongs` names, for a key that is known elsewhere, where it belongs
+    /// ("'levels' belongs in [defaults.procedure]."), else "".
+    void allow(KeyList allowed, const std::function<std::string(std::string_view)>& belongs = {}) const;
     const toml::node* get(std::string_view key) const { return table_.get(key); }
     [[noreturn]] void missing(std::string_view key, std::string_view what) const;
     [[noreturn]] void fail(std::string_view key, const std::string& message) const;

@@ -103,7 +103,7 @@ std::string read_text(const std::filesystem::path& file, std::string_view what,
 }
 
 InputError input_error(const p::ProtocolError& e) {
-    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
+    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message(), e.further());
 }
 
 /// The response codes of trials the procedure never saw (docs/running.md,
@@ -1130,7 +1130,9 @@ int run_session(const RunOptions& o) {
     } catch (const p::ProtocolError& e) {
         throw input_error(e);
     }
-    const std::string protocol_text = read_text(o.protocol, "protocol file");
+    // The protocol file's text, with its conditions files (if any) appended as
+    // comments: the study stores the whole design (protocol_file.h).
+    const std::string protocol_text = p::with_conditions_files(read_text(o.protocol, "protocol file"), o.protocol);
     const std::string protocol_sha = st::sha256_hex(protocol_text);
     const std::filesystem::path scene_file = protocol.scene;
     const std::string scene_text = read_text(scene_file, "scene template");

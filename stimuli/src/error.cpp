@@ -25,6 +25,16 @@ std::string format_error(const SourceLocation& w, const std::string& message) {
 InputError::InputError(SourceLocation where, const std::string& message)
     : std::runtime_error(format_error(where, message)), where_(std::move(where)), message_(text::one_line(message)) {}
 
+InputError::InputError(SourceLocation where, const std::string& message, std::vector<std::string> further)
+    : std::runtime_error([&] {
+          std::string s = format_error(where, message);
+          for (const std::string& f : further) s += "\n" + f;
+          return s;
+      }()),
+      further_(std::move(further)),
+      where_(std::move(where)),
+      message_(text::one_line(message)) {}
+
 InputError::InputError(const std::string& message)
     : std::runtime_error(text::one_line(message)), message_(text::one_line(message)) {}
 

@@ -27,6 +27,7 @@
 #include <utility>
 
 #include "atonlab/stimuli/atmosphere.h"
+#include "atonlab/common/error_list.h"
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
@@ -1182,22 +1183,31 @@ void read_discs(const Section& root, SceneBuilder& builder) {
 }
 
 Scene build_scene(const Document& doc, const toml::table& root_table) {
+    // Every table (and every light) is read even after an error in another:
+    // all the errors, in file order, in one run (text::ErrorList; docs/scene-file.md).
+    text::ErrorList errors;
+    const auto problem = [](const InputError& e) {
+        const SourceLocation w = e.where().value_or(SourceLocation{});
+        return text::Problem{w.file, w.line, w.column, w.key, e.message(), e.what()};
+    };
+    const auto step = [&](auto&& f) { return errors.attempt<InputError>(f, problem); };
     Section root(doc, root_table, "", "the scene");
-    {
-        // Unknown top-level tables are reported with the list of sections.
-        for (auto&& [k, v] : root_table) {
-            if (contains(kSections, k.str())) continue;
+    // Unknown top-level tables are reported with the list of sections.
+    for (auto&& [k, v] : root_table) {
+        if (contains(kSections, k.str())) continue;
+        step([&] {
             throw InputError(
                 doc.where(k, std::string(k.str())),
                 fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key",
                             text::echo(k.str()), suggestion(k.str(), kSections), join(kSections)));
-        }
+        });
     }
     Scene scene;
-    scene.display = read_display(doc, root);
-    scene.camera = read_camera(doc, root);
-    scene.environment = read_environment(doc, root);
-    scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation);
+    step([&] { scene.display = read_display(doc, root); });
+    step([&] { scene.camera = read_camera(doc, root); });
+    step([&] { scene.environment = read_environment(doc, root); });
+    step(
+        [&] { scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation); });
     scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
     // The pupil the glare stage will use (glare_stage.h glare_pupil_mm): given,
     // or eq 3.15 from the fixed adaptation, or the dark-adapted 7.9 mm when the
@@ -1206,21 +1216,33 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
                             : scene.output.adaptation.mode == AdaptationMode::dynamic
                                 ? pupil_diameter_mm_from_adaptation(0.0)
                                 : pupil_diameter_mm_from_adaptation(scene.adaptation_cd_m2);
-    read_glare(doc, root, scene.glare, pupil_mm);
-    read_output(doc, root, scene.output);
-    const Profiles profiles = read_profiles(doc, root);
+    step([&] { read_glare(doc, root, scene.glare, pupil_mm); });
+    const bool output_read = step([&] { read_output(doc, root, scene.output); });
+    Profiles profiles;
+    const bool profiles_read = step([&] { profiles = read_profiles(doc, root); });
 
     SceneBuilder builder{doc, scene, profiles, {}};
-    if (const toml::node* lights = root.get("light")) {
-        if (!lights->is_array())
-            root.fail(lights, "light",
-                      fmt::format("expected an array of [[light]] tables, got {}; write [[light]], not [light].",
-                                  type_phrase(lights->type())));
-        const toml::array& a = *lights->as_array();
-        for (std::size_t i = 0; i < a.size(); ++i) builder.read_light(*a.get(i), i);
+    if (const toml::node* lights = root.get("light"); lights != nullptr && profiles_read) {
+        const bool is_array = step([&] {
+            if (!lights->is_array())
+                root.fail(lights, "light",
+                          fmt::format("expected an array of [[light]] tables, got {}; write [[light]], not [light].",
+                                      type_phrase(lights->type())));
+        });
+        if (is_array) {
+            const toml::array& a = *lights->as_array();
+            for (std::size_t i = 0; i < a.size(); ++i) step([&] { builder.read_light(*a.get(i), i); });
+        }
     }
-    read_discs(root, builder);
-    check_billboard(doc, root, scene);  // after the lights: each may ask for its own glare model
+    step([&] { read_discs(root, builder); });
+    // The billboard check needs the display, the output and each light's own
+    // glare model as read.
+    if (output_read && errors.empty()) step([&] { check_billboard(doc, root, scene); });
+    if (!errors.empty()) {
+        const text::Problem first = errors.in_file_order().front();
+        throw InputError(SourceLocation{first.file, first.line, first.column, first.key}, first.message,
+                         errors.further_lines());
+    }
     return scene;
 }
 

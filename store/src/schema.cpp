@@ -208,11 +208,33 @@ ALTER TABLE sessions ADD COLUMN displayability_json TEXT
     CHECK (displayability_json IS NULL OR json_valid(displayability_json));
 )sql";
 
-constexpr std::array<Migration, 4> migrations = {
+// Version 5: a tidy view of the overrides each trial's frames set (docs/store.md):
+// one row per trial, frame and override, the value typed and without its TOML
+// quotes (a number as a number, a string's contents, true / false as 1 / 0),
+// the text as the protocol wrote it kept beside it.
+constexpr std::string_view schema_v5 = R"sql(
+CREATE VIEW trial_settings AS
+SELECT t.session_id, t.trial_index, t.condition_id, f.key AS frame,
+       coalesce(json_extract(f.value, '$.role'), 'both') AS frame_role,
+       substr(o.value, 1, instr(o.value, '=') - 1) AS key,
+       CASE
+         WHEN json_valid(substr(o.value, instr(o.value, '=') + 1))
+           THEN json_extract(substr(o.value, instr(o.value, '=') + 1), '$')
+         WHEN substr(o.value, instr(o.value, '=') + 1) GLOB '''*'''
+           THEN substr(o.value, instr(o.value, '=') + 2, length(o.value) - instr(o.value, '=') - 2)
+         ELSE substr(o.value, instr(o.value, '=') + 1)
+       END AS value,
+       substr(o.value, instr(o.value, '=') + 1) AS toml_value
+FROM trials t, json_each(t.stimulus_json, '$.frames') f, json_each(f.value, '$.overrides') o
+WHERE instr(o.value, '=') > 0;
+)sql";
+
+constexpr std::array<Migration, 5> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
     Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
     Migration{3, "instrument transcripts of calibration readings", schema_v3},
     Migration{4, "sessions.displayability_json", schema_v4},
+    Migration{5, "view trial_settings: each trial's overrides, typed and unquoted", schema_v5},
 };
 
 }  // namespace

@@ -44,6 +44,17 @@ for bad in 'src="http' 'href="http' '<script'; do
   if grep -qiF -- "$bad" "$outdir/report/report.html"; then echo "report.html contains $bad"; fail=1; fi
 done
 
+# fits.csv carries the design's factors as typed columns (a CSV reader, no pandas): the adaptation
+# luminance and the tone mapper of every condition, and the block's environment luminance (a factor
+# column named by its scene key), with no TOML quotes.
+if ! bash "$(dirname "$0")/check_fits_factors.sh" "$outdir/report/fits.csv" adaptation_cd_m2=number \
+     tone_operator=name glare_test=name environment.luminance_cd_m2=number; then fail=1; fi
+# trials.csv: a chose_reference column; session ids that do not depend on the path given to analyze.
+if ! head -1 "$outdir/report/trials.csv" | grep -q ',chose_reference,'; then echo "trials.csv has no chose_reference"; fail=1; fi
+if grep -qF -- "$outdir/study.db#" "$outdir/report/trials.csv" || ! grep -q '^study\.db#1,' "$outdir/report/trials.csv"; then
+  echo "trials.csv session ids are not study.db#ID"; fail=1
+fi
+
 # The tidy trials.csv read back as input gives the same fits (rows sorted: a CSV does not carry the protocol's order).
 "$atonlab" analyze --csv "$outdir/report/trials.csv" --out "$outdir/again" --bootstrap 400 >/dev/null 2>"$outdir/again.err"
 status=$?

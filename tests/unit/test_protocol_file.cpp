@@ -1041,3 +1041,202 @@ TEST(ProtocolConvergence, EveryExampleFindsTheModelObserversTruePoint) {
 }
 
 }  // namespace
+
+// ---- Every error at once ------------------------------------------------------------
+
+TEST(ProtocolErrors, FiveErrorsInDifferentPlacesAreAllReportedInFileOrder) {
+    // Five mistakes in four tables; the loader reads on past each one. Line
+    // numbers count the 9-line header of error_of's protocols.
+    const std::string what = error_of(R"(
+[timing]
+stimulus = 0.5
+
+[defaults]
+task = "2afc"
+levels = [1.0, 2.0]
+
+[[block]]
+name = "b"
+repetitions = "two"
+
+[[block.condition]]
+name = "c1"
+level_key = "light.r.intensity_cd"
+procedure = { kind = "staircase", start = 1.0, step_type = "lin", n_reversals = 4, step_size = 0.1 }
+
+[[block.condition]]
+name = "c2"
+level_key = "light.r.intensity_cd"
+procedure = { kind = "constant-stimuli", levels = [50.0, 100.0, 200.0], repetitions = 4 }
+)");
+    std::vector<std::string> lines;
+    for (std::size_t at = 0; at <= what.size();) {
+        const std::size_t end = std::min(what.find('\n', at), what.size());
+        lines.push_back(what.substr(at, end - at));
+        at = end + 1;
+    }
+    ASSERT_EQ(lines.size(), 5u) << what;
+    const std::vector<std::pair<std::string, std::string>> expected = {
+        {"inline.toml:12: key 'timing.stimulus'",
+         "unknown key 'stimulus' in the [timing] table. Did you mean 'stimulus_s'?"},
+        {"inline.toml:16: key 'defaults.levels'", "'levels' belongs in [defaults.procedure]"},
+        {"inline.toml:20: key 'block[0].repetitions'", "expected an integer, got a string."},
+        {"inline.toml:25: key 'block[0].condition[0].procedure.step_size'", "Did you mean 'step_sizes'?"},
+        {"inline.toml:30: key 'block[0].condition[1].procedure.levels'", "These look like linear values"},
+    };
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        SCOPED_TRACE(i);
+        EXPECT_EQ(lines[i].rfind(expected[i].first, 0), 0u) << lines[i];
+        EXPECT_NE(lines[i].find(expected[i].second), std::string::npos) << lines[i];
+    }
+}
+
+TEST(ProtocolErrors, TheFirstErrorKeepsItsFieldsAndTheOthersFollow) {
+    try {
+        (void)parse(R"(
+[timing]
+stimulus = 0.5
+inter_trial = 1.0
+
+[[block]]
+[[block.condition]]
+task = "2afc"
+level_key = "light.r.intensity_cd"
+level_scale = "linear"
+procedure = { kind = "staircase", start = -2.0, step_type = "lin", n_reversals = 4 }
+)");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(e.line(), 12);
+        EXPECT_EQ(e.key(), "timing.stimulus");
+        ASSERT_EQ(e.further().size(), 2u) << e.what();
+        EXPECT_EQ(e.further()[0].rfind("inline.toml:13: key 'timing.inter_trial'", 0), 0u) << e.further()[0];
+        EXPECT_NE(e.further()[1].find("These look like log10 values"), std::string::npos) << e.further()[1];
+    }
+}
+
+// ---- Conditions files ------------------------------------------------------------------
+
+TEST(ConditionsFile, TheCsvExampleGivesTheSameScheduleAsItsTomlTwin) {
+    const Protocol toml = load_protocol(example("glare_brightness_2afc.toml"));
+    const Protocol csv = load_protocol(example("glare_brightness_2afc_csv.toml"));
+    ASSERT_EQ(csv.blocks.size(), toml.blocks.size());
+    for (std::size_t b = 0; b < toml.blocks.size(); ++b) {
+        ASSERT_EQ(csv.blocks[b].conditions.size(), toml.blocks[b].conditions.size());
+        for (std::size_t c = 0; c < toml.blocks[b].conditions.size(); ++c)
+            EXPECT_EQ(csv.blocks[b].conditions[c].name, toml.blocks[b].conditions[c].name);
+    }
+    // The same trials, stimuli and procedure states on the same answers, seed for seed.
+    for (const std::uint64_t seed : {toml.seed, std::uint64_t{99}}) {
+        SCOPED_TRACE(seed);
+        Schedule a(toml, seed), b(csv, seed);
+        Rng rng(3);
+        std::size_t n = 0;
+        while (true) {
+            const auto ta = a.next();
+            const auto tb = b.next();
+            ASSERT_EQ(ta.has_value(), tb.has_value());
+            if (!ta) break;
+            ASSERT_EQ(ta->procedure_id, tb->procedure_id) << "trial " << n;
+            EXPECT_EQ(ta->proposal.level, tb->proposal.level);
+            EXPECT_EQ(ta->proposal.test_on_left, tb->proposal.test_on_left);
+            ASSERT_EQ(ta->stimulus.frames.size(), tb->stimulus.frames.size());
+            for (std::size_t f = 0; f < ta->stimulus.frames.size(); ++f) {
+                EXPECT_EQ(ta->stimulus.frames[f].overrides, tb->stimulus.frames[f].overrides) << "trial " << n;
+            }
+            EXPECT_EQ(a.state(), b.state());
+            const Response r = random_response(ta->task, rng);
+            a.record(r);
+            b.record(r);
+            ++n;
+        }
+        EXPECT_GT(n, 100u);
+    }
+}
+
+TEST(ConditionsFile, ErrorsNameTheCsvFileRowAndColumn) {
+    const fs::path dir = fs::temp_directory_path() / "atonlab-conditions-file-test";
+    fs::create_directories(dir);
+    {
+        std::ofstream(dir / "scene.toml") << "";
+        std::ofstream(dir / "c.csv") << "name,procedure.start,eye.adaptation_cd_m2,level_scale\n"
+                                        "a,1.0,0.1,log10\n"
+                                        "b,\"[1.0, x]\",0.1,log10\n"
+                                        "c,1.0,0.1,logarithmic\n";
+        std::ofstream(dir / "p.toml") << std::string(kHeader) + R"(
+[defaults]
+task = "2afc"
+level_key = "light.r.intensity_cd"
+procedure = { kind = "staircase", step_sizes = [0.1], step_type = "lin", n_reversals = 4 }
+
+[[block]]
+conditions_file = "c.csv"
+)";
+    }
+    try {
+        (void)load_protocol(dir / "p.toml");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        const std::string csv = (dir / "c.csv").string();
+        EXPECT_EQ(e.file(), csv) << e.what();
+        EXPECT_EQ(e.line(), 3) << e.what();
+        ASSERT_EQ(e.further().size(), 1u) << e.what();
+        EXPECT_EQ(e.further()[0].rfind(csv + ":4: column 4 'level_scale': ", 0), 0u) << e.further()[0];
+    }
+    {
+        std::ofstream(dir / "c.csv") << "name,procedure.strat\n"
+                                        "a,1.0\n";
+    }
+    try {
+        (void)load_protocol(dir / "p.toml");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind((dir / "c.csv").string() + ":2: column 2 'procedure.strat': ", 0), 0u)
+            << e.what();
+    }
+    {
+        std::ofstream(dir / "c.csv") << "name,colour\n"
+                                        "a,red\n";
+    }
+    try {
+        (void)load_protocol(dir / "p.toml");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind((dir / "c.csv").string() + ":1: column 2 'colour': not a column", 0), 0u)
+            << e.what();
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ConditionsFile, TheStoredTextCarriesTheCsvSoThatItParsesWithoutIt) {
+    const fs::path file = example("glare_brightness_2afc_csv.toml");
+    std::ifstream in(file);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string stored = with_conditions_files(text, file);
+    EXPECT_NE(stored.find("\n#@conditions_file glare_brightness_2afc.conditions.csv\n#@|block,name,"),
+              std::string::npos);
+    // Parsed from the text alone (no such folder: the CSV cannot be opened), as analyze does.
+    const Protocol p = parse_protocol(stored, "/nonexistent/glare_brightness_2afc_csv.toml");
+    const Protocol twin = load_protocol(example("glare_brightness_2afc.toml"));
+    ASSERT_EQ(p.blocks.size(), twin.blocks.size());
+    for (std::size_t b = 0; b < p.blocks.size(); ++b) {
+        ASSERT_EQ(p.blocks[b].conditions.size(), twin.blocks[b].conditions.size());
+        for (std::size_t c = 0; c < p.blocks[b].conditions.size(); ++c) {
+            std::vector<std::string> a, t;
+            for (const Override& o : p.blocks[b].conditions[c].set) a.push_back(o.text());
+            for (const Override& o : twin.blocks[b].conditions[c].set) t.push_back(o.text());
+            EXPECT_EQ(a, t);
+        }
+    }
+    // A protocol without a conditions file is stored as it is.
+    const std::string plain = "[protocol]\nscene = \"s.toml\"\n";
+    EXPECT_EQ(with_conditions_files(plain, "p.toml"), plain);
+    // Without the CSV and without the stored copy, the error names the key.
+    try {
+        (void)parse_protocol(text, "/nonexistent/glare_brightness_2afc_csv.toml");
+        ADD_FAILURE() << "no ProtocolError";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(e.key(), "block[0].conditions_file") << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot read the conditions file"), std::string::npos) << e.what();
+    }
+}

@@ -777,3 +777,39 @@ TEST(SceneFile, SectorThroughNorthAndBearingTable) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------
+// Every error at once.
+
+TEST(SceneFileErrors, ErrorsInSeveralTablesAreAllReportedInFileOrder) {
+    const std::string text = std::string(kMinimal) + R"(
+[camera]
+fov_dge = 30
+
+[environment]
+luminance_cd_m2 = "dark"
+
+[[light]]
+name = "a"
+position_m = [0.0, 0.0, -500.0]
+intensity_cd = -1
+
+[[light]]
+name = "b"
+position_m = [0.0, 0.0]
+intensity_cd = 10
+)";
+    const InputError e = error_of(text);
+    ASSERT_TRUE(e.where().has_value());
+    EXPECT_EQ(e.where()->line, line_of(text, "fov_dge"));
+    EXPECT_EQ(e.where()->key, "camera.fov_dge");
+    ASSERT_EQ(e.further().size(), 3u) << e.what();
+    const std::vector<std::string> at = {":" + std::to_string(line_of(text, "luminance_cd_m2 = \"dark\"")) + ":",
+                                         ":" + std::to_string(line_of(text, "intensity_cd = -1")) + ":",
+                                         ":" + std::to_string(line_of(text, "position_m = [0.0, 0.0]")) + ":"};
+    for (std::size_t i = 0; i < at.size(); ++i)
+        EXPECT_NE(e.further()[i].find(std::string(kFile) + at[i]), std::string::npos) << e.further()[i];
+    // what() is every line: the first, then the others.
+    const std::string all = e.what();
+    EXPECT_EQ(std::count(all.begin(), all.end(), '\n'), 3) << all;
+}

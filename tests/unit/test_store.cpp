@@ -422,4 +422,26 @@ TEST(StoreMigrations, ReadOnlyOpenOfAnOlderFileAsksForAWriter) {
 }
 
 }  // namespace
+// --- The tidy view of the overrides ----------------------------------------------------
+
+TEST(Store, TrialSettingsGivesEachOverrideTypedAndUnquoted) {
+    TempDir dir;
+    const auto path = dir / "study.db";
+    {
+        Store s = Store::create_or_open(path);
+        const SessionId id = s.begin_session(make_start("P01", 1));
+        TrialRecord t = make_trial(0);
+        t.stimulus_json =
+            R"({"frames":[{"role":"test","overrides":["tonemap.operator=\"perceptual\"","eye.adaptation_cd_m2=0.03",)"
+            R"("output.dither=true","eye.glare='none'"]},{"role":"reference","overrides":["light.a.intensity_cd=2"]}]})";
+        s.record_trial(id, t);
+    }
+    RawDb raw(path);
+    EXPECT_EQ(raw.text("SELECT group_concat(frame_role || ' ' || key || ' ' || value || ' ' || typeof(value), '; ') "
+                       "FROM trial_settings"),
+              "test tonemap.operator perceptual text; test eye.adaptation_cd_m2 0.03 real; "
+              "test output.dither 1 integer; test eye.glare none text; reference light.a.intensity_cd 2 integer");
+    EXPECT_EQ(raw.text("SELECT toml_value FROM trial_settings WHERE key = 'tonemap.operator'"), "\"perceptual\"");
+}
+
 }  // namespace atonlab::store

@@ -15,6 +15,7 @@
 // gives the staircase reversals and QUEST's posterior after every trial.
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -92,6 +93,11 @@ struct Trial {
     std::string glare_test;
     std::string glare_reference;              ///< the same for the reference light
     std::optional<double> test_intensity_cd;  ///< the test light's intensity_cd, cd
+    /// Every other override of the trial's frames, by factor column (raw TOML
+    /// value text): the scene key where the test's and the reference's frames
+    /// agree, else "test.KEY" and "reference.KEY". The level's own key and the
+    /// keys of the columns above are left out. Empty for a CSV input.
+    std::map<std::string, std::string> settings;
 
     // --- what the procedure implies -----------------------------------------------
     double guess_rate = 0.0;  ///< gamma of the psychometric function for `outcome`
@@ -118,6 +124,11 @@ struct SessionInfo {
     std::uint64_t seed = 0;
     std::string started_at, ended_at;
     std::string status;  ///< running, quit, completed, crashed ("" for a CSV)
+    /// Who answered: "person", "model" or "script" (the first trial's
+    /// procedure_state_json); "" when unknown (a CSV, no trials). Only a
+    /// person's session has frame timing worth plotting: the model and script
+    /// observers run on the virtual clock when headless.
+    std::string answered_by;
     std::int64_t trial_count = 0;
     std::optional<std::int64_t> calibration_id;
     /// The displayability check before the first trial (docs/running.md,

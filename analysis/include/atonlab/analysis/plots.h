@@ -54,6 +54,12 @@ PlotResult make_figures(const std::filesystem::path& out_dir, const Dataset& dat
 /// anything else '_'.
 std::string file_slug(const std::string& name);
 
+/// Whether the frame-timing figure has anything to show: some session was
+/// answered by a person (or by an observer of unknown kind, a CSV's), or some
+/// frame was dropped. Sessions of the model or scripted observer alone run on
+/// the virtual clock when headless: their timing is not the display's.
+bool has_display_timing(const Dataset& data, const StudyResults& results);
+
 /// The file-name form of each condition name, all distinct, for figures,
 /// snapshots and the report's anchors: file_slug(name) where no other name
 /// has the same slug; where two do ("a<b" and "a>b" are both "a_b"), the slug

@@ -19,8 +19,10 @@
 // Nothing here is NaN: a value that cannot be given is absent, with a reason.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "atonlab/analysis/dataset.h"
@@ -57,6 +59,9 @@ struct ConditionInfo {
     double target_p = 0.5;
     std::vector<std::string> mixed;
     int n_trials = 0;
+    /// The trials' other overrides (Trial::settings) that are the same in every
+    /// trial of the condition, by factor column; raw TOML value text.
+    std::map<std::string, std::string> settings;
 
     /// The unit of the level: "log10 cd", "cd", "log10 cd/m2", ... from level_key and level_scale.
     std::string level_unit() const;
@@ -141,12 +146,25 @@ struct StudyResults {
     std::vector<PairedResult> paired;
     std::vector<SessionTiming> timing;
     std::vector<std::string> warnings;  ///< the reader's notes and anything doubtful found here
+    /// The settings columns (ConditionInfo::settings) whose value is not the
+    /// same in every condition: the factors of the design beyond adaptation,
+    /// tone mapper, glare and test intensity. Sorted.
+    std::vector<std::string> factor_columns;
 
     const ConditionInfo* condition(const std::string& name) const;
     /// The group of a condition that the figures and the summary lead with:
     /// kPooled when there are several observers, else the one observer.
     const GroupResult* main_group(const std::string& condition) const;
 };
+
+/// An override's TOML value text, typed: a number, a boolean, or text (a
+/// string's contents without its quotes; anything else as written).
+struct SettingValue {
+    std::optional<double> number;
+    std::optional<bool> boolean;
+    std::string text;
+};
+SettingValue setting_value(std::string_view toml_value);
 
 /// Analyses every condition of the dataset. Never throws for the shape of the
 /// data (degenerate groups are flagged); std::invalid_argument for bad options.

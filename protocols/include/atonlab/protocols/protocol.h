@@ -35,14 +35,21 @@ namespace atonlab::protocols {
 class ProtocolError : public std::runtime_error {
 public:
     ProtocolError(std::string file, int line, int column, std::string key, const std::string& message);
+    /// The first of several errors (in file order), with the others' whole
+    /// lines: what() is the first line, then each further one on its own line.
+    ProtocolError(std::string file, int line, int column, std::string key, const std::string& message,
+                  std::vector<std::string> further);
 
     const std::string& file() const noexcept { return file_; }
     int line() const noexcept { return line_; }               ///< 1-based; 0 when unknown
     int column() const noexcept { return column_; }           ///< 1-based; 0 when unknown
     const std::string& key() const noexcept { return key_; }  ///< dotted key as written; may be empty
     const std::string& message() const noexcept { return message_; }
+    /// The other errors found in the same run, each a whole line ("FILE:LINE: ..."); empty when one.
+    const std::vector<std::string>& further() const noexcept { return further_; }
 
 private:
+    std::vector<std::string> further_;
     std::string file_;
     int line_;
     int column_;

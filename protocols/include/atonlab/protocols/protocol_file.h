@@ -19,4 +19,12 @@ Protocol load_protocol(const std::filesystem::path& file);
 /// path (its folder), which is not checked for existence. Throws ProtocolError.
 Protocol parse_protocol(std::string_view toml_text, std::string_view file_name);
 
+/// The protocol file's `text` with the text of each conditions file its blocks
+/// name (conditions_file, relative to `protocol_file`) appended as comment lines
+/// ("#@conditions_file NAME", then "#@|LINE" per line of the CSV): what a study
+/// stores, so that parse_protocol() of the stored text finds the rows when the
+/// CSV itself is not at hand. `text` unchanged when it names none (or one
+/// cannot be read: load_protocol reports that).
+std::string with_conditions_files(std::string_view text, const std::filesystem::path& protocol_file);
+
 }  // namespace atonlab::protocols

@@ -4,6 +4,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace atonlab {
 
@@ -21,12 +22,18 @@ struct SourceLocation {
 class InputError : public std::runtime_error {
 public:
     InputError(SourceLocation where, const std::string& message);
+    /// The first of several errors (in file order) with the others' whole
+    /// lines: what() is the first line, then each further one on its own line.
+    InputError(SourceLocation where, const std::string& message, std::vector<std::string> further);
     explicit InputError(const std::string& message);  ///< no location
 
     const std::optional<SourceLocation>& where() const noexcept { return where_; }
     const std::string& message() const noexcept { return message_; }
+    /// The other errors found in the same run, each a whole line; empty when one.
+    const std::vector<std::string>& further() const noexcept { return further_; }
 
 private:
+    std::vector<std::string> further_;
     std::optional<SourceLocation> where_;
     std::string message_;
 };
