@@ -203,7 +203,7 @@ TEST(StoreSchemaV3, VersionTwoFileKeepsItsReadingsWithoutTranscripts) {
                   "");
     }
     Store s = Store::create_or_open(path);
-    EXPECT_EQ(s.file_schema_version(), 3);
+    EXPECT_EQ(s.file_schema_version(), schema_version());
     const auto readings = s.calibration_readings(CalibrationId{1});
     ASSERT_EQ(readings.size(), 1u);
     EXPECT_EQ(readings[0].luminance_cd_m2, 0.25);
