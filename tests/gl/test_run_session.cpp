@@ -282,11 +282,16 @@ TEST_F(run, KilledTwentyTimesEachResumeContinuesTheUninterruptedSequence) {
         const bool began = unfinished || sessions.size() > sessions_before;
         if (began && !sessions.empty() && code == 128 + SIGKILL) {
             const auto n = static_cast<long>(s.trials(sessions.back().id).size());
-            if (static_cast<std::size_t>(n) > stored_before) ++mid_session;  // it had committed trials when killed
+            const bool committed = static_cast<std::size_t>(n) > stored_before;
+            if (committed) ++mid_session;  // it had committed trials when killed
             stored_before = static_cast<std::size_t>(n);
             const long reported = last_reported(out());
             EXPECT_GE(n, reported) << "a trial reported committed is missing";
-            EXPECT_LE(n, reported + 1) << "at most the trial being reported when killed";
+            // (A resumed run killed while it still checked the protocol
+            // committed and reported nothing of its own.)
+            if (committed) {
+                EXPECT_LE(n, reported + 1) << "at most the trial being reported when killed";
+            }
         }
         if (code == 0 || (!sessions.empty() && sessions.back().status == store::SessionStatus::completed))
             stored_before = 0;  // a new session begins next (a run may be killed after completing, in its summary)
