@@ -67,7 +67,11 @@ text::Problem Document::problem(const ProtocolError& e) {
 }
 
 void Document::throw_at(int line, int column, const std::string& key, const std::string& message) const {
-    for (const auto& [path, row] : csv_rows_) {
+    for (const auto& entry : csv_rows_) {
+        // Named references, not structured bindings: clang 14 (the fuzz
+        // build) cannot capture a binding in a lambda.
+        const auto& path = entry.first;
+        const auto& row = entry.second;
         if (key != path && key.rfind(path + ".", 0) != 0) continue;
         const std::string rest = key.size() > path.size() ? key.substr(path.size() + 1) : std::string();
         // The column: an override's by its index, a procedure parameter's by

@@ -1193,7 +1193,11 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     const auto step = [&](auto&& f) { return errors.attempt<InputError>(f, problem); };
     Section root(doc, root_table, "", "the scene");
     // Unknown top-level tables are reported with the list of sections.
-    for (auto&& [k, v] : root_table) {
+    for (auto&& entry : root_table) {
+        // Named references, not structured bindings: clang 14 (the fuzz
+        // build) cannot capture a binding in a lambda.
+        const toml::key& k = entry.first;
+        const toml::node& v = entry.second;
         if (contains(kSections, k.str())) continue;
         step([&] {
             throw InputError(
