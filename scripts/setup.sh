@@ -11,7 +11,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev
   libopenexr-dev libimath-dev libpng-dev libsqlite3-dev libfftw3-dev
-  libtomlplusplus-dev libcli11-dev libfmt-dev
+  libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev libnlopt-cxx-dev libstb-dev fonts-dejavu-core
   gnuplot-nox
