@@ -18,8 +18,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double number_or_nan(const store::JsonReader& j, const std::string& path) {
-    return j.number(path).value_or(kNaN);
+double number_or_nan(const nlohmann::json& j, std::string_view at) {
+    return store::number_at(j, at).value_or(kNaN);
 }
 
 /// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 stamp
@@ -61,39 +61,39 @@ std::string num(double v) {
 
 std::optional<DriftPoint> drift_point(const store::CalibrationCheck& check) {
     try {
-        const store::JsonReader j(check.results_json, fmt::format("results_json of check {}", check.id.value));
-        if (!j.number("$.tolerances.luminance_percent")) return std::nullopt;
+        const nlohmann::json j =
+            store::parse_json(check.results_json, fmt::format("results_json of check {}", check.id.value));
+        if (!store::number_at(j, "/tolerances/luminance_percent")) return std::nullopt;
         DriftPoint p;
         p.check_id = check.id.value;
         p.calibration_id = check.calibration.value;
         p.checked_at = check.checked_at;
-        p.calibration_measured_at = j.string("$.calibration_measured_at").value_or("");
+        p.calibration_measured_at = store::string_at(j, "/calibration_measured_at").value_or("");
         p.passed = check.passed;
-        for (std::size_t i = 0; i < j.array_length("$.failed"); ++i)
-            if (const auto f = j.string(fmt::format("$.failed[{}]", i))) p.failed.push_back(*f);
+        for (const nlohmann::json& f : store::array_at(j, "/failed"))
+            if (f.is_string()) p.failed.push_back(f.get<std::string>());
         // Black is the patch at code 0, white (the peak) the one at the largest code.
         p.peak_cd_m2 = p.peak_predicted_cd_m2 = p.black_cd_m2 = p.black_predicted_cd_m2 = kNaN;
         double white_code = -1.0;
-        for (std::size_t i = 0; i < j.array_length("$.patches"); ++i) {
-            const std::string at = fmt::format("$.patches[{}]", i);
-            const double code = number_or_nan(j, at + ".code");
+        for (const nlohmann::json& patch : store::array_at(j, "/patches")) {
+            const double code = number_or_nan(patch, "/code");
             if (code == 0.0) {
-                p.black_cd_m2 = number_or_nan(j, at + ".measured_cd_m2");
-                p.black_predicted_cd_m2 = number_or_nan(j, at + ".predicted_cd_m2");
+                p.black_cd_m2 = number_or_nan(patch, "/measured_cd_m2");
+                p.black_predicted_cd_m2 = number_or_nan(patch, "/predicted_cd_m2");
             } else if (code > white_code) {
                 white_code = code;
-                p.peak_cd_m2 = number_or_nan(j, at + ".measured_cd_m2");
-                p.peak_predicted_cd_m2 = number_or_nan(j, at + ".predicted_cd_m2");
+                p.peak_cd_m2 = number_or_nan(patch, "/measured_cd_m2");
+                p.peak_predicted_cd_m2 = number_or_nan(patch, "/predicted_cd_m2");
             }
         }
-        p.gamma_measured = number_or_nan(j, "$.gamma_measured");
-        p.gamma_predicted = number_or_nan(j, "$.gamma_predicted");
-        p.worst_error_percent = number_or_nan(j, "$.values.luminance_percent");
-        p.worst_patch = j.string("$.worst_patch").value_or("");
-        p.tol_luminance_percent = number_or_nan(j, "$.tolerances.luminance_percent");
-        p.tol_black_cd_m2 = number_or_nan(j, "$.tolerances.black_cd_m2");
-        p.tol_peak_percent = number_or_nan(j, "$.tolerances.peak_percent");
-        p.tol_gamma = number_or_nan(j, "$.tolerances.gamma");
+        p.gamma_measured = number_or_nan(j, "/gamma_measured");
+        p.gamma_predicted = number_or_nan(j, "/gamma_predicted");
+        p.worst_error_percent = number_or_nan(j, "/values/luminance_percent");
+        p.worst_patch = store::string_at(j, "/worst_patch").value_or("");
+        p.tol_luminance_percent = number_or_nan(j, "/tolerances/luminance_percent");
+        p.tol_black_cd_m2 = number_or_nan(j, "/tolerances/black_cd_m2");
+        p.tol_peak_percent = number_or_nan(j, "/tolerances/peak_percent");
+        p.tol_gamma = number_or_nan(j, "/tolerances/gamma");
         return p;
     } catch (const store::StoreError&) {
         return std::nullopt;

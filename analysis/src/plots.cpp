@@ -448,7 +448,7 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
         }
         std::string model;
         try {
-            model = store::JsonReader(c.fit_json).string("$.model").value_or("");
+            model = store::string_at(store::parse_json(c.fit_json), "/model").value_or("");
         } catch (const store::StoreError&) {
         }
         const bool nominal = model == "nominal";
@@ -621,34 +621,33 @@ std::map<std::string, std::string> condition_slugs(const StudyResults& results) 
 
 std::optional<double> model_grey_luminance_cd_m2(const std::string& fit_json, double v) {
     try {
-        const store::JsonReader j(fit_json, "fit_json");
+        const nlohmann::json j = store::parse_json(fit_json, "fit_json");
         // A measured calibration keeps its display model under "display"
         // (docs/calibration.md "fit_json"); the runner's nominal model at the top.
-        const std::string root = j.array_length("$.display.channels") > 0 ? "$.display" : "$";
-        const std::size_t n = j.array_length(root + ".channels");
-        if (n == 0) return std::nullopt;
+        const nlohmann::json& model = store::array_at(j, "/display/channels").empty() ? j : j.at("display");
+        const nlohmann::json& channels = store::array_at(model, "/channels");
+        if (channels.empty()) return std::nullopt;
         double sum = 0.0;
-        for (std::size_t c = 0; c < n; ++c) {
-            const std::string at = fmt::format("{}.channels[{}]", root, c);
-            const std::string kind = j.string(at + ".transfer").value_or("");
+        for (const nlohmann::json& ch : channels) {
+            const std::string kind = store::string_at(ch, "/transfer").value_or("");
             if (kind == "srgb" || kind == "pq") {
-                const auto black = j.number(at + ".black_cd_m2");
-                const auto white = j.number(at + ".white_cd_m2");
+                const auto black = store::number_at(ch, "/black_cd_m2");
+                const auto white = store::number_at(ch, "/white_cd_m2");
                 if (!black || !white) return std::nullopt;
                 if (kind == "srgb") {
                     sum += *black + (*white - *black) * srgb_decode(v);
                 } else {
                     // docs/display-calibration.md: clamp(w_c EOTF(V), black_c, white_c); w_c is white_c / peak.
-                    const auto peak = j.number(root + ".peak_cd_m2");
+                    const auto peak = store::number_at(model, "/peak_cd_m2");
                     if (!peak || *peak <= 0.0) return std::nullopt;
                     sum += std::clamp(*white / *peak * pq_eotf_cd_m2(v), *black, *white);
                 }
             } else if (kind == "gog") {
                 // Berns' gain-offset-gamma with black offset: a + (b + k V)^gamma where b + k V > 0, else a.
-                const auto a = j.number(at + ".a");
-                const auto b = j.number(at + ".b");
-                const auto k = j.number(at + ".k");
-                const auto g = j.number(at + ".gamma");
+                const auto a = store::number_at(ch, "/a");
+                const auto b = store::number_at(ch, "/b");
+                const auto k = store::number_at(ch, "/k");
+                const auto g = store::number_at(ch, "/gamma");
                 if (!a || !b || !k || !g) return std::nullopt;
                 const double base = *b + *k * v;
                 sum += *a + (base > 0.0 ? std::pow(base, *g) : 0.0);

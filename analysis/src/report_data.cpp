@@ -7,140 +7,155 @@
 
 #include "atonlab/analysis/report.h"
 #include "atonlab/common/atomic_file.h"
+#include "atonlab/store/json.h"
 #include "csv.h"
-#include "json_writer.h"
 
 namespace atonlab::analysis {
 
 namespace {
 
-using detail::JsonWriter;
+using Json = nlohmann::ordered_json;  // summary.json keeps its members in the order written here
 
-void interval(JsonWriter& j, std::string_view key, const std::optional<Interval>& ci) {
-    j.key(key);
-    if (!ci) {
-        j.null();
-        return;
-    }
-    j.begin_array().value(ci->lower).value(ci->upper).end_array();
+/// An absent value is null (as a non-finite one is: store::dump_json).
+Json or_null(const std::optional<double>& v) {
+    return v ? Json(*v) : Json(nullptr);
 }
 
-void write_headline(JsonWriter& j, const HeadlineEstimate& h) {
-    j.key("headline").begin_object();
-    j.field("value", h.value);
-    interval(j, "ci", h.ci);
-    j.field("method", h.method).field("reliable", h.reliable).field("reason", h.reason);
-    j.end_object();
+/// [lower, upper], or null without an interval.
+Json interval(const std::optional<Interval>& ci) {
+    return ci ? Json::array({ci->lower, ci->upper}) : Json(nullptr);
 }
 
-void write_fit(JsonWriter& j, const GroupResult& g, const ConditionInfo& c) {
-    j.key("psychometric");
-    if (!g.fit) {
-        j.null();
-        return;
-    }
+Json headline_json(const HeadlineEstimate& h) {
+    Json j;
+    j["value"] = or_null(h.value);
+    j["ci"] = interval(h.ci);
+    j["method"] = h.method;
+    j["reliable"] = h.reliable;
+    j["reason"] = h.reason;
+    return j;
+}
+
+Json bootstrap_json(const PsychometricBootstrap& b) {
+    Json j;
+    j["requested"] = b.n_requested;
+    j["done"] = b.n_done;
+    j["failed"] = b.n_failed;
+    j["at_bound"] = b.n_at_bound;
+    j["reliable"] = b.reliable;
+    j["reason"] = b.reason;
+    j["ci"] = Json{{"threshold", interval(b.threshold)},
+                   {"slope", interval(b.slope)},
+                   {"width", interval(b.width)},
+                   {"lambda", interval(b.lambda)}};
+    j["goodness_of_fit"] = Json{{"deviance", b.goodness_of_fit.deviance},
+                                {"dof", b.goodness_of_fit.dof},
+                                {"p_value", or_null(b.goodness_of_fit.p_value)},
+                                {"p_value_chi2", or_null(b.goodness_of_fit.p_value_chi2)}};
+    return j;
+}
+
+Json fit_json(const GroupResult& g, const ConditionInfo& c) {
+    if (!g.fit) return nullptr;
     const PsychometricFit& f = *g.fit;
-    j.begin_object();
-    j.field("family", std::string(to_string(g.family))).field("family_note", g.family_note);
-    j.field("guess_rate", c.guess_rate).field("target_p", c.target_p);
-    j.field("threshold_proportion", g.threshold_proportion);
-    j.field("reliable", f.reliable).field("reason", f.reason);
-    j.field("n_trials", f.n_trials).field("n_levels", f.n_levels).field("n_free", f.n_free);
-    j.field("converged", f.converged).field("at_bound", f.at_bound);
+    Json j;
+    j["family"] = std::string(to_string(g.family));
+    j["family_note"] = g.family_note;
+    j["guess_rate"] = c.guess_rate;
+    j["target_p"] = c.target_p;
+    j["threshold_proportion"] = or_null(g.threshold_proportion);
+    j["reliable"] = f.reliable;
+    j["reason"] = f.reason;
+    j["n_trials"] = f.n_trials;
+    j["n_levels"] = f.n_levels;
+    j["n_free"] = f.n_free;
+    j["converged"] = f.converged;
+    j["at_bound"] = f.at_bound;
     if (f.estimate) {
         const PsychometricEstimate& e = *f.estimate;
-        j.field("alpha", e.params.alpha).field("beta", e.params.beta);
-        j.field("gamma", e.params.gamma).field("lambda", e.params.lambda);
-        j.field("threshold", e.threshold).field("psi_at_threshold", e.psi_at_threshold);
-        j.field("slope", e.slope).field("width", e.width);
-        j.field("log_likelihood", e.log_likelihood).field("deviance", e.deviance);
+        j["alpha"] = e.params.alpha;
+        j["beta"] = e.params.beta;
+        j["gamma"] = e.params.gamma;
+        j["lambda"] = e.params.lambda;
+        j["threshold"] = or_null(e.threshold);
+        j["psi_at_threshold"] = or_null(e.psi_at_threshold);
+        j["slope"] = or_null(e.slope);
+        j["width"] = or_null(e.width);
+        j["log_likelihood"] = e.log_likelihood;
+        j["deviance"] = e.deviance;
     } else {
         for (const char* k : {"alpha", "beta", "gamma", "lambda", "threshold", "psi_at_threshold", "slope", "width",
                               "log_likelihood", "deviance"})
-            j.field_null(k);
+            j[k] = nullptr;
     }
-    j.key("bootstrap");
-    if (!g.bootstrap) {
-        j.null();
-    } else {
-        const PsychometricBootstrap& b = *g.bootstrap;
-        j.begin_object();
-        j.field("requested", b.n_requested).field("done", b.n_done).field("failed", b.n_failed);
-        j.field("at_bound", b.n_at_bound).field("reliable", b.reliable).field("reason", b.reason);
-        j.key("ci").begin_object();
-        interval(j, "threshold", b.threshold);
-        interval(j, "slope", b.slope);
-        interval(j, "width", b.width);
-        interval(j, "lambda", b.lambda);
-        j.end_object();
-        j.key("goodness_of_fit").begin_object();
-        j.field("deviance", b.goodness_of_fit.deviance).field("dof", b.goodness_of_fit.dof);
-        j.field("p_value", b.goodness_of_fit.p_value).field("p_value_chi2", b.goodness_of_fit.p_value_chi2);
-        j.end_object();
-        j.end_object();
-    }
-    j.end_object();
+    j["bootstrap"] = g.bootstrap ? bootstrap_json(*g.bootstrap) : Json(nullptr);
+    return j;
 }
 
-void write_group(JsonWriter& j, const GroupResult& g, const ConditionInfo& c) {
-    j.begin_object();
-    j.field("observer", g.observer).field("n_trials", g.n_trials).field("n_scored", g.n_scored);
-    j.field("n_sessions", g.n_sessions);
-    write_headline(j, g.headline);
-    j.key("counts").begin_array();
-    for (const LevelCounts& k : g.counts)
-        j.begin_object().field("level", k.level).field("n", k.n_trials).field("yes", k.n_yes).end_object();
-    j.end_array();
-    write_fit(j, g, c);
-    j.key("tracks").begin_array();
-    for (const TrackResult& t : g.tracks) {
-        j.begin_object();
-        j.field("session", t.session).field("observer", t.observer).field("track", t.track);
-        j.field("procedure", t.procedure).field("n_trials", static_cast<int>(t.levels.size()));
-        j.key("reversals");
-        if (t.reversals) {
-            const ReversalSummary& r = *t.reversals;
-            j.begin_object().field("n_reversals", r.n_reversals).field("n_used", r.n_used);
-            j.field("mean", r.mean).field("sd", r.sd).field("sem", r.sem);
-            j.field("reliable", r.reliable).field("reason", r.reason).end_object();
-        } else {
-            j.null();
-        }
-        j.key("quest");
-        if (t.quest) {
-            const QuestSummary& q = *t.quest;
-            j.begin_object().field("mean", q.mean).field("sd", q.sd);
-            interval(j, "interval", q.interval);
-            j.field("interval_is_normal_approximation", q.interval_is_normal_approximation);
-            j.field("reliable", q.reliable).field("reason", q.reason).end_object();
-        } else {
-            j.null();
-        }
-        j.end_object();
+Json track_json(const TrackResult& t) {
+    Json j;
+    j["session"] = t.session;
+    j["observer"] = t.observer;
+    j["track"] = t.track;
+    j["procedure"] = t.procedure;
+    j["n_trials"] = static_cast<int>(t.levels.size());
+    j["reversals"] = nullptr;
+    if (t.reversals) {
+        const ReversalSummary& r = *t.reversals;
+        j["reversals"] = Json{
+            {"n_reversals", r.n_reversals}, {"n_used", r.n_used},     {"mean", or_null(r.mean)}, {"sd", or_null(r.sd)},
+            {"sem", or_null(r.sem)},        {"reliable", r.reliable}, {"reason", r.reason}};
     }
-    j.end_array();
-    j.field("reversal_mean", g.reversal_mean).field("quest_mean", g.quest_mean);
-    j.key("adjustment");
+    j["quest"] = nullptr;
+    if (t.quest) {
+        const QuestSummary& q = *t.quest;
+        j["quest"] = Json{{"mean", or_null(q.mean)},
+                          {"sd", or_null(q.sd)},
+                          {"interval", interval(q.interval)},
+                          {"interval_is_normal_approximation", q.interval_is_normal_approximation},
+                          {"reliable", q.reliable},
+                          {"reason", q.reason}};
+    }
+    return j;
+}
+
+Json group_json(const GroupResult& g, const ConditionInfo& c) {
+    Json j;
+    j["observer"] = g.observer;
+    j["n_trials"] = g.n_trials;
+    j["n_scored"] = g.n_scored;
+    j["n_sessions"] = g.n_sessions;
+    j["headline"] = headline_json(g.headline);
+    j["counts"] = Json::array();
+    for (const LevelCounts& k : g.counts)
+        j["counts"].push_back(Json{{"level", k.level}, {"n", k.n_trials}, {"yes", k.n_yes}});
+    j["psychometric"] = fit_json(g, c);
+    j["tracks"] = Json::array();
+    for (const TrackResult& t : g.tracks) j["tracks"].push_back(track_json(t));
+    j["reversal_mean"] = or_null(g.reversal_mean);
+    j["quest_mean"] = or_null(g.quest_mean);
+    j["adjustment"] = nullptr;
     if (g.matches) {
         const AdjustmentSummary& m = *g.matches;
-        j.begin_object().field("n", m.n).field("mean", m.mean_log10_ratio).field("median", m.median_log10_ratio);
-        j.field("sd", m.sd_log10_ratio);
-        interval(j, "mean_ci", m.mean_ci);
-        interval(j, "median_ci", m.median_ci);
-        j.field("reliable", m.reliable).field("reason", m.reason).end_object();
-    } else {
-        j.null();
+        j["adjustment"] = Json{{"n", m.n},
+                               {"mean", or_null(m.mean_log10_ratio)},
+                               {"median", or_null(m.median_log10_ratio)},
+                               {"sd", or_null(m.sd_log10_ratio)},
+                               {"mean_ci", interval(m.mean_ci)},
+                               {"median_ci", interval(m.median_ci)},
+                               {"reliable", m.reliable},
+                               {"reason", m.reason}};
     }
-    j.key("match_ratio");
+    j["match_ratio"] = nullptr;
     if (g.match_ratio) {
         const MatchRatio& m = *g.match_ratio;
-        j.begin_object().field("log10_ratio", m.value);
-        interval(j, "ci", m.ci);
-        j.field("method", m.method).field("reliable", m.reliable).field("reason", m.reason).end_object();
-    } else {
-        j.null();
+        j["match_ratio"] = Json{{"log10_ratio", or_null(m.value)},
+                                {"ci", interval(m.ci)},
+                                {"method", m.method},
+                                {"reliable", m.reliable},
+                                {"reason", m.reason}};
     }
-    j.end_object();
+    return j;
 }
 
 std::string opt(const std::optional<double>& v) {
@@ -155,15 +170,12 @@ std::string setting_csv(const std::string& toml_value) {
     return detail::csv_field(v.text);
 }
 
-/// The same as a JSON member.
-void setting_json(JsonWriter& j, const std::string& key, const std::string& toml_value) {
+/// The same as a JSON value.
+Json setting_json(const std::string& toml_value) {
     const SettingValue v = setting_value(toml_value);
-    if (v.number)
-        j.field(key, *v.number);
-    else if (v.boolean)
-        j.field(key, *v.boolean);
-    else
-        j.field(key, v.text);
+    if (v.number) return *v.number;
+    if (v.boolean) return *v.boolean;
+    return v.text;
 }
 
 }  // namespace
@@ -213,147 +225,157 @@ const std::vector<std::string>& fits_csv_columns() {
 void write_summary_json(const std::filesystem::path& file, const ReportContext& ctx) {
     const StudyResults& r = *ctx.results;
     const Dataset& d = *ctx.data;
-    JsonWriter j;
-    j.begin_object();
-    j.field("format", "atonlab-analysis-summary").field("format_version", 1);
+    Json j;
+    j["format"] = "atonlab-analysis-summary";
+    j["format_version"] = 1;
     // First, so a reader cannot miss it: inputs that were damaged and salvaged.
-    j.key("damaged_inputs").begin_array();
-    for (const DamagedInput& x : d.damaged) {
-        j.begin_object().field("file", x.file).field("problem", x.problem);
-        j.field("sessions_read", static_cast<std::int64_t>(x.sessions_read));
-        j.field("trials_read", static_cast<std::int64_t>(x.trials_read));
-        j.field("sessions_unreadable", x.sessions_unreadable).field("trials_unreadable", x.trials_unreadable);
-        j.end_object();
-    }
-    j.end_array();
-    j.field("software_version", ctx.software_version);
-    j.key("inputs").begin_array();
-    for (const std::string& s : d.sources) j.value(s);
-    j.end_array();
-    j.key("options").begin_object();
-    j.field("bootstrap", r.options.bootstrap).field("seed", std::to_string(r.options.seed));
-    j.field("family", std::string(to_string(r.options.family))).field("ci_level", r.options.ci_level);
-    j.field("last_reversals", r.options.last_reversals).end_object();
-    j.key("factor_columns").begin_array();
-    for (const std::string& k : r.factor_columns) j.value(k);
-    j.end_array();
-    j.key("observers").begin_array();
-    for (const std::string& o : r.observers) j.value(o);
-    j.end_array();
-    j.key("sessions").begin_array();
+    j["damaged_inputs"] = Json::array();
+    for (const DamagedInput& x : d.damaged)
+        j["damaged_inputs"].push_back(Json{{"file", x.file},
+                                           {"problem", x.problem},
+                                           {"sessions_read", static_cast<std::int64_t>(x.sessions_read)},
+                                           {"trials_read", static_cast<std::int64_t>(x.trials_read)},
+                                           {"sessions_unreadable", x.sessions_unreadable},
+                                           {"trials_unreadable", x.trials_unreadable}});
+    j["software_version"] = ctx.software_version;
+    j["inputs"] = d.sources;
+    j["options"] = Json{{"bootstrap", r.options.bootstrap},
+                        {"seed", std::to_string(r.options.seed)},
+                        {"family", std::string(to_string(r.options.family))},
+                        {"ci_level", r.options.ci_level},
+                        {"last_reversals", r.options.last_reversals}};
+    j["factor_columns"] = r.factor_columns;
+    j["observers"] = r.observers;
+    j["sessions"] = Json::array();
     for (const SessionInfo& s : d.sessions) {
-        j.begin_object().field("session", s.key).field("source", s.source).field("id", s.id);
-        j.field("observer", s.observer).field("protocol_name", s.protocol_name);
-        j.field("protocol_sha256", s.protocol_sha256).field("software_version", s.software_version);
-        j.field("seed", std::to_string(s.seed)).field("status", s.status).field("started_at", s.started_at);
-        j.field("ended_at", s.ended_at).field("trials", s.trial_count);
+        Json o{{"session", s.key},
+               {"source", s.source},
+               {"id", s.id},
+               {"observer", s.observer},
+               {"protocol_name", s.protocol_name},
+               {"protocol_sha256", s.protocol_sha256},
+               {"software_version", s.software_version},
+               {"seed", std::to_string(s.seed)},
+               {"status", s.status},
+               {"started_at", s.started_at},
+               {"ended_at", s.ended_at},
+               {"trials", s.trial_count}};
         if (s.displayable) {
-            j.field("displayable", *s.displayable).field("allowed_undisplayable", s.allowed_undisplayable);
-            j.key("undisplayable_conditions").begin_array();
-            for (const std::string& c : s.undisplayable) j.value(c);
-            j.end_array();
+            o["displayable"] = *s.displayable;
+            o["allowed_undisplayable"] = s.allowed_undisplayable;
+            o["undisplayable_conditions"] = s.undisplayable;
         }
-        j.end_object();
+        j["sessions"].push_back(std::move(o));
     }
-    j.end_array();
-    j.key("conditions").begin_array();
+    j["conditions"] = Json::array();
     for (const ConditionInfo& c : r.conditions) {
-        j.begin_object();
-        j.field("condition", c.condition).field("task", std::string(to_string(c.task)));
-        j.field("procedure", c.procedure).field("level_key", c.level_key).field("level_scale", c.level_scale);
-        j.field("level_unit", c.level_unit()).field("level_on", c.level_on);
-        j.field("adaptation_cd_m2", c.adaptation_cd_m2).field("tone_operator", c.tone_operator);
-        j.field("glare_test", c.glare_test).field("glare_reference", c.glare_reference);
-        j.field("test_intensity_cd", c.test_intensity_cd).field("guess_rate", c.guess_rate);
-        j.field("target_p", c.target_p).field("n_trials", c.n_trials);
+        Json o{{"condition", c.condition},
+               {"task", std::string(to_string(c.task))},
+               {"procedure", c.procedure},
+               {"level_key", c.level_key},
+               {"level_scale", c.level_scale},
+               {"level_unit", c.level_unit()},
+               {"level_on", c.level_on},
+               {"adaptation_cd_m2", or_null(c.adaptation_cd_m2)},
+               {"tone_operator", c.tone_operator},
+               {"glare_test", c.glare_test},
+               {"glare_reference", c.glare_reference},
+               {"test_intensity_cd", or_null(c.test_intensity_cd)},
+               {"guess_rate", c.guess_rate},
+               {"target_p", c.target_p},
+               {"n_trials", c.n_trials}};
         // The design's other factors (StudyResults::factor_columns), typed; null where the condition has none.
-        j.key("factors").begin_object();
+        Json factors = Json::object();
         for (const std::string& key : r.factor_columns) {
             const auto it = c.settings.find(key);
-            if (it == c.settings.end())
-                j.field_null(key);
-            else
-                setting_json(j, key, it->second);
+            factors[key] = it == c.settings.end() ? Json(nullptr) : setting_json(it->second);
         }
-        j.end_object();
-        j.key("mixed").begin_array();
-        for (const std::string& m : c.mixed) j.value(m);
-        j.end_array();
-        j.key("groups").begin_array();
+        o["factors"] = std::move(factors);
+        o["mixed"] = c.mixed;
+        o["groups"] = Json::array();
         for (const GroupResult& g : r.groups)
-            if (g.condition == c.condition) write_group(j, g, c);
-        j.end_array();
-        j.end_object();
+            if (g.condition == c.condition) o["groups"].push_back(group_json(g, c));
+        j["conditions"].push_back(std::move(o));
     }
-    j.end_array();
-    j.key("paired_comparisons").begin_array();
+    j["paired_comparisons"] = Json::array();
     for (const PairedResult& p : r.paired) {
         const PairedComparison& c = p.comparison;
-        j.begin_object().field("condition_a", p.condition_a).field("condition_b", p.condition_b);
-        j.field("factor", p.factor);
-        j.key("observers").begin_array();
-        for (const std::string& o : p.observers) j.value(o);
-        j.end_array();
-        j.field("n", c.n).field("mean_difference", c.mean_difference).field("sd_difference", c.sd_difference);
-        interval(j, "ci", c.ci);
-        j.field("t", c.t).field("dof", c.dof).field("p_value", c.p_value);
-        interval(j, "t_ci", c.t_ci);
-        j.field("reliable", c.reliable).field("reason", c.reason).end_object();
+        j["paired_comparisons"].push_back(Json{{"condition_a", p.condition_a},
+                                               {"condition_b", p.condition_b},
+                                               {"factor", p.factor},
+                                               {"observers", p.observers},
+                                               {"n", c.n},
+                                               {"mean_difference", or_null(c.mean_difference)},
+                                               {"sd_difference", or_null(c.sd_difference)},
+                                               {"ci", interval(c.ci)},
+                                               {"t", or_null(c.t)},
+                                               {"dof", c.dof},
+                                               {"p_value", or_null(c.p_value)},
+                                               {"t_ci", interval(c.t_ci)},
+                                               {"reliable", c.reliable},
+                                               {"reason", c.reason}});
     }
-    j.end_array();
-    j.key("frame_timing").begin_array();
-    for (const SessionTiming& s : r.timing) {
-        j.begin_object().field("session", s.session).field("observer", s.observer).field("trials", s.n_trials);
-        j.field("dropped_frames", s.dropped_frames).field("trials_with_drops", s.trials_with_drops);
-        j.field("missed_deadlines", s.missed_deadlines).end_object();
-    }
-    j.end_array();
-    j.key("calibrations").begin_array();
+    j["frame_timing"] = Json::array();
+    for (const SessionTiming& s : r.timing)
+        j["frame_timing"].push_back(Json{{"session", s.session},
+                                         {"observer", s.observer},
+                                         {"trials", s.n_trials},
+                                         {"dropped_frames", s.dropped_frames},
+                                         {"trials_with_drops", s.trials_with_drops},
+                                         {"missed_deadlines", s.missed_deadlines}});
+    j["calibrations"] = Json::array();
     for (const CalibrationInfo& c : d.calibrations) {
-        j.begin_object().field("source", c.source).field("id", c.id).field("display", c.display_name);
-        j.field("width_px", c.width_px).field("height_px", c.height_px).field("width_m", c.width_m);
-        j.field("height_m", c.height_m).field("viewing_distance_m", c.viewing_distance_m);
-        j.field("how", c.how).field("measured_at", c.measured_at);
-        j.field("readings", static_cast<int>(c.readings.size())).field("fit_json", c.fit_json);
-        j.key("checks").begin_array();
-        for (const DriftPoint& p : c.drift) {
-            j.begin_object().field("check_id", p.check_id).field("checked_at", p.checked_at);
-            j.field("passed", p.passed).field("peak_cd_m2", p.peak_cd_m2);
-            j.field("peak_predicted_cd_m2", p.peak_predicted_cd_m2).field("black_cd_m2", p.black_cd_m2);
-            j.field("black_predicted_cd_m2", p.black_predicted_cd_m2).field("gamma_measured", p.gamma_measured);
-            j.field("gamma_predicted", p.gamma_predicted).field("worst_error_percent", p.worst_error_percent);
-            j.field("worst_patch", p.worst_patch).field("tol_peak_percent", p.tol_peak_percent);
-            j.field("tol_black_cd_m2", p.tol_black_cd_m2).field("tol_gamma", p.tol_gamma);
-            j.field("tol_luminance_percent", p.tol_luminance_percent).end_object();
-        }
-        j.end_array().end_object();
+        Json checks = Json::array();
+        for (const DriftPoint& p : c.drift)
+            checks.push_back(Json{{"check_id", p.check_id},
+                                  {"checked_at", p.checked_at},
+                                  {"passed", p.passed},
+                                  {"peak_cd_m2", p.peak_cd_m2},
+                                  {"peak_predicted_cd_m2", p.peak_predicted_cd_m2},
+                                  {"black_cd_m2", p.black_cd_m2},
+                                  {"black_predicted_cd_m2", p.black_predicted_cd_m2},
+                                  {"gamma_measured", p.gamma_measured},
+                                  {"gamma_predicted", p.gamma_predicted},
+                                  {"worst_error_percent", p.worst_error_percent},
+                                  {"worst_patch", p.worst_patch},
+                                  {"tol_peak_percent", p.tol_peak_percent},
+                                  {"tol_black_cd_m2", p.tol_black_cd_m2},
+                                  {"tol_gamma", p.tol_gamma},
+                                  {"tol_luminance_percent", p.tol_luminance_percent}});
+        j["calibrations"].push_back(Json{{"source", c.source},
+                                         {"id", c.id},
+                                         {"display", c.display_name},
+                                         {"width_px", c.width_px},
+                                         {"height_px", c.height_px},
+                                         {"width_m", c.width_m},
+                                         {"height_m", c.height_m},
+                                         {"viewing_distance_m", c.viewing_distance_m},
+                                         {"how", c.how},
+                                         {"measured_at", c.measured_at},
+                                         {"readings", static_cast<int>(c.readings.size())},
+                                         {"fit_json", c.fit_json},
+                                         {"checks", std::move(checks)}});
     }
-    j.end_array();
-    j.key("figures").begin_array();
-    if (ctx.plots) {
-        for (const Figure& f : ctx.plots->figures) {
-            j.begin_object().field("id", f.id).field("kind", f.kind).field("condition", f.condition);
-            j.field("title", f.title).field("caption", f.caption).field("png", f.png.generic_string());
-            j.field("svg", f.svg.generic_string()).end_object();
-        }
-    }
-    j.end_array();
-    j.key("snapshots").begin_array();
-    for (const SnapshotImage& s : ctx.snapshots)
-        j.begin_object()
-            .field("condition", s.condition)
-            .field("session", s.session)
-            .field("png", s.png.generic_string())
-            .end_object();
-    j.end_array();
-    j.key("warnings").begin_array();
-    for (const std::string& w : r.warnings) j.value(w);
+    j["figures"] = Json::array();
     if (ctx.plots)
-        for (const std::string& w : ctx.plots->problems) j.value(w);
-    for (const std::string& w : ctx.problems) j.value(w);
-    j.end_array();
-    j.end_object();
-    files::write_file_atomically(file, j.text() + "\n");
+        for (const Figure& f : ctx.plots->figures)
+            j["figures"].push_back(Json{{"id", f.id},
+                                        {"kind", f.kind},
+                                        {"condition", f.condition},
+                                        {"title", f.title},
+                                        {"caption", f.caption},
+                                        {"png", f.png.generic_string()},
+                                        {"svg", f.svg.generic_string()}});
+    j["snapshots"] = Json::array();
+    for (const SnapshotImage& s : ctx.snapshots)
+        j["snapshots"].push_back(
+            Json{{"condition", s.condition}, {"session", s.session}, {"png", s.png.generic_string()}});
+    Json warnings = r.warnings;
+    if (ctx.plots)
+        for (const std::string& w : ctx.plots->problems) warnings.push_back(w);
+    for (const std::string& w : ctx.problems) warnings.push_back(w);
+    j["warnings"] = std::move(warnings);
+    files::write_file_atomically(file, store::dump_json(j, 2) + "\n");
 }
 
 void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {

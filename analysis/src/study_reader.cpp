@@ -59,29 +59,25 @@ std::optional<std::string> glare_of(const Frame& frame, const std::string& light
 }
 
 /// Fills the trial's task, level scale and stimulus parameters from its
-/// stimulus JSON (docs/running.md "What each trial stores"), read with the
-/// store's JsonReader (SQLite's JSON functions: no second JSON library).
+/// stimulus JSON (docs/running.md "What each trial stores").
 void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& problems) {
-    std::optional<store::JsonReader> jr;
+    nlohmann::json j;
     try {
-        jr.emplace(json, fmt::format("the stimulus_json of trial {}", t.trial_index));
+        j = store::parse_json(json, fmt::format("the stimulus_json of trial {}", t.trial_index));
     } catch (const store::StoreError& e) {
         problems.push_back(e.what());
         return;
     }
-    const store::JsonReader& j = *jr;
-    if (const auto task = parse_task(j.string("$.task").value_or(""))) t.task = *task;
-    t.level_key = j.string("$.level_key").value_or("");
-    t.level_scale = j.string("$.level_scale").value_or("log10");
-    t.level_on = j.string("$.level_on").value_or(t.task == Task::YesNo ? "test" : "reference");
+    if (const auto task = parse_task(store::string_at(j, "/task").value_or(""))) t.task = *task;
+    t.level_key = store::string_at(j, "/level_key").value_or("");
+    t.level_scale = store::string_at(j, "/level_scale").value_or("log10");
+    t.level_on = store::string_at(j, "/level_on").value_or(t.task == Task::YesNo ? "test" : "reference");
     std::vector<Frame> frames;
-    const std::size_t n_frames = j.array_length("$.frames");
-    for (std::size_t f = 0; f < n_frames; ++f) {
+    for (const nlohmann::json& f : store::array_at(j, "/frames")) {
         Frame frame;
-        frame.role = j.string(fmt::format("$.frames[{}].role", f)).value_or("both");
-        const std::size_t n_overrides = j.array_length(fmt::format("$.frames[{}].overrides", f));
-        for (std::size_t k = 0; k < n_overrides; ++k) {
-            const std::string text = j.string(fmt::format("$.frames[{}].overrides[{}]", f, k)).value_or("");
+        frame.role = store::string_at(f, "/role").value_or("both");
+        for (const nlohmann::json& o : store::array_at(f, "/overrides")) {
+            const std::string text = o.is_string() ? o.get<std::string>() : std::string();
             const auto eq = text.find('=');
             if (eq == std::string::npos) continue;
             frame.overrides.emplace_back(text.substr(0, eq), text.substr(eq + 1));
@@ -93,11 +89,10 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
     // it (its own model, else the eye's); absent in files written before lights
     // had their own model.
     std::optional<std::string> test_glare, reference_glare;
-    const std::size_t n_views = j.array_length("$.views");
-    for (std::size_t v = 0; v < n_views; ++v) {
-        const std::string role = j.string(fmt::format("$.views[{}].role", v)).value_or("");
-        const std::string light = j.string(fmt::format("$.views[{}].light", v)).value_or("");
-        const std::optional<std::string> glare = j.string(fmt::format("$.views[{}].glare", v));
+    for (const nlohmann::json& view : store::array_at(j, "/views")) {
+        const std::string role = store::string_at(view, "/role").value_or("");
+        const std::string light = store::string_at(view, "/light").value_or("");
+        const std::optional<std::string> glare = store::string_at(view, "/glare");
         if (role == "test") {
             test_light = light;
             test_glare = glare;
@@ -234,8 +229,9 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
     info.trial_count = s.trial_count;
     if (!records.empty()) {
         try {
-            const store::JsonReader state(records.front().procedure_state_json, "procedure_state_json");
-            info.answered_by = state.string("$.observer").value_or("");
+            const nlohmann::json state =
+                store::parse_json(records.front().procedure_state_json, "procedure_state_json");
+            info.answered_by = store::string_at(state, "/observer").value_or("");
         } catch (const store::StoreError&) {
             // Unknown: the report then treats the session's timing as real.
         }
@@ -245,12 +241,13 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         calibrations.insert(s.calibration->value);
     }
     if (s.displayability_json) {
-        const store::JsonReader j(*s.displayability_json, fmt::format("displayability_json of session {}", s.id.value));
-        info.displayable = j.boolean("$.displayable");
-        info.allowed_undisplayable = j.boolean("$.allowed_undisplayable").value_or(false);
-        for (std::size_t i = 0; i < j.array_length("$.conditions"); ++i)
-            if (!j.boolean(fmt::format("$.conditions[{}].displayable", i)).value_or(true))
-                info.undisplayable.push_back(j.string(fmt::format("$.conditions[{}].name", i)).value_or("?"));
+        const nlohmann::json j =
+            store::parse_json(*s.displayability_json, fmt::format("displayability_json of session {}", s.id.value));
+        info.displayable = store::boolean_at(j, "/displayable");
+        info.allowed_undisplayable = store::boolean_at(j, "/allowed_undisplayable").value_or(false);
+        for (const nlohmann::json& c : store::array_at(j, "/conditions"))
+            if (!store::boolean_at(c, "/displayable").value_or(true))
+                info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
         if (info.displayable == false)
             d.notes.push_back(fmt::format(
                 "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "

@@ -18,7 +18,6 @@
 #include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/store/error.h"
-#include "atonlab/store/json.h"
 #include "atonlab/store/profiles.h"
 #include "atonlab/store/store.h"
 #include "calibrate/instrument_session.h"

@@ -44,15 +44,14 @@ private:
 std::string fit_values(const store::Calibration& c) {
     if (!is_measured(c)) return "nominal model (not measured)";
     try {
-        const store::JsonReader j(c.fit_json);
+        const nlohmann::json j = store::parse_json(c.fit_json);
         std::string gamma = "-";
-        for (std::size_t i = 0; i < j.array_length("$.ramps"); ++i)
-            if (j.string(fmt::format("$.ramps[{}].channel", i)) == "grey")
-                if (const auto g = j.number(fmt::format("$.ramps[{}].effective_gamma", i)))
-                    gamma = fmt::format("{:.3f}", *g);
+        for (const nlohmann::json& ramp : store::array_at(j, "/ramps"))
+            if (store::string_at(ramp, "/channel") == "grey")
+                if (const auto g = store::number_at(ramp, "/effective_gamma")) gamma = fmt::format("{:.3f}", *g);
         return fmt::format("peak {:.4g} cd/m², black {:.4g} cd/m², grey effective γ {}",
-                           j.number("$.display.peak_cd_m2").value_or(NAN),
-                           j.number("$.display.black_cd_m2").value_or(NAN), gamma);
+                           store::number_at(j, "/display/peak_cd_m2").value_or(NAN),
+                           store::number_at(j, "/display/black_cd_m2").value_or(NAN), gamma);
     } catch (const store::StoreError&) {
         return "unreadable fit_json";
     }

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <limits>
 
-#include "json_text.h"
+#include "atonlab/store/json.h"
 
 extern char** environ;
 
@@ -91,33 +91,41 @@ CheckOutcome evaluate_check(const stimuli::DisplayModel& model, const std::vecto
 }
 
 std::string check_results_json(const CheckOutcome& o, const CheckTolerances& tol, const store::Calibration& cal) {
-    std::string patches;
+    using Json = nlohmann::ordered_json;
+    Json patches = Json::array();
     for (const CheckPatch& c : o.patches) {
-        std::string xyz = "null";
-        if (c.measured.xyz_cd_m2)
-            xyz = fmt::format("[{},{},{}]", json_number(c.measured.xyz_cd_m2->x), json_number(c.measured.xyz_cd_m2->y),
-                              json_number(c.measured.xyz_cd_m2->z));
+        Json patch{{"patch", c.patch.name},
+                   {"code", c.patch.code},
+                   {"bits", Patch::bits},
+                   {"predicted_cd_m2", c.predicted_cd_m2},
+                   {"measured_cd_m2", c.measured.luminance_cd_m2},
+                   {"error_cd_m2", c.error_cd_m2},
+                   {"error_percent", c.error_percent},
+                   {"xyz_cd_m2", nullptr}};
+        if (const auto& xyz = c.measured.xyz_cd_m2) patch["xyz_cd_m2"] = Json::array({xyz->x, xyz->y, xyz->z});
         // With --instrument: what the instrument said for the patch, raw.
-        const std::string transcript =
-            c.measured.transcript.empty() ? "" : ",\"transcript\":" + json_string(c.measured.transcript);
-        patches += fmt::format(
-            R"({}{{"patch":{},"code":{},"bits":{},"predicted_cd_m2":{},"measured_cd_m2":{},"error_cd_m2":{},)"
-            R"("error_percent":{},"xyz_cd_m2":{}{}}})",
-            patches.empty() ? "" : ",", json_string(c.patch.name), c.patch.code, Patch::bits,
-            json_number(c.predicted_cd_m2), json_number(c.measured.luminance_cd_m2), json_number(c.error_cd_m2),
-            json_number(c.error_percent), xyz, transcript);
+        if (!c.measured.transcript.empty()) patch["transcript"] = c.measured.transcript;
+        patches.push_back(std::move(patch));
     }
-    std::string failed;
-    for (const std::string& f : o.failed) failed += (failed.empty() ? "" : ",") + json_string(f);
-    return fmt::format(R"({{"calibration_id":{},"calibration_measured_at":{},"passed":{},"failed":[{}],)"
-                       R"("tolerances":{{"luminance_percent":{},"black_cd_m2":{},"peak_percent":{},"gamma":{}}},)"
-                       R"("values":{{"luminance_percent":{},"black_cd_m2":{},"peak_percent":{},"gamma":{}}},)"
-                       R"("worst_patch":{},"gamma_measured":{},"gamma_predicted":{},"patches":[{}]}})",
-                       cal.id.value, json_string(cal.measured_at), o.passed() ? "true" : "false", failed,
-                       json_number(tol.luminance_percent), json_number(tol.black_cd_m2), json_number(tol.peak_percent),
-                       json_number(tol.gamma), json_number(o.luminance_percent), json_number(o.black_cd_m2),
-                       json_number(o.peak_percent), json_number(o.gamma), json_string(o.worst_patch),
-                       json_number(o.gamma_measured), json_number(o.gamma_predicted), patches);
+    const Json j{{"calibration_id", cal.id.value},
+                 {"calibration_measured_at", cal.measured_at},
+                 {"passed", o.passed()},
+                 {"failed", o.failed},
+                 {"tolerances",
+                  {{"luminance_percent", tol.luminance_percent},
+                   {"black_cd_m2", tol.black_cd_m2},
+                   {"peak_percent", tol.peak_percent},
+                   {"gamma", tol.gamma}}},
+                 {"values",
+                  {{"luminance_percent", o.luminance_percent},
+                   {"black_cd_m2", o.black_cd_m2},
+                   {"peak_percent", o.peak_percent},
+                   {"gamma", o.gamma}}},
+                 {"worst_patch", o.worst_patch},
+                 {"gamma_measured", o.gamma_measured},
+                 {"gamma_predicted", o.gamma_predicted},
+                 {"patches", std::move(patches)}};
+    return store::dump_json(j);
 }
 
 void print_check(std::FILE* out, const CheckOutcome& o, const CheckTolerances& tol) {

@@ -28,14 +28,15 @@ std::optional<std::chrono::sys_days> date_of(const std::string& iso) {
 /// "peak_percent 10.3 > 5, luminance_percent 10.1 > 5" from a check's results_json.
 std::string failed_tolerances(const store::CalibrationCheck& check) {
     try {
-        const store::JsonReader j(check.results_json);
+        const nlohmann::json j = store::parse_json(check.results_json);
         std::string out;
-        for (std::size_t i = 0; i < j.array_length("$.failed"); ++i) {
-            const auto name = j.string(fmt::format("$.failed[{}]", i));
-            if (!name) continue;
-            const auto value = j.number(fmt::format("$.values.{}", *name));
-            const auto limit = j.number(fmt::format("$.tolerances.{}", *name));
-            out += fmt::format("{}{} {} > {}", out.empty() ? "" : ", ", *name,
+        for (const nlohmann::json& failed : store::array_at(j, "/failed")) {
+            if (!failed.is_string()) continue;
+            const std::string name = failed.get<std::string>();
+            using Pointer = nlohmann::json::json_pointer;  // escapes a name's '/' and '~'
+            const auto value = store::number_at(j, (Pointer("/values") / name).to_string());
+            const auto limit = store::number_at(j, (Pointer("/tolerances") / name).to_string());
+            out += fmt::format("{}{} {} > {}", out.empty() ? "" : ", ", name,
                                value ? fmt::format("{:.3g}", *value) : std::string("(not computable)"),
                                limit ? fmt::format("{}", *limit) : std::string("?"));
         }

@@ -7,16 +7,20 @@
 
 #include "atonlab/stimuli/error.h"
 #include "atonlab/store/json.h"
-#include "json_text.h"
 
 namespace atonlab::runner {
 namespace {
 
 const char* const kChannelNames[3] = {"red", "green", "blue"};
 
-std::string gog_json(const stimuli::GogParams& p) {
-    return fmt::format(R"("a":{},"b":{},"k":{},"gamma":{})", json_number(p.a), json_number(p.b), json_number(p.k),
-                       json_number(p.gamma));
+using Json = nlohmann::ordered_json;
+
+/// The GOG parameters as members of `j` (a ramp or a channel).
+void add_gog(Json& j, const stimuli::GogParams& p) {
+    j["a"] = p.a;
+    j["b"] = p.b;
+    j["k"] = p.k;
+    j["gamma"] = p.gamma;
 }
 
 }  // namespace
@@ -34,36 +38,44 @@ std::string DisplayGeometry::describe() const {
 
 std::string measured_fit_json(const stimuli::CalibrationReport& report, const stimuli::DisplayModel& model,
                               const DisplayGeometry& geometry, std::string_view method) {
-    std::string ramps;
+    Json ramps = Json::array();
     for (const stimuli::RampReport& r : report.ramps) {
-        ramps += fmt::format(
-            R"({}{{"channel":{},{},"effective_gamma":{},"black_cd_m2":{},"peak_cd_m2":{},"rmse_log10":{},"n":{},)"
-            R"("levels":{}}})",
-            ramps.empty() ? "" : ",", json_string(stimuli::channel_name(r.channel)),
-            gog_json(stimuli::gog_params(r.fit)), json_number(r.effective_gamma), json_number(r.black_cd_m2),
-            json_number(r.white_cd_m2), json_number(r.fit.rmse_log10), r.fit.n, r.levels);
+        Json ramp{{"channel", stimuli::channel_name(r.channel)}};
+        add_gog(ramp, stimuli::gog_params(r.fit));
+        ramp["effective_gamma"] = r.effective_gamma;
+        ramp["black_cd_m2"] = r.black_cd_m2;
+        ramp["peak_cd_m2"] = r.white_cd_m2;
+        ramp["rmse_log10"] = r.fit.rmse_log10;
+        ramp["n"] = r.fit.n;
+        ramp["levels"] = r.levels;
+        ramps.push_back(std::move(ramp));
     }
-    std::string channels;
+    Json channels = Json::array();
     for (int c = 0; c < 3; ++c) {
-        const stimuli::ChannelTransfer& ch = model.channels[static_cast<std::size_t>(c)];
-        channels += fmt::format(R"({}{{"channel":"{}","transfer":"gog",{}}})", c ? "," : "", kChannelNames[c],
-                                gog_json(ch.gog));
+        Json channel{{"channel", kChannelNames[c]}, {"transfer", "gog"}};
+        add_gog(channel, model.channels[static_cast<std::size_t>(c)].gog);
+        channels.push_back(std::move(channel));
     }
-    std::string notes;
-    for (const std::string& n : report.notes) notes += (notes.empty() ? "" : ",") + json_string(n);
-    return fmt::format(R"({{"model":"gog","method":{},"black_cd_m2":{},"white_cd_m2":{},"contrast_ratio":{},)"
-                       R"("pixels_per_degree":{},"n_measurements":{},"n_other":{},"ramps":[{}],)"
-                       R"("display":{{"peak_cd_m2":{},"black_cd_m2":{},"channels":[{}]}},"notes":[{}]}})",
-                       json_string(method), json_number(report.black_cd_m2), json_number(report.white_cd_m2),
-                       json_number(report.contrast_ratio), json_number(geometry.pixels_per_degree()),
-                       report.n_measurements, report.n_other, ramps, json_number(model.peak_cd_m2),
-                       json_number(model.black_cd_m2), channels, notes);
+    const Json j{
+        {"model", "gog"},
+        {"method", method},
+        {"black_cd_m2", report.black_cd_m2},
+        {"white_cd_m2", report.white_cd_m2},
+        {"contrast_ratio", report.contrast_ratio},
+        {"pixels_per_degree", geometry.pixels_per_degree()},
+        {"n_measurements", report.n_measurements},
+        {"n_other", report.n_other},
+        {"ramps", std::move(ramps)},
+        {"display",
+         {{"peak_cd_m2", model.peak_cd_m2}, {"black_cd_m2", model.black_cd_m2}, {"channels", std::move(channels)}}},
+        {"notes", report.notes}};
+    return store::dump_json(j);
 }
 
 bool is_measured(const store::Calibration& c) {
     try {
-        const store::JsonReader j(c.fit_json);
-        return j.string("$.model") == "gog" && j.array_length("$.display.channels") == 3;
+        const nlohmann::json j = store::parse_json(c.fit_json);
+        return store::string_at(j, "/model") == "gog" && store::array_at(j, "/display/channels").size() == 3;
     } catch (const store::StoreError&) {
         return false;
     }
@@ -75,11 +87,11 @@ stimuli::DisplayModel display_model_of(const store::Calibration& c) {
         throw InputError(SourceLocation{"", 0, 0, "fit_json"}, fmt::format("{} {}", what, why));
     };
     if (!is_measured(c)) return fail("is not a measured calibration (its fit_json has no GOG display model)");
-    const store::JsonReader j(c.fit_json, "fit_json of " + what);
+    const nlohmann::json j = store::parse_json(c.fit_json, "fit_json of " + what);
     std::array<stimuli::GogParams, 3> params{};
     for (int ch = 0; ch < 3; ++ch) {
         auto value = [&](const char* name) {
-            const auto v = j.number(fmt::format("$.display.channels[{}].{}", ch, name));
+            const auto v = store::number_at(j, fmt::format("/display/channels/{}/{}", ch, name));
             if (!v) fail(fmt::format("has no number display.channels[{}].{}", ch, name));
             return *v;
         };

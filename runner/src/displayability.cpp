@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "atonlab/protocols/observer.h"
-#include "json_text.h"
+#include "atonlab/store/json.h"
 
 namespace atonlab::runner {
 
@@ -180,33 +180,38 @@ std::string displayability_refusal(const Displayability& d, const std::string& p
 }
 
 std::string displayability_json(const Displayability& d, bool allowed) {
-    std::string j = fmt::format(
-        "{{\"display\":{{\"width_px\":{},\"height_px\":{},\"width_m\":{},\"viewing_distance_m\":{},\"deg_per_px\":{},"
-        "\"bits\":{},\"white_code\":{}}},\"min_rise_codes\":{},\"displayable\":{},\"allowed_undisplayable\":{},"
-        "\"conditions\":[",
-        d.width_px, d.height_px, json_number(d.width_m), json_number(d.viewing_distance_m), json_number(d.deg_per_px),
-        d.bits, (1 << d.bits) - 1, kMinRiseCodes, d.displayable() ? "true" : "false", allowed ? "true" : "false");
-    for (std::size_t i = 0; i < d.conditions.size(); ++i) {
-        const ConditionDisplayability& c = d.conditions[i];
-        j += fmt::format("{}{{\"name\":{},\"displayable\":{},\"problems\":[", i ? "," : "", json_string(c.name),
-                         c.displayable() ? "true" : "false");
-        for (std::size_t k = 0; k < c.problems.size(); ++k) j += (k ? "," : "") + json_string(c.problems[k]);
-        j += "],\"ends\":[";
+    using Json = nlohmann::ordered_json;
+    Json conditions = Json::array();
+    for (const ConditionDisplayability& c : d.conditions) {
+        Json ends = Json::array();
         for (const LevelEnd* end : {&c.low, &c.high}) {
-            j += fmt::format("{}{{\"level\":{},\"lights\":[", end == &c.low ? "" : ",", json_number(end->level));
-            for (std::size_t k = 0; k < end->lights.size(); ++k) {
-                const ShownLight& s = end->lights[k];
-                j += fmt::format(
-                    "{}{{\"role\":{},\"light\":{},\"peak_code\":{},\"background_code\":{},\"rise_codes\":{},"
-                    "\"clipped\":{},\"light_lux\":{}}}",
-                    k ? "," : "", json_string(p::to_string(s.role)), json_string(s.light), s.peak_code,
-                    s.background_code, s.rise_codes, s.clipped ? "true" : "false", json_number(s.light_lux));
-            }
-            j += "]}";
+            Json lights = Json::array();
+            for (const ShownLight& s : end->lights)
+                lights.push_back(Json{{"role", p::to_string(s.role)},
+                                      {"light", s.light},
+                                      {"peak_code", s.peak_code},
+                                      {"background_code", s.background_code},
+                                      {"rise_codes", s.rise_codes},
+                                      {"clipped", s.clipped},
+                                      {"light_lux", s.light_lux}});
+            ends.push_back(Json{{"level", end->level}, {"lights", std::move(lights)}});
         }
-        j += "]}";
+        conditions.push_back(Json{
+            {"name", c.name}, {"displayable", c.displayable()}, {"problems", c.problems}, {"ends", std::move(ends)}});
     }
-    return j + "]}";
+    const Json j{{"display",
+                  {{"width_px", d.width_px},
+                   {"height_px", d.height_px},
+                   {"width_m", d.width_m},
+                   {"viewing_distance_m", d.viewing_distance_m},
+                   {"deg_per_px", d.deg_per_px},
+                   {"bits", d.bits},
+                   {"white_code", (1 << d.bits) - 1}}},
+                 {"min_rise_codes", kMinRiseCodes},
+                 {"displayable", d.displayable()},
+                 {"allowed_undisplayable", allowed},
+                 {"conditions", std::move(conditions)}};
+    return store::dump_json(j);
 }
 
 }  // namespace atonlab::runner

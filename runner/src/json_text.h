@@ -1,7 +1,9 @@
 #pragma once
-// JSON text for what the runner stores (fit_json, results_json): numbers in
-// the shortest form that reads back as the same double, non-finite as null,
-// strings escaped (RFC 8259 §7). Reading goes through store::JsonReader.
+// JSON text built by hand, left only for run_session.cpp's trial records until
+// they are built with nlohmann::json like every other JSON atonlab writes
+// (atonlab/store/json.h); then this file goes. Numbers in the shortest form
+// that reads back as the same double, non-finite as null, strings escaped
+// (RFC 8259 §7).
 #include <string>
 #include <string_view>
 

@@ -1,79 +1,57 @@
-// JsonReader: json_type() / json_extract() on a private in-memory SQLite
-// connection (see json.h).
+// Parsing, writing and reading JSON with nlohmann::json (json.h).
 #include "atonlab/store/json.h"
 
 #include <fmt/format.h>
 
-#include "sqlite.h"
+#include "atonlab/store/error.h"
 
 namespace atonlab::store {
 
-struct JsonReader::Impl {
-    std::string text;
-    std::string what;
-    sql::Connection db{":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_MEMORY};
-
-    /// json_type and the value at `path`; type "" when the path is absent.
-    template <class F>
-    auto at(std::string_view path, F&& read) {
-        sql::Use s(db.cached("SELECT json_type(?1, ?2), json_extract(?1, ?2)"));
-        s->bind(1, text);
-        s->bind(2, path);
-        const std::string doing = fmt::format("read {} from {}", path, what);
-        s->step(doing);
-        const std::string type = s->is_null(0) ? std::string() : s->text(0);
-        return read(type, *s);
+nlohmann::json parse_json(std::string_view text, std::string_view what) {
+    try {
+        return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 6: syntax error ..."
+        // -- a sentence for a programmer; the byte and the reason after the last ": " say where.
+        const std::string why = e.what();
+        const std::size_t colon = why.rfind(": ");
+        throw StoreError(StoreErrc::invalid_argument, {},
+                         fmt::format("{} is not valid JSON (at byte {}: {})", what, e.byte,
+                                     colon == std::string::npos ? why : why.substr(colon + 2)));
     }
-};
-
-JsonReader::JsonReader(std::string text, std::string what) : impl_(std::make_unique<Impl>()) {
-    impl_->text = std::move(text);
-    impl_->what = std::move(what);
-    sql::Use s(impl_->db.cached("SELECT json_valid(?1)"));
-    s->bind(1, impl_->text);
-    s->step("check JSON text");
-    if (s->int64(0) != 1)
-        throw StoreError(StoreErrc::invalid_argument, {}, fmt::format("{} is not valid JSON", impl_->what));
 }
 
-JsonReader::JsonReader(JsonReader&&) noexcept = default;
-JsonReader& JsonReader::operator=(JsonReader&&) noexcept = default;
-JsonReader::~JsonReader() = default;
-
-const std::string& JsonReader::text() const noexcept {
-    return impl_->text;
+std::string dump_json(const nlohmann::ordered_json& j, int indent) {
+    return j.dump(indent, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
-std::optional<double> JsonReader::number(std::string_view path) const {
-    return impl_->at(path, [](const std::string& type, const sql::Statement& s) -> std::optional<double> {
-        if (type != "integer" && type != "real") return std::nullopt;
-        return s.real(1);
-    });
+const nlohmann::json* json_at(const nlohmann::json& j, std::string_view at) {
+    const nlohmann::json::json_pointer pointer{std::string(at)};
+    return j.contains(pointer) ? &j.at(pointer) : nullptr;
 }
 
-std::optional<std::string> JsonReader::string(std::string_view path) const {
-    return impl_->at(path, [](const std::string& type, const sql::Statement& s) -> std::optional<std::string> {
-        if (type != "text") return std::nullopt;
-        return s.text(1);
-    });
+std::optional<double> number_at(const nlohmann::json& j, std::string_view at) {
+    const nlohmann::json* v = json_at(j, at);
+    if (!v || !v->is_number()) return std::nullopt;
+    return v->get<double>();
 }
 
-std::optional<bool> JsonReader::boolean(std::string_view path) const {
-    return impl_->at(path, [](const std::string& type, const sql::Statement&) -> std::optional<bool> {
-        if (type == "true") return true;
-        if (type == "false") return false;
-        return std::nullopt;
-    });
+std::optional<std::string> string_at(const nlohmann::json& j, std::string_view at) {
+    const nlohmann::json* v = json_at(j, at);
+    if (!v || !v->is_string()) return std::nullopt;
+    return v->get<std::string>();
 }
 
-std::size_t JsonReader::array_length(std::string_view path) const {
-    sql::Connection& c = impl_->db;
-    sql::Use s(c.cached("SELECT json_type(?1, ?2), json_array_length(?1, ?2)"));
-    s->bind(1, impl_->text);
-    s->bind(2, path);
-    s->step(fmt::format("read {} from {}", path, impl_->what));
-    if (s->is_null(0) || s->text(0) != "array") return 0;
-    return static_cast<std::size_t>(s->int64(1));
+std::optional<bool> boolean_at(const nlohmann::json& j, std::string_view at) {
+    const nlohmann::json* v = json_at(j, at);
+    if (!v || !v->is_boolean()) return std::nullopt;
+    return v->get<bool>();
+}
+
+const nlohmann::json& array_at(const nlohmann::json& j, std::string_view at) {
+    static const nlohmann::json empty = nlohmann::json::array();
+    const nlohmann::json* v = json_at(j, at);
+    return v && v->is_array() ? *v : empty;
 }
 
 }  // namespace atonlab::store

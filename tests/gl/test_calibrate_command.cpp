@@ -43,7 +43,6 @@ namespace atonlab {
 namespace {
 
 namespace fs = std::filesystem;
-using store::JsonReader;
 using store::Store;
 using store::test_support::file_bytes;
 using store::test_support::TempDir;
@@ -145,10 +144,12 @@ const std::vector<std::string> kGeometry = {"--width-px", "1920",  "--height-px"
 /// The stored model, read from fit_json as docs/calibration.md lays it out
 /// (independently of the runner's own reader).
 stimuli::DisplayModel stored_model(const store::Calibration& c) {
-    const JsonReader j(c.fit_json);
+    const nlohmann::json j = store::parse_json(c.fit_json);
     std::array<stimuli::GogParams, 3> p{};
     for (int ch = 0; ch < 3; ++ch) {
-        auto v = [&](const char* k) { return j.number(fmt::format("$.display.channels[{}].{}", ch, k)).value(); };
+        auto v = [&](const char* k) {
+            return store::number_at(j, fmt::format("/display/channels/{}/{}", ch, k)).value();
+        };
         p[static_cast<std::size_t>(ch)] = {v("a"), v("b"), v("k"), v("gamma")};
     }
     return stimuli::DisplayModel::gog(p);
@@ -287,12 +288,12 @@ TEST_F(CalibrateCommand, ExactReadingsGiveBackTheDisplaysLaw) {
     EXPECT_LT(worst_relative_error(m), 2e-3);
     EXPECT_NEAR(m.black_cd_m2, kTruth[0].a + kTruth[1].a + kTruth[2].at(0.0), 1e-3 * m.black_cd_m2);
     EXPECT_NEAR(m.peak_cd_m2, truth_cd_m2(255, 255, 255), 1e-3 * m.peak_cd_m2);
-    const JsonReader j(cal->fit_json);
+    const nlohmann::json j = store::parse_json(cal->fit_json);
     for (int i = 0; i < 3; ++i) {
-        const std::string ramp = fmt::format("$.ramps[{}]", i);
-        ASSERT_EQ(j.string(ramp + ".channel"), (std::array<const char*, 3>{"red", "green", "blue"})[i]);
-        EXPECT_NEAR(j.number(ramp + ".effective_gamma").value(), effective_gamma(kTruth[i]), 2e-3) << ramp;
-        EXPECT_LT(j.number(ramp + ".rmse_log10").value(), 1e-3);
+        const std::string ramp = fmt::format("/ramps/{}", i);
+        ASSERT_EQ(store::string_at(j, ramp + "/channel"), (std::array<const char*, 3>{"red", "green", "blue"})[i]);
+        EXPECT_NEAR(store::number_at(j, ramp + "/effective_gamma").value(), effective_gamma(kTruth[i]), 2e-3) << ramp;
+        EXPECT_LT(store::number_at(j, ramp + "/rmse_log10").value(), 1e-3);
     }
     // The 41 readings are stored with their codes.
     const auto readings = s.calibration_readings(cal->id);
@@ -323,7 +324,7 @@ TEST_F(CalibrateCommand, NoisyReadingsAreRecoveredAndChecked) {
     EXPECT_NEAR(m.peak_cd_m2, truth_cd_m2(255, 255, 255), 0.03 * truth_cd_m2(255, 255, 255));
     // Each ramp's black, peak and effective gamma within 4 standard errors of the
     // fit, the errors that 1 % noise on these levels (black once, 8 ramp levels) allows.
-    const JsonReader j(cal.fit_json);
+    const nlohmann::json j = store::parse_json(cal.fit_json);
     std::vector<double> levels = {0.0};
     for (const PatchCodes& p : patches_)
         if (p.g == 0 && p.b == 0 && p.r > 0) levels.push_back(p.r / 255.0);
@@ -331,22 +332,24 @@ TEST_F(CalibrateCommand, NoisyReadingsAreRecoveredAndChecked) {
     for (int i = 0; i < 3; ++i) {
         SCOPED_TRACE(fmt::format("ramp {}", i));
         const Theta t = ramp_truth(i);
-        const std::string ramp = fmt::format("$.ramps[{}]", i);
+        const std::string ramp = fmt::format("/ramps/{}", i);
         const double se_gamma = standard_error(t, levels, 0.01, ramp_effective_gamma);
         const double se_black = standard_error(t, levels, 0.01, [](const Theta& u) { return ramp_at(u, 0.0); });
         const double se_peak = standard_error(t, levels, 0.01, [](const Theta& u) { return ramp_at(u, 1.0); });
-        EXPECT_NEAR(j.number(ramp + ".effective_gamma").value(), ramp_effective_gamma(t), 4.0 * se_gamma)
+        EXPECT_NEAR(store::number_at(j, ramp + "/effective_gamma").value(), ramp_effective_gamma(t), 4.0 * se_gamma)
             << "SE " << se_gamma;
-        EXPECT_NEAR(j.number(ramp + ".black_cd_m2").value(), ramp_at(t, 0.0), 4.0 * se_black) << "SE " << se_black;
-        EXPECT_NEAR(j.number(ramp + ".peak_cd_m2").value(), ramp_at(t, 1.0), 4.0 * se_peak) << "SE " << se_peak;
+        EXPECT_NEAR(store::number_at(j, ramp + "/black_cd_m2").value(), ramp_at(t, 0.0), 4.0 * se_black)
+            << "SE " << se_black;
+        EXPECT_NEAR(store::number_at(j, ramp + "/peak_cd_m2").value(), ramp_at(t, 1.0), 4.0 * se_peak)
+            << "SE " << se_peak;
         std::printf(
             "  ramp %d: effective gamma %.4f (true %.4f, SE %.4f), black %.5f (true %.5f, SE %.5f), "
             "peak %.4f (true %.4f, SE %.4f) cd/m²\n",
-            i, j.number(ramp + ".effective_gamma").value(), ramp_effective_gamma(t), se_gamma,
-            j.number(ramp + ".black_cd_m2").value(), ramp_at(t, 0.0), se_black, j.number(ramp + ".peak_cd_m2").value(),
-            ramp_at(t, 1.0), se_peak);
+            i, store::number_at(j, ramp + "/effective_gamma").value(), ramp_effective_gamma(t), se_gamma,
+            store::number_at(j, ramp + "/black_cd_m2").value(), ramp_at(t, 0.0), se_black,
+            store::number_at(j, ramp + "/peak_cd_m2").value(), ramp_at(t, 1.0), se_peak);
         // The residuals are the noise: 1 % is 0.0043 in log10.
-        const double rmse = j.number(ramp + ".rmse_log10").value();
+        const double rmse = store::number_at(j, ramp + "/rmse_log10").value();
         EXPECT_GT(rmse, 0.0015);
         EXPECT_LT(rmse, 0.009);
     }
@@ -384,13 +387,13 @@ TEST_F(CalibrateCommand, NoisyReadingsAreRecoveredAndChecked) {
     EXPECT_FALSE(checks[0].passed);  // the latest (2024-06-02)
     EXPECT_EQ(checks[0].checked_at, "2024-06-02");
     EXPECT_TRUE(checks[1].passed);
-    const JsonReader failed(checks[0].results_json);
+    const nlohmann::json failed = store::parse_json(checks[0].results_json);
     bool names_peak = false;
-    for (std::size_t i = 0; i < failed.array_length("$.failed"); ++i)
-        names_peak = names_peak || failed.string(fmt::format("$.failed[{}]", i)) == "peak_percent";
+    for (std::size_t i = 0; i < store::array_at(failed, "/failed").size(); ++i)
+        names_peak = names_peak || store::string_at(failed, fmt::format("/failed/{}", i)) == "peak_percent";
     EXPECT_TRUE(names_peak) << checks[0].results_json;
-    EXPECT_NEAR(failed.number("$.values.peak_percent").value(), 10.0, 3.0);
-    EXPECT_EQ(failed.number("$.tolerances.peak_percent"), 5.0);
+    EXPECT_NEAR(store::number_at(failed, "/values/peak_percent").value(), 10.0, 3.0);
+    EXPECT_EQ(store::number_at(failed, "/tolerances/peak_percent"), 5.0);
 }
 
 TEST_F(CalibrateCommand, BadReadingsAndOptionsExitTwoStoringNothing) {
@@ -475,8 +478,8 @@ TEST(CalibrateImport, ArgyllAndCsvFilesAreStoredWithTheirReadings) {
     EXPECT_EQ(csv[1].source_line, 6);
     EXPECT_FALSE(csv[1].xyz_x_cd_m2.has_value());
     // The .ti3's white: LUMINANCE_XYZ_CDM2 says Y = 120 cd/m²; the fit's white is near it.
-    const JsonReader j(all[1].fit_json);
-    EXPECT_NEAR(j.number("$.white_cd_m2").value(), 120.0, 1.2);
+    const nlohmann::json j = store::parse_json(all[1].fit_json);
+    EXPECT_NEAR(store::number_at(j, "/white_cd_m2").value(), 120.0, 1.2);
 }
 
 TEST(CalibrateImport, MalformedFilesExitTwoNamingFileAndLine) {

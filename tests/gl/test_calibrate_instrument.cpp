@@ -42,7 +42,6 @@ namespace atonlab {
 namespace {
 
 namespace fs = std::filesystem;
-using store::JsonReader;
 using store::Store;
 using store::test_support::file_bytes;
 using store::test_support::TempDir;
@@ -127,10 +126,12 @@ const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px", 
                                             "--width-m",  "0.1", "--viewing-distance-m", "0.9"};
 
 stimuli::DisplayModel stored_model(const store::Calibration& c) {
-    const JsonReader j(c.fit_json);
+    const nlohmann::json j = store::parse_json(c.fit_json);
     std::array<stimuli::GogParams, 3> p{};
     for (int ch = 0; ch < 3; ++ch) {
-        auto v = [&](const char* k) { return j.number(fmt::format("$.display.channels[{}].{}", ch, k)).value(); };
+        auto v = [&](const char* k) {
+            return store::number_at(j, fmt::format("/display/channels/{}/{}", ch, k)).value();
+        };
         p[static_cast<std::size_t>(ch)] = {v("a"), v("b"), v("k"), v("gamma")};
     }
     return stimuli::DisplayModel::gog(p);
@@ -191,12 +192,12 @@ TEST_F(CalibrateVirtual, NoiseFreeMeasureRecoversEveryPatchAndGamma) {
         EXPECT_NEAR(fitted, want[1], 2e-3 * want[1]) << p.name;
     }
     // The grey ramp's effective γ is the law's γ (L − L(0) = (peak − black) V^γ exactly), within 0.5 %.
-    const JsonReader j(cal->fit_json);
+    const nlohmann::json j = store::parse_json(cal->fit_json);
     bool grey = false;
     for (int i = 0; i < 4; ++i) {
-        const auto channel = j.string(fmt::format("$.ramps[{}].channel", i));
+        const auto channel = store::string_at(j, fmt::format("/ramps/{}/channel", i));
         if (!channel) break;
-        const double gamma = j.number(fmt::format("$.ramps[{}].effective_gamma", i)).value();
+        const double gamma = store::number_at(j, fmt::format("/ramps/{}/effective_gamma", i)).value();
         EXPECT_NEAR(gamma, kDisplay.gamma, 5e-3 * kDisplay.gamma) << *channel;
         grey = grey || *channel == "grey";
     }
@@ -249,10 +250,10 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
     }
     const double se_gamma = std::sqrt(sw / (sw * swxx - swx * swx));
     const Store s = Store::open_read_only(db());
-    const JsonReader j(s.latest_calibration("virtual-lcd").value().fit_json);
+    const nlohmann::json j = store::parse_json(s.latest_calibration("virtual-lcd").value().fit_json);
     for (int i = 0; i < 4; ++i)
-        if (j.string(fmt::format("$.ramps[{}].channel", i)) == std::optional<std::string>("grey")) {
-            const double gamma = j.number(fmt::format("$.ramps[{}].effective_gamma", i)).value();
+        if (store::string_at(j, fmt::format("/ramps/{}/channel", i)) == std::optional<std::string>("grey")) {
+            const double gamma = store::number_at(j, fmt::format("/ramps/{}/effective_gamma", i)).value();
             EXPECT_LE(std::abs(gamma - kDisplay.gamma), 4.0 * se_gamma) << gamma << " ± " << se_gamma;
             EXPECT_LT(se_gamma, 0.01);  // 1 % noise leaves γ known to better than 0.01
         }
@@ -335,8 +336,9 @@ TEST_F(CalibrateVirtual, CheckPassesOnTheSameDisplayAndFailsWhenThePeakDrops) {
     const auto checks = s.calibration_checks(cal.id);
     ASSERT_EQ(checks.size(), 2u);
     // Each checked patch keeps the instrument's transcript.
-    const JsonReader j(checks[0].results_json);
-    EXPECT_TRUE(contains(j.string("$.patches[4].transcript").value_or(""), "Result is XYZ")) << checks[0].results_json;
+    const nlohmann::json j = store::parse_json(checks[0].results_json);
+    EXPECT_TRUE(contains(store::string_at(j, "/patches/4/transcript").value_or(""), "Result is XYZ"))
+        << checks[0].results_json;
 }
 
 fs::path protocol_for(const fs::path& dir, const std::string& display) {

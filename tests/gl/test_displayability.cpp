@@ -182,21 +182,22 @@ TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
         const std::vector<store::SessionRecord> sessions = study.sessions();
         ASSERT_EQ(sessions.size(), 1u);
         ASSERT_TRUE(sessions[0].displayability_json.has_value());
-        const store::JsonReader j(*sessions[0].displayability_json);
-        EXPECT_EQ(j.boolean("$.displayable"), false);
-        EXPECT_EQ(j.boolean("$.allowed_undisplayable"), true);
-        EXPECT_EQ(j.string("$.conditions[0].name"), "too-dim");
-        EXPECT_EQ(j.number("$.display.width_px"), 320.0);
-        EXPECT_EQ(j.number("$.display.white_code"), 255.0);
+        const nlohmann::json j = store::parse_json(*sessions[0].displayability_json);
+        EXPECT_EQ(store::boolean_at(j, "/displayable"), false);
+        EXPECT_EQ(store::boolean_at(j, "/allowed_undisplayable"), true);
+        EXPECT_EQ(store::string_at(j, "/conditions/0/name"), "too-dim");
+        EXPECT_EQ(store::number_at(j, "/display/width_px"), 320.0);
+        EXPECT_EQ(store::number_at(j, "/display/white_code"), 255.0);
         // The test light is the first of a 2AFC stimulus; at 1e-7 cd it adds (almost) nothing.
-        EXPECT_EQ(j.string("$.conditions[0].ends[1].lights[0].role"), "test");
-        EXPECT_LE(j.number("$.conditions[0].ends[1].lights[0].rise_codes").value_or(99.0), 1.0);
+        EXPECT_EQ(store::string_at(j, "/conditions/0/ends/1/lights/0/role"), "test");
+        EXPECT_LE(store::number_at(j, "/conditions/0/ends/1/lights/0/rise_codes").value_or(99.0), 1.0);
     }
     const Result analyzed =
         atonlab({"analyze", db.string(), "--out", (dir / "report").string(), "--bootstrap", "20"}, dir.path(), "an");
     EXPECT_TRUE(analyzed.code == 0 || analyzed.code == 5) << analyzed.err;
     EXPECT_TRUE(contains(analyzed.out, "ran with --allow-undisplayable: too-dim")) << analyzed.out;
-    EXPECT_TRUE(contains(file_bytes(dir / "report/summary.json"), "\"allowed_undisplayable\":true"));
+    const nlohmann::json summary = store::parse_json(file_bytes(dir / "report/summary.json"), "summary.json");
+    EXPECT_EQ(store::boolean_at(summary, "/sessions/0/allowed_undisplayable"), true);
 }
 
 TEST(Displayability, CheckCommandExitsTwoOrZeroAndWritesNothing) {

@@ -15,41 +15,32 @@
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/rng.h"
+#include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 
 namespace atonlab::analysis::test_data {
 
-inline std::string json_escape(const std::string& s) {
-    std::string o;
-    for (const char ch : s) {
-        if (ch == '"' || ch == '\\') o += '\\';
-        o += ch;
-    }
-    return o;
-}
-
 /// The runner's stimulus JSON for a scheduled trial (the keys analysis reads).
 inline std::string stimulus_json(const protocols::Condition& c, const protocols::ScheduledTrial& t) {
     namespace p = atonlab::protocols;
-    std::string j = fmt::format(
-        R"({{"task":"{}","presentation":"{}","level_key":"{}","level_scale":"{}","level_on":"{}","level":{},"scene_value":{},"frames":[)",
-        p::to_string(c.task), p::to_string(c.presentation), c.level_key, p::to_string(c.level_scale),
-        p::to_string(c.level_on), t.stimulus.level, t.stimulus.scene_value);
-    for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
-        const p::Frame& fr = t.stimulus.frames[f];
-        j += fmt::format(R"({}{{"role":"{}","time_s":0,"overrides":[)", f ? "," : "",
-                         fr.role ? std::string(p::to_string(*fr.role)) : std::string("both"));
-        for (std::size_t i = 0; i < fr.overrides.size(); ++i)
-            j += fmt::format(R"({}"{}")", i ? "," : "", json_escape(fr.overrides[i]));
-        j += "]}";
-    }
-    j += "],\"views\":[";
-    for (std::size_t i = 0; i < t.stimulus.views.size(); ++i) {
-        const p::StimulusView& v = t.stimulus.views[i];
-        j += fmt::format(R"({}{{"frame":{},"light":"{}","role":"{}"}})", i ? "," : "", v.frame, v.light,
-                         p::to_string(v.role));
-    }
-    return j + "]}";
+    using Json = nlohmann::ordered_json;
+    Json frames = Json::array();
+    for (const p::Frame& fr : t.stimulus.frames)
+        frames.push_back(Json{{"role", fr.role ? std::string(p::to_string(*fr.role)) : std::string("both")},
+                              {"time_s", 0},
+                              {"overrides", fr.overrides}});
+    Json views = Json::array();
+    for (const p::StimulusView& v : t.stimulus.views)
+        views.push_back(Json{{"frame", v.frame}, {"light", v.light}, {"role", p::to_string(v.role)}});
+    return store::dump_json(Json{{"task", p::to_string(c.task)},
+                                 {"presentation", p::to_string(c.presentation)},
+                                 {"level_key", c.level_key},
+                                 {"level_scale", p::to_string(c.level_scale)},
+                                 {"level_on", p::to_string(c.level_on)},
+                                 {"level", t.stimulus.level},
+                                 {"scene_value", t.stimulus.scene_value},
+                                 {"frames", std::move(frames)},
+                                 {"views", std::move(views)}});
 }
 
 /// A simulated observer: P(outcome) = gamma + (1 - gamma) Phi((level - mu) / sigma)

@@ -5,7 +5,10 @@
 // gives a report; a simulated observer's known PSE is recovered.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <set>
@@ -107,19 +110,19 @@ TEST(AnalysisReport, DegenerateConditionsAreFlaggedWithReasonsNeverNaN) {
     const std::string csv = file_bytes(dir / "fits.csv");
     const std::string html = file_bytes(dir / "report.html");
     for (const std::string* text : {&json, &csv, &html}) EXPECT_EQ(non_finite_word(*text), "");
-    // Valid JSON (SQLite's json_valid through the store's reader), nulls with reasons.
-    const store::JsonReader j(json, "summary.json");
-    const std::size_t n = j.array_length("$.conditions");
+    // Valid JSON (the store's parser refuses anything else), nulls with reasons.
+    const nlohmann::json j = store::parse_json(json, "summary.json");
+    const std::size_t n = store::array_at(j, "/conditions").size();
     ASSERT_EQ(n, 6u);
     for (std::size_t i = 0; i < n; ++i) {
-        const std::string at = fmt::format("$.conditions[{}].groups[0].headline", i);
-        const auto reason = j.string(at + ".reason");
+        const std::string at = fmt::format("/conditions/{}/groups/0/headline", i);
+        const auto reason = store::string_at(j, at + "/reason");
         ASSERT_TRUE(reason.has_value());
         EXPECT_FALSE(reason->empty()) << at;
-        EXPECT_EQ(j.boolean(at + ".reliable"), std::optional<bool>(false)) << at;
-        const std::string cond = *j.string(fmt::format("$.conditions[{}].condition", i));
+        EXPECT_EQ(store::boolean_at(j, at + "/reliable"), std::optional<bool>(false)) << at;
+        const std::string cond = *store::string_at(j, fmt::format("/conditions/{}/condition", i));
         if (cond == "no-trials" || cond == "one-trial" || cond == "no-answers") {
-            EXPECT_FALSE(j.number(at + ".value").has_value()) << cond << ": value should be null";
+            EXPECT_FALSE(store::number_at(j, at + "/value").has_value()) << cond << ": value should be null";
         }
         EXPECT_NE(html.find(fmt::format(">{}<", cond)), std::string::npos) << cond;
     }
@@ -226,21 +229,117 @@ TEST(AnalysisReport, RecoversAKnownPseAndWritesAWellFormedSelfContainedReport) {
     const std::string html = file_bytes(out / "report.html");
     expect_well_formed_and_self_contained(html);
     // Every figure summary.json lists exists, is non-empty, and is embedded in the report.
-    const store::JsonReader j(file_bytes(out / "summary.json"), "summary.json");
-    const std::size_t n = j.array_length("$.figures");
+    const nlohmann::json j = store::parse_json(file_bytes(out / "summary.json"), "summary.json");
+    const std::size_t n = store::array_at(j, "/figures").size();
     EXPECT_EQ(n, plots.figures.size());
     for (std::size_t i = 0; i < n; ++i) {
         for (const char* key : {"png", "svg"}) {
-            const auto rel = j.string(fmt::format("$.figures[{}].{}", i, key));
+            const auto rel = store::string_at(j, fmt::format("/figures/{}/{}", i, key));
             ASSERT_TRUE(rel.has_value());
             std::error_code ec;
             EXPECT_GT(fs::file_size(out / *rel, ec), 0u) << *rel;
             EXPECT_FALSE(ec) << *rel;
         }
-        const std::string png = file_bytes(out / *j.string(fmt::format("$.figures[{}].png", i)));
+        const std::string png = file_bytes(out / *store::string_at(j, fmt::format("/figures/{}/png", i)));
         EXPECT_EQ(png.substr(1, 3), "PNG");
         EXPECT_NE(html.find(base64(png).substr(0, 200)), std::string::npos) << "figure " << i << " not embedded";
     }
+}
+
+/// Compares the number at `at` with `want` bit for bit (a finite double must
+/// read back as the same double); absent or non-finite must be null.
+/// Returns whether a finite number was compared.
+bool expect_same_bits(const nlohmann::json& j, const std::string& at, std::optional<double> want) {
+    const nlohmann::json* v = store::json_at(j, at);
+    if (!v) {
+        ADD_FAILURE() << at << " is missing";
+        return false;
+    }
+    if (!want || !std::isfinite(*want)) {
+        EXPECT_TRUE(v->is_null()) << at << " should be null, is " << v->dump();
+        return false;
+    }
+    EXPECT_TRUE(v->is_number()) << at << " is " << v->dump();
+    if (!v->is_number()) return false;
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(v->get<double>()), std::bit_cast<std::uint64_t>(*want))
+        << at << ": " << fmt::format("{} read back as {}", *want, v->get<double>());
+    return true;
+}
+
+TEST(AnalysisReport, SummaryJsonNumbersReadBackBitForBit) {
+    TempDir dir;
+    td::run_simulated(dir / "s.db", td::constant_stimuli_protocol(10), td::sim("A", 1.95, 0.12));
+    td::run_simulated(dir / "s.db", td::staircase_protocol(), td::sim("B", 2.0, 0.1, 5));
+    const Dataset d = read_study(dir / "s.db");
+    AnalysisOptions o;
+    o.bootstrap = 40;
+    const StudyResults r = analyze_study(d, o);
+    const PlotResult plots;
+    ReportContext ctx;
+    ctx.data = &d;
+    ctx.results = &r;
+    ctx.plots = &plots;
+    ctx.software_version = "test";
+    write_summary_json(dir / "summary.json", ctx);
+    const nlohmann::json j = store::parse_json(file_bytes(dir / "summary.json"), "summary.json");
+    int compared = 0;
+    auto same = [&](const std::string& at, std::optional<double> want) { compared += expect_same_bits(j, at, want); };
+    auto same_interval = [&](const std::string& at, const std::optional<Interval>& ci) {
+        if (!ci) return same(at, std::nullopt);
+        same(at + "/0", ci->lower);
+        same(at + "/1", ci->upper);
+    };
+    ASSERT_EQ(store::array_at(j, "/conditions").size(), r.conditions.size());
+    for (std::size_t i = 0; i < r.conditions.size(); ++i) {
+        const ConditionInfo& c = r.conditions[i];
+        const std::string cat = fmt::format("/conditions/{}", i);
+        same(cat + "/guess_rate", c.guess_rate);
+        same(cat + "/target_p", c.target_p);
+        same(cat + "/adaptation_cd_m2", c.adaptation_cd_m2);
+        same(cat + "/test_intensity_cd", c.test_intensity_cd);
+        std::size_t k = 0;
+        for (const GroupResult& g : r.groups) {
+            if (g.condition != c.condition) continue;
+            const std::string at = fmt::format("{}/groups/{}", cat, k++);
+            same(at + "/headline/value", g.headline.value);
+            same_interval(at + "/headline/ci", g.headline.ci);
+            same(at + "/reversal_mean", g.reversal_mean);
+            same(at + "/quest_mean", g.quest_mean);
+            for (std::size_t l = 0; l < g.counts.size(); ++l)
+                same(fmt::format("{}/counts/{}/level", at, l), g.counts[l].level);
+            if (g.fit && g.fit->estimate) {
+                const PsychometricEstimate& e = *g.fit->estimate;
+                same(at + "/psychometric/threshold_proportion", g.threshold_proportion);
+                for (const auto& [key, want] : {std::pair{"alpha", e.params.alpha},
+                                                {"beta", e.params.beta},
+                                                {"gamma", e.params.gamma},
+                                                {"lambda", e.params.lambda},
+                                                {"threshold", e.threshold},
+                                                {"psi_at_threshold", e.psi_at_threshold},
+                                                {"slope", e.slope},
+                                                {"width", e.width},
+                                                {"log_likelihood", e.log_likelihood},
+                                                {"deviance", e.deviance}})
+                    same(at + "/psychometric/" + key, want);
+            }
+            if (g.bootstrap) {
+                const PsychometricBootstrap& b = *g.bootstrap;
+                same_interval(at + "/psychometric/bootstrap/ci/threshold", b.threshold);
+                same_interval(at + "/psychometric/bootstrap/ci/slope", b.slope);
+                same(at + "/psychometric/bootstrap/goodness_of_fit/deviance", b.goodness_of_fit.deviance);
+                same(at + "/psychometric/bootstrap/goodness_of_fit/p_value", b.goodness_of_fit.p_value);
+                same(at + "/psychometric/bootstrap/goodness_of_fit/p_value_chi2", b.goodness_of_fit.p_value_chi2);
+            }
+            for (std::size_t t = 0; t < g.tracks.size(); ++t)
+                if (const auto& rev = g.tracks[t].reversals) {
+                    same(fmt::format("{}/tracks/{}/reversals/mean", at, t), rev->mean);
+                    same(fmt::format("{}/tracks/{}/reversals/sd", at, t), rev->sd);
+                }
+            if (g.match_ratio) same(at + "/match_ratio/log10_ratio", g.match_ratio->value);
+        }
+    }
+    // Fits, bootstrap intervals and staircase means: many numbers with all 17 digits.
+    EXPECT_GT(compared, 50);
 }
 
 TEST(AnalysisReport, WithoutGnuplotTheReportSaysSoAndIsStillWritten) {

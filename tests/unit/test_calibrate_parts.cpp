@@ -221,12 +221,12 @@ TEST(CalibrateCheck, ExactReadingsPassAndEachDriftFailsItsOwnTolerance) {
     store::Calibration cal;
     cal.id = store::CalibrationId{7};
     cal.measured_at = "2024-05-01";
-    const store::JsonReader j(check_results_json(dim, tol, cal));
-    EXPECT_EQ(j.number("$.calibration_id"), 7.0);
-    EXPECT_EQ(j.array_length("$.failed"), 2u);
-    EXPECT_EQ(j.string("$.failed[1]"), "peak_percent");
-    EXPECT_EQ(j.number("$.tolerances.peak_percent"), 5.0);
-    EXPECT_EQ(j.array_length("$.patches"), 5u);
+    const nlohmann::json j = store::parse_json(check_results_json(dim, tol, cal));
+    EXPECT_EQ(store::number_at(j, "/calibration_id"), 7.0);
+    EXPECT_EQ(store::array_at(j, "/failed").size(), 2u);
+    EXPECT_EQ(store::string_at(j, "/failed/1"), "peak_percent");
+    EXPECT_EQ(store::number_at(j, "/tolerances/peak_percent"), 5.0);
+    EXPECT_EQ(store::array_at(j, "/patches").size(), 5u);
 }
 
 // --- fit_json, geometry ------------------------------------------------------------------

@@ -4,14 +4,13 @@
 // every row; a newer file is refused untouched; readings and checks round-trip
 // (read back through raw SQLite, not only the store); bad readings store
 // nothing; calibrations, readings and checks are append-only in the file
-// itself; JsonReader reads what SQLite's JSON functions see.
+// itself. (Reading the JSON columns: test_store_json.cpp.)
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
 #include "../store/store_test_support.h"
-#include "atonlab/store/json.h"
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
 
@@ -294,34 +293,6 @@ TEST(StoreCalibrationChecks, LatestByDateThenByRow) {
                        [&] { s.put_calibration_check(make_check(new_cal, "2024-01-01", true, "{oops")); });
     expect_store_error(StoreErrc::invalid_argument,
                        [&] { s.put_calibration_check(make_check(new_cal, "yesterday", true)); });
-}
-
-// --- JsonReader -------------------------------------------------------------------
-
-TEST(StoreJsonReader, ReadsNumbersStringsBooleansAndArrays) {
-    const JsonReader j(R"({"model":"gog","peak":120.5,"n":7,"ok":true,"no":false,
-                           "channels":[{"gamma":2.2},{"gamma":2.4e0},{"gamma":-0.125}],"s":"12"})");
-    EXPECT_EQ(j.string("$.model"), "gog");
-    EXPECT_EQ(j.number("$.peak"), 120.5);
-    EXPECT_EQ(j.number("$.n"), 7.0);
-    EXPECT_EQ(j.number("$.channels[1].gamma"), 2.4);
-    EXPECT_EQ(j.number("$.channels[2].gamma"), -0.125);
-    EXPECT_EQ(j.array_length("$.channels"), 3u);
-    EXPECT_EQ(j.array_length("$.model"), 0u);
-    EXPECT_EQ(j.array_length("$.missing"), 0u);
-    EXPECT_EQ(j.boolean("$.ok"), true);
-    EXPECT_EQ(j.boolean("$.no"), false);
-    EXPECT_FALSE(j.number("$.s").has_value());  // a string, not a number
-    EXPECT_FALSE(j.number("$.missing").has_value());
-    EXPECT_FALSE(j.string("$.peak").has_value());
-    EXPECT_FALSE(j.boolean("$.n").has_value());
-    // Shortest round-trip decimal text (what fmt writes) reads back as the same double.
-    const double third = 1.0 / 3.0, tiny = 4.9406564584124654e-320, big = 1.7976931348623157e308;
-    const JsonReader k("[0.3333333333333333,4.9406564584124654e-320,1.7976931348623157e+308]");
-    EXPECT_EQ(k.number("$[0]"), third);
-    EXPECT_EQ(k.number("$[1]"), tiny);
-    EXPECT_EQ(k.number("$[2]"), big);
-    expect_store_error(StoreErrc::invalid_argument, [] { JsonReader bad("{\"a\":", "fit_json of calibration 3"); });
 }
 
 }  // namespace

@@ -224,8 +224,9 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file);
 
 /// Writes `data.trials` as the tidy trials.csv: a header of trials_csv_columns()
 /// and one row per trial. Numbers in their shortest round-trip form, so that
-/// read_trials_csv gives back the same values. Throws std::runtime_error when
-/// the file cannot be written.
+/// read_trials_csv gives back the same values. Written whole or not at all
+/// (files::write_file_atomically); throws files::WriteError (a
+/// std::runtime_error) when the file cannot be written.
 void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data);
 
 /// Appends `more` to `into`. A session key already present (the same study

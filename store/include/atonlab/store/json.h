@@ -1,40 +1,46 @@
 #pragma once
-// Reads values out of JSON text (a calibration's fit_json, a check's
-// results_json) with SQLite's own JSON functions: the parser whose
-// json_valid() the schema's CHECKs already trust, so atonlab needs no second
-// JSON library. Paths are SQLite JSON paths: "$.display.channels[1].gamma".
-#include <cstddef>
-#include <memory>
+// The JSON text atonlab keeps (a calibration's fit_json, a check's
+// results_json, a session's displayability_json, a trial's stimulus_json) and
+// writes (the analysis's summary.json), through one library, nlohmann::json.
+// Callers build and walk nlohmann::json themselves; what lives here is what
+// every one of them must do the same way: refuse invalid text with a
+// StoreError naming it, write non-finite numbers as null and read null back as
+// "no number", and never throw on a byte that is not UTF-8.
+#include <nlohmann/json.hpp>
+
 #include <optional>
 #include <string>
 #include <string_view>
 
 namespace atonlab::store {
 
-class JsonReader {
-public:
-    /// Throws StoreError (invalid_argument) when `text` is not valid JSON;
-    /// `what` names the text in that message (e.g. "fit_json of calibration 3").
-    explicit JsonReader(std::string text, std::string what = "the JSON text");
-    JsonReader(JsonReader&&) noexcept;
-    JsonReader& operator=(JsonReader&&) noexcept;
-    ~JsonReader();
+/// Parses `text`. Throws StoreError (invalid_argument) when it is not valid JSON
+/// (RFC 8259); `what` names the text in that message ("fit_json of calibration 3
+/// is not valid JSON (at byte 5: ...)").
+nlohmann::json parse_json(std::string_view text, std::string_view what = "the JSON text");
 
-    /// The number at `path` (an integer or a real), or nullopt when the path is
-    /// absent or holds something else.
-    std::optional<double> number(std::string_view path) const;
-    /// The string at `path`, or nullopt when absent or not a string.
-    std::optional<std::string> string(std::string_view path) const;
-    /// true / false at `path`, or nullopt when absent or not a boolean.
-    std::optional<bool> boolean(std::string_view path) const;
-    /// The number of elements of the array at `path`; 0 when absent or not an array.
-    std::size_t array_length(std::string_view path) const;
+/// The JSON text of `j`: compact with `indent` < 0, else one member per line.
+/// Keys keep the order they were added in (ordered_json); numbers are a
+/// decimal that reads back as the same double (Grisu2: nearly always the
+/// shortest); NaN and ±inf are written as null (JSON has no such numbers); a
+/// byte that is not UTF-8 is written as U+FFFD instead of throwing (an
+/// instrument's transcript may hold one).
+std::string dump_json(const nlohmann::ordered_json& j, int indent = -1);
 
-    const std::string& text() const noexcept;
+// Reading a value that may be absent. `at` is a JSON pointer (RFC 6901):
+// "/display/channels/1/gamma"; "" is the whole document.
 
-private:
-    struct Impl;
-    std::unique_ptr<Impl> impl_;
-};
+/// The value at `at`, or nullptr when there is none.
+const nlohmann::json* json_at(const nlohmann::json& j, std::string_view at);
+/// The number at `at` (an integer or a real), or nullopt when absent, null (a
+/// non-finite number as written) or something else.
+std::optional<double> number_at(const nlohmann::json& j, std::string_view at);
+/// The string at `at`, or nullopt when absent or not a string.
+std::optional<std::string> string_at(const nlohmann::json& j, std::string_view at);
+/// true / false at `at`, or nullopt when absent or not a boolean.
+std::optional<bool> boolean_at(const nlohmann::json& j, std::string_view at);
+/// The array at `at`; an empty array when absent or not an array (so a caller
+/// can loop over it without checking first).
+const nlohmann::json& array_at(const nlohmann::json& j, std::string_view at);
 
 }  // namespace atonlab::store
