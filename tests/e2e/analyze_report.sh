@@ -21,7 +21,7 @@ for bad in 'src="http' "href=\"http" 'src="//' 'href="//' '<script' '<link' '@im
 done
 if ! grep -q '^<!DOCTYPE html>' "$html" || ! grep -q '</html>' "$html"; then echo "report.html is not a whole HTML page"; fail=1; fi
 n=0
-for rel in $(grep -o '"\(png\|svg\)":"[^"]*"' "$outdir/report/summary.json" | sed 's/.*:"\(.*\)"/\1/'); do
+for rel in $(grep -o '"\(png\|svg\)": *"[^"]*"' "$outdir/report/summary.json" | sed 's/.*: *"\(.*\)"/\1/'); do
   n=$((n + 1))
   if [ ! -s "$outdir/report/$rel" ]; then echo "figure $rel is listed but missing or empty"; fail=1; fi
 done
@@ -31,7 +31,7 @@ if [ "$(grep -c 'data:image/png;base64,' "$html")" -lt 2 ]; then echo "report.ht
 for who in P01 P02 '(pooled)'; do
   if ! grep -q "^night,$who,headline," "$outdir/report/fits.csv"; then echo "no headline row for $who"; fail=1; fi
 done
-if ! grep -q '"factor":"adaptation luminance"' "$outdir/report/summary.json"; then
+if ! grep -q '"factor": *"adaptation luminance"' "$outdir/report/summary.json"; then
   echo "no paired comparison of night and dusk"; fail=1
 fi
 echo "$n figure files; $(wc -l <"$outdir/report/fits.csv") lines in fits.csv"
