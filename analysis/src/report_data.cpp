@@ -178,6 +178,40 @@ Json setting_json(const std::string& toml_value) {
     return v.text;
 }
 
+/// One display calibration the sessions used, with its checks over time.
+Json calibration_json(const CalibrationInfo& c) {
+    Json checks = Json::array();
+    for (const DriftPoint& p : c.drift)
+        checks.push_back(Json{{"check_id", p.check_id},
+                              {"checked_at", p.checked_at},
+                              {"passed", p.passed},
+                              {"peak_cd_m2", p.peak_cd_m2},
+                              {"peak_predicted_cd_m2", p.peak_predicted_cd_m2},
+                              {"black_cd_m2", p.black_cd_m2},
+                              {"black_predicted_cd_m2", p.black_predicted_cd_m2},
+                              {"gamma_measured", p.gamma_measured},
+                              {"gamma_predicted", p.gamma_predicted},
+                              {"worst_error_percent", p.worst_error_percent},
+                              {"worst_patch", p.worst_patch},
+                              {"tol_peak_percent", p.tol_peak_percent},
+                              {"tol_black_cd_m2", p.tol_black_cd_m2},
+                              {"tol_gamma", p.tol_gamma},
+                              {"tol_luminance_percent", p.tol_luminance_percent}});
+    return Json{{"source", c.source},
+                {"id", c.id},
+                {"display", c.display_name},
+                {"width_px", c.width_px},
+                {"height_px", c.height_px},
+                {"width_m", c.width_m},
+                {"height_m", c.height_m},
+                {"viewing_distance_m", c.viewing_distance_m},
+                {"how", c.how},
+                {"measured_at", c.measured_at},
+                {"readings", static_cast<int>(c.readings.size())},
+                {"fit_json", c.fit_json},
+                {"checks", std::move(checks)}};
+}
+
 }  // namespace
 
 const std::vector<std::string>& fits_csv_columns() {
@@ -324,38 +358,7 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
                                          {"trials_with_drops", s.trials_with_drops},
                                          {"missed_deadlines", s.missed_deadlines}});
     j["calibrations"] = Json::array();
-    for (const CalibrationInfo& c : d.calibrations) {
-        Json checks = Json::array();
-        for (const DriftPoint& p : c.drift)
-            checks.push_back(Json{{"check_id", p.check_id},
-                                  {"checked_at", p.checked_at},
-                                  {"passed", p.passed},
-                                  {"peak_cd_m2", p.peak_cd_m2},
-                                  {"peak_predicted_cd_m2", p.peak_predicted_cd_m2},
-                                  {"black_cd_m2", p.black_cd_m2},
-                                  {"black_predicted_cd_m2", p.black_predicted_cd_m2},
-                                  {"gamma_measured", p.gamma_measured},
-                                  {"gamma_predicted", p.gamma_predicted},
-                                  {"worst_error_percent", p.worst_error_percent},
-                                  {"worst_patch", p.worst_patch},
-                                  {"tol_peak_percent", p.tol_peak_percent},
-                                  {"tol_black_cd_m2", p.tol_black_cd_m2},
-                                  {"tol_gamma", p.tol_gamma},
-                                  {"tol_luminance_percent", p.tol_luminance_percent}});
-        j["calibrations"].push_back(Json{{"source", c.source},
-                                         {"id", c.id},
-                                         {"display", c.display_name},
-                                         {"width_px", c.width_px},
-                                         {"height_px", c.height_px},
-                                         {"width_m", c.width_m},
-                                         {"height_m", c.height_m},
-                                         {"viewing_distance_m", c.viewing_distance_m},
-                                         {"how", c.how},
-                                         {"measured_at", c.measured_at},
-                                         {"readings", static_cast<int>(c.readings.size())},
-                                         {"fit_json", c.fit_json},
-                                         {"checks", std::move(checks)}});
-    }
+    for (const CalibrationInfo& c : d.calibrations) j["calibrations"].push_back(calibration_json(c));
     j["figures"] = Json::array();
     if (ctx.plots)
         for (const Figure& f : ctx.plots->figures)
