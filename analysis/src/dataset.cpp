@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "atonlab/analysis/study_analysis.h"
+#include "atonlab/common/atomic_file.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/protocols/procedure.h"
 #include "csv.h"
@@ -407,8 +408,7 @@ std::string setting_field(const std::string& toml_value) {
 }  // namespace
 
 void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data) {
-    std::ofstream out(csv_file, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot be written", csv_file.string()));
+    std::ostringstream out;  // written whole or not at all, as every output file (atomic_file.h)
     const auto& cols = trials_csv_columns();
     for (std::size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << cols[i];
     // Then every setting any trial has (Trial::settings), typed, in name order.
@@ -462,8 +462,7 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
         }
         out << '\n';
     }
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("{}: writing failed (disk full?)", csv_file.string()));
+    files::write_file_atomically(csv_file, out.str());
 }
 
 // ---------------------------------------------------------------------------
