@@ -407,7 +407,7 @@ std::string setting_field(const std::string& toml_value) {
 }  // namespace
 
 void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data) {
-    std::ostringstream out;
+    std::ostringstream out;  // written whole or not at all, as every output file (atomic_file.h)
     const auto& cols = trials_csv_columns();
     for (std::size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << cols[i];
     // Then every setting any trial has (Trial::settings), typed, in name order.

@@ -7,10 +7,10 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "atonlab/common/input_text.h"
 
 extern char** environ;
 
@@ -65,10 +65,7 @@ GnuplotRun run_gnuplot(const std::string& program, const std::filesystem::path& 
     // 127: the shell convention for "command not found", which some spawn
     // implementations report through the child instead of the return value.
     if (out.exit_status == 127) out.not_found = true;
-    std::ifstream err(err_file);
-    std::ostringstream ss;
-    ss << err.rdbuf();
-    out.errors = ss.str();
+    out.errors = text::read_text_file(err_file).text;
     return out;
 }
 

@@ -197,6 +197,128 @@ std::vector<LevelCounts> tabulate(std::span<const double> levels, std::span<cons
     return pool_levels(rows);
 }
 
+namespace {
+
+/// The search region on the internal axis: a = alpha (log10 alpha for the
+/// Weibull), b = ln beta.
+struct SearchBounds {
+    double a_lo, a_hi, b_lo, b_hi;
+};
+
+/// A point of the starting grid and the objective there.
+struct Candidate {
+    double value;
+    double a, b;
+    int i, j;  // grid indices
+};
+
+/// Where the local searches start: the best point of a grid over a (7 points
+/// over the tested range plus a quarter on each side) and b (5 widths from
+/// range/20 to 2 range, log-spaced), within the bounds, and the best one that
+/// is not its neighbour on the grid (a second basin, e.g. a steep fit with a
+/// large lapse against a shallow one without).
+std::vector<Candidate> grid_starts(detail::FitProblem& problem, const std::vector<double>& start, const SearchBounds& s,
+                                   double u_min, double u_max, double z_width) {
+    const double range = u_max - u_min;
+    std::vector<Candidate> grid;
+    {
+        double ga_lo = std::max(s.a_lo, u_min - 0.25 * range);
+        double ga_hi = std::min(s.a_hi, u_max + 0.25 * range);
+        if (!(ga_lo < ga_hi)) {
+            ga_lo = s.a_lo;
+            ga_hi = s.a_hi;
+        }
+        double gb_lo = std::clamp(std::log(z_width / (2.0 * range)), s.b_lo, s.b_hi);
+        double gb_hi = std::clamp(std::log(z_width / (range / 20.0)), s.b_lo, s.b_hi);
+        if (!(gb_lo < gb_hi)) {
+            gb_lo = s.b_lo;
+            gb_hi = s.b_hi;
+        }
+        constexpr int na = 7;
+        constexpr int nb = 5;
+        std::vector<double> x = start;
+        grid.reserve(na * nb);
+        for (int i = 0; i < na; ++i) {
+            x[0] = ga_lo + (ga_hi - ga_lo) * i / (na - 1);
+            for (int j = 0; j < nb; ++j) {
+                x[1] = gb_lo + (gb_hi - gb_lo) * j / (nb - 1);
+                grid.push_back({problem.evaluate(x, {}), x[0], x[1], i, j});
+            }
+        }
+    }
+    std::sort(grid.begin(), grid.end(), [](const Candidate& p, const Candidate& q) { return p.value < q.value; });
+    std::vector<Candidate> starts{grid.front()};
+    for (const Candidate& c : grid) {
+        if (std::abs(c.i - grid.front().i) > 1 || std::abs(c.j - grid.front().j) > 1) {
+            starts.push_back(c);
+            break;
+        }
+    }
+    return starts;
+}
+
+/// SLSQP within [lower, upper] from each start (a, b; the rates as in
+/// `start`); the problem keeps the best point it evaluated. True when a
+/// search reported convergence.
+bool minimise(detail::FitProblem& problem, const std::vector<double>& lower, const std::vector<double>& upper,
+              const std::vector<double>& start, const std::vector<Candidate>& starts) {
+    nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, static_cast<unsigned>(lower.size()));
+    nlopt_set_lower_bounds(opt, lower.data());
+    nlopt_set_upper_bounds(opt, upper.data());
+    nlopt_set_min_objective(opt, nlopt_objective, &problem);
+    // The objective is deviance / (2 N): 1e-13 per trial is far below any
+    // difference that matters, and far above rounding.
+    nlopt_set_ftol_abs(opt, 1e-13);
+    nlopt_set_xtol_rel(opt, 1e-8);
+    nlopt_set_maxeval(opt, 500);
+    bool converged = false;
+    for (const Candidate& c : starts) {
+        std::vector<double> x = start;
+        x[0] = c.a;
+        x[1] = c.b;
+        double value = 0.0;
+        const nlopt_result rc = nlopt_optimize(opt, x.data(), &value);
+        if (rc > 0) converged = true;
+    }
+    nlopt_destroy(opt);
+    return converged;
+}
+
+/// Sets fit.at_bound, fit.reliable and fit.reason from the minimum `x` (on
+/// the internal axis) and the fitted beta.
+void judge_reliability(PsychometricFit& fit, const std::vector<double>& x, const SearchBounds& s, double range,
+                       double min_spacing, double z_width, double beta) {
+    const double a_tol = 1e-6 * std::max(1.0, range);
+    const bool a_bound = x[0] <= s.a_lo + a_tol || x[0] >= s.a_hi - a_tol;
+    const bool b_bound = x[1] <= s.b_lo + 1e-6 || x[1] >= s.b_hi - 1e-6;
+    fit.at_bound = a_bound || b_bound;
+    std::vector<std::string> reasons;
+    if (a_bound)
+        reasons.push_back(
+            fmt::format("alpha ended on its search bound ({}): the threshold is outside the levels tested",
+                        x[0] <= s.a_lo + a_tol ? "lower" : "upper"));
+    if (b_bound)
+        reasons.push_back(x[1] >= s.b_hi - 1e-6
+                              ? "beta ended on its upper bound: the data do not constrain the slope (responses "
+                                "perfectly separated between two levels?)"
+                              : "beta ended on its lower bound: the responses hardly change with the level");
+    const double internal_width = z_width / beta;
+    if (!b_bound && internal_width < min_spacing)
+        reasons.push_back(
+            fmt::format("the fitted rise (width {:.3g}{}) is narrower than the closest spacing of the levels ({:.3g}): "
+                        "the slope is "
+                        "not constrained by the data (responses separating perfectly between neighbouring levels?)",
+                        internal_width, fit.options.family == Family::Weibull ? " log10 units" : "", min_spacing));
+    if (fit.n_levels < fit.n_free)
+        reasons.push_back(
+            fmt::format("{} distinct levels for {} free parameters: underdetermined", fit.n_levels, fit.n_free));
+    if (!fit.converged) reasons.push_back("the minimiser did not report convergence");
+    fit.reliable = reasons.empty();
+    for (std::size_t i = 0; i < reasons.size(); ++i) fit.reason += (i ? "; " : "") + reasons[i];
+}
+
+}  // namespace
+
 PsychometricFit fit_psychometric(std::span<const LevelCounts> data, const FitOptions& options) {
     validate(options);
     PsychometricFit fit;
@@ -305,69 +427,9 @@ PsychometricFit fit_psychometric(std::span<const LevelCounts> data, const FitOpt
                 1.0 - highest->k / highest->n, options.lapse.lower, 0.5 * (options.lapse.lower + options.lapse.upper));
     }
 
-    // Grid over a (7 points over the tested range plus a quarter on each side)
-    // and b (5 widths from range/20 to 2 range, log-spaced), within the bounds.
-    struct Candidate {
-        double value;
-        double a, b;
-        int i, j;  // grid indices
-    };
-    std::vector<Candidate> grid;
-    {
-        double ga_lo = std::max(a_lo, u_min - 0.25 * range);
-        double ga_hi = std::min(a_hi, u_max + 0.25 * range);
-        if (!(ga_lo < ga_hi)) {
-            ga_lo = a_lo;
-            ga_hi = a_hi;
-        }
-        double gb_lo = std::clamp(std::log(z_width / (2.0 * range)), b_lo, b_hi);
-        double gb_hi = std::clamp(std::log(z_width / (range / 20.0)), b_lo, b_hi);
-        if (!(gb_lo < gb_hi)) {
-            gb_lo = b_lo;
-            gb_hi = b_hi;
-        }
-        constexpr int na = 7;
-        constexpr int nb = 5;
-        std::vector<double> x = start;
-        grid.reserve(na * nb);
-        for (int i = 0; i < na; ++i) {
-            x[0] = ga_lo + (ga_hi - ga_lo) * i / (na - 1);
-            for (int j = 0; j < nb; ++j) {
-                x[1] = gb_lo + (gb_hi - gb_lo) * j / (nb - 1);
-                grid.push_back({problem.evaluate(x, {}), x[0], x[1], i, j});
-            }
-        }
-    }
-    // Local searches from the best grid point and from the best one that is not
-    // its neighbour on the grid (a second basin, e.g. a steep fit with a large
-    // lapse against a shallow one without).
-    std::sort(grid.begin(), grid.end(), [](const Candidate& p, const Candidate& q) { return p.value < q.value; });
-    std::vector<Candidate> starts{grid.front()};
-    for (const Candidate& c : grid) {
-        if (std::abs(c.i - grid.front().i) > 1 || std::abs(c.j - grid.front().j) > 1) {
-            starts.push_back(c);
-            break;
-        }
-    }
-
-    nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, static_cast<unsigned>(dim));
-    nlopt_set_lower_bounds(opt, lower.data());
-    nlopt_set_upper_bounds(opt, upper.data());
-    nlopt_set_min_objective(opt, nlopt_objective, &problem);
-    // The objective is deviance / (2 N): 1e-13 per trial is far below any
-    // difference that matters, and far above rounding.
-    nlopt_set_ftol_abs(opt, 1e-13);
-    nlopt_set_xtol_rel(opt, 1e-8);
-    nlopt_set_maxeval(opt, 500);
-    for (const Candidate& c : starts) {
-        std::vector<double> x = start;
-        x[0] = c.a;
-        x[1] = c.b;
-        double value = 0.0;
-        const nlopt_result rc = nlopt_optimize(opt, x.data(), &value);
-        if (rc > 0) fit.converged = true;
-    }
-    nlopt_destroy(opt);
+    const SearchBounds bounds{a_lo, a_hi, b_lo, b_hi};
+    const std::vector<Candidate> starts = grid_starts(problem, start, bounds, u_min, u_max, z_width);
+    fit.converged = minimise(problem, lower, upper, start, starts);
     fit.n_evaluations = problem.evaluations;
 
     if (problem.best_x.size() != dim) return fail("the likelihood could not be evaluated");
@@ -394,34 +456,7 @@ PsychometricFit fit_psychometric(std::span<const LevelCounts> data, const FitOpt
         if (!std::isfinite(v)) return fail("the fit produced a non-finite value");
     fit.estimate = e;
 
-    // Reliability.
-    const double a_tol = 1e-6 * std::max(1.0, range);
-    const bool a_bound = x[0] <= a_lo + a_tol || x[0] >= a_hi - a_tol;
-    const bool b_bound = x[1] <= b_lo + 1e-6 || x[1] >= b_hi - 1e-6;
-    fit.at_bound = a_bound || b_bound;
-    std::vector<std::string> reasons;
-    if (a_bound)
-        reasons.push_back(
-            fmt::format("alpha ended on its search bound ({}): the threshold is outside the levels tested",
-                        x[0] <= a_lo + a_tol ? "lower" : "upper"));
-    if (b_bound)
-        reasons.push_back(x[1] >= b_hi - 1e-6
-                              ? "beta ended on its upper bound: the data do not constrain the slope (responses "
-                                "perfectly separated between two levels?)"
-                              : "beta ended on its lower bound: the responses hardly change with the level");
-    const double internal_width = z_width / p.beta;
-    if (!b_bound && internal_width < min_spacing)
-        reasons.push_back(
-            fmt::format("the fitted rise (width {:.3g}{}) is narrower than the closest spacing of the levels ({:.3g}): "
-                        "the slope is "
-                        "not constrained by the data (responses separating perfectly between neighbouring levels?)",
-                        internal_width, f == Family::Weibull ? " log10 units" : "", min_spacing));
-    if (fit.n_levels < fit.n_free)
-        reasons.push_back(
-            fmt::format("{} distinct levels for {} free parameters: underdetermined", fit.n_levels, fit.n_free));
-    if (!fit.converged) reasons.push_back("the minimiser did not report convergence");
-    fit.reliable = reasons.empty();
-    for (std::size_t i = 0; i < reasons.size(); ++i) fit.reason += (i ? "; " : "") + reasons[i];
+    judge_reliability(fit, x, bounds, range, min_spacing, z_width, p.beta);
     return fit;
 }
 

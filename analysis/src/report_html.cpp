@@ -6,14 +6,13 @@
 #include <fmt/ranges.h>
 
 #include <charconv>
-#include <fstream>
 #include <cmath>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "atonlab/analysis/report.h"
 #include "atonlab/common/atomic_file.h"
+#include "atonlab/common/input_text.h"
 #include "csv.h"
 
 namespace atonlab::analysis {
@@ -125,15 +124,8 @@ std::string drift_html(const Dataset& d) {
     return h;
 }
 
-std::string read_file(const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 std::string figure_html(const std::filesystem::path& out_dir, const Figure& f) {
-    const std::string png = read_file(out_dir / f.png);
+    const std::string png = text::read_text_file(out_dir / f.png).text;  // empty when it was not drawn
     if (png.empty()) return {};
     std::string h = "<figure>\n";
     h += fmt::format("<img alt=\"{}\" src=\"data:image/png;base64,{}\">\n", esc(f.title), base64(png));

@@ -160,6 +160,39 @@ ResampleOptions resample_options(const AnalysisOptions& o, const std::string& la
     return r;
 }
 
+/// The method of adjustment's headline: the mean of the confirmed matches
+/// (and of log10(match / test) when the level is the reference's log10
+/// intensity), with bootstrap intervals over matches.
+void analyse_matches(GroupResult& g, const ConditionInfo& info, const std::vector<const Trial*>& trials,
+                     const AnalysisOptions& o, const std::string& label) {
+    HeadlineEstimate& h = g.headline;
+    const bool log_levels = info.level_scale == "log10";
+    std::vector<double> matched;
+    for (const Trial* t : trials)
+        if (t->is_match()) matched.push_back(t->level);
+    g.n_scored = static_cast<int>(matched.size());
+    g.matches = summarize_log_ratios(matched, resample_options(o, label));
+    const AdjustmentSummary& m = *g.matches;
+    h.value = m.mean_log10_ratio;
+    h.ci = m.mean_ci;
+    h.method = "mean of the matched levels (bootstrap over matches)";
+    h.reliable = m.reliable;
+    h.reason = matched.empty() ? "no match was confirmed" : m.reason;
+    if (log_levels && info.level_on == "reference" && info.test_intensity_cd) {
+        const double test = std::log10(*info.test_intensity_cd);
+        std::vector<double> ratios;
+        for (const double v : matched) ratios.push_back(v - test);
+        const AdjustmentSummary r = summarize_log_ratios(ratios, resample_options(o, label));
+        MatchRatio mr;
+        mr.value = r.mean_log10_ratio;
+        mr.ci = r.mean_ci;
+        mr.method = "mean of log10(match / test) over matches";
+        mr.reliable = r.reliable;
+        mr.reason = r.reason;
+        g.match_ratio = mr;
+    }
+}
+
 GroupResult analyse_group(const ConditionInfo& info, const std::string& observer,
                           const std::vector<const Trial*>& trials, const AnalysisOptions& o,
                           std::vector<std::string>& warnings) {
@@ -179,30 +212,7 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
     const bool log_levels = info.level_scale == "log10";
 
     if (info.task == Task::Adjust) {
-        std::vector<double> matched;
-        for (const Trial* t : trials)
-            if (t->is_match()) matched.push_back(t->level);
-        g.n_scored = static_cast<int>(matched.size());
-        g.matches = summarize_log_ratios(matched, resample_options(o, label));
-        const AdjustmentSummary& m = *g.matches;
-        h.value = m.mean_log10_ratio;
-        h.ci = m.mean_ci;
-        h.method = "mean of the matched levels (bootstrap over matches)";
-        h.reliable = m.reliable;
-        h.reason = matched.empty() ? "no match was confirmed" : m.reason;
-        if (log_levels && info.level_on == "reference" && info.test_intensity_cd) {
-            const double test = std::log10(*info.test_intensity_cd);
-            std::vector<double> ratios;
-            for (const double v : matched) ratios.push_back(v - test);
-            const AdjustmentSummary r = summarize_log_ratios(ratios, resample_options(o, label));
-            MatchRatio mr;
-            mr.value = r.mean_log10_ratio;
-            mr.ci = r.mean_ci;
-            mr.method = "mean of log10(match / test) over matches";
-            mr.reliable = r.reliable;
-            mr.reason = r.reason;
-            g.match_ratio = mr;
-        }
+        analyse_matches(g, info, trials, o, label);
         return g;
     }
 

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "atonlab/common/input_text.h"
+#include "atonlab/common/read_file.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -84,10 +85,7 @@ int run_check(const CheckOptions& o) {
         throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
     }
     for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
-    const text::FileText scene = text::read_text_file(protocol.scene, text::kMaxInputFileBytes);
-    if (!scene.ok())
-        throw InputError(SourceLocation{protocol.scene.string(), 0, 0, ""},
-                         fmt::format("cannot read the scene template: {}.", scene.error));
+    const std::string scene_text = files::read_text(protocol.scene, "scene template");
 
     std::optional<stimuli::DisplayModel> model;
     if (!o.db.empty()) {
@@ -103,7 +101,7 @@ int run_check(const CheckOptions& o) {
     }
     auto context = gl::create_headless_context();
     const p::ModelObserverParams params{};
-    StimulusRenderer renderer(scene.text, protocol.scene, params.window_radius_deg, protocol.timing.stimulus_s);
+    StimulusRenderer renderer(scene_text, protocol.scene, params.window_radius_deg, protocol.timing.stimulus_s);
     if (model) renderer.use_display_model(*model);
     const Displayability d = check_displayability(renderer, protocol);
     std::printf("%s", displayability_table(d).c_str());

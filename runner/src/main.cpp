@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "atonlab/common/read_file.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "calibrate_command.h"
@@ -62,6 +63,9 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("tonemap")) return atonlab::runner::run_tonemap(tonemap);
         if (app.got_subcommand("glare")) return atonlab::runner::run_glare(glare);
     } catch (const atonlab::InputError& e) {
+        std::fprintf(stderr, "atonlab: %s\n", e.what());
+        return 2;
+    } catch (const atonlab::files::ReadError& e) {  // an input file that cannot be read is bad input too
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;
     } catch (const atonlab::gl::ContextUnavailable& e) {

@@ -4,9 +4,9 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
+#include "atonlab/common/read_file.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::runner {
@@ -87,8 +87,7 @@ std::variant<PhotometerReading, std::pair<std::string, int>> values_of(const std
 std::vector<PhotometerReading> read_readings_file(const std::filesystem::path& path,
                                                   const std::vector<Patch>& patches) {
     const std::string file = path.string();
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(SourceLocation{file, 0, 0, ""}, "the readings file cannot be opened.");
+    std::istringstream in(files::read_text(path, "readings file"));
     std::vector<PhotometerReading> out;
     std::string line;
     int line_no = 0;

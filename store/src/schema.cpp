@@ -6,6 +6,8 @@
 
 #include <array>
 
+#include "display_tables.h"
+
 namespace atonlab::store {
 namespace {
 
@@ -15,14 +17,10 @@ namespace {
 //  * durations and stimulus-clock times are REAL seconds (…_s);
 //  * …_json columns are JSON text, checked with SQLite's json_valid();
 //  * booleans are INTEGER 0/1; ids are INTEGER PRIMARY KEY row ids.
-constexpr std::string_view schema_v1 = R"sql(
--- Which atonlab built or migrated this file, step by step.
-CREATE TABLE schema_history (
-    version          INTEGER PRIMARY KEY,        -- the user_version this step reached
-    description      TEXT NOT NULL,
-    software_version TEXT NOT NULL,              -- atonlab version that applied the step
-    applied_at       TEXT NOT NULL
-);
+//
+// Version 1: the tables shared with the display-profile file
+// (display_tables.h) among the study's own, in the order they shipped.
+constexpr char protocols_v1[] = R"sql(
 
 -- Protocol files, byte for byte, stored once per distinct text.
 CREATE TABLE protocols (
@@ -31,30 +29,9 @@ CREATE TABLE protocols (
     name     TEXT NOT NULL,                      -- the name it was first stored under (usually the file name)
     text     TEXT NOT NULL,
     added_at TEXT NOT NULL
-);
+);)sql";
 
--- Displays, by the name the lab gives them.
-CREATE TABLE displays (
-    id   INTEGER PRIMARY KEY,
-    name TEXT NOT NULL UNIQUE CHECK (length(name) > 0)
-);
-
--- A display's geometry and fitted model at one date. Never updated: a new
--- calibration is a new row, so every session keeps the one it ran with.
-CREATE TABLE calibrations (
-    id                 INTEGER PRIMARY KEY,
-    display_id         INTEGER NOT NULL REFERENCES displays(id),
-    width_px           INTEGER NOT NULL CHECK (width_px > 0),
-    height_px          INTEGER NOT NULL CHECK (height_px > 0),
-    width_m            REAL NOT NULL CHECK (width_m > 0),
-    height_m           REAL NOT NULL CHECK (height_m > 0),
-    viewing_distance_m REAL NOT NULL CHECK (viewing_distance_m > 0),
-    fit_json           TEXT NOT NULL CHECK (json_valid(fit_json)),  -- the display model's parameters
-    source             TEXT NOT NULL,            -- "measured", "imported FILE", ...
-    measured_at        TEXT NOT NULL,            -- ISO 8601 date (or date-time) of the measurement
-    recorded_at        TEXT NOT NULL
-);
-CREATE INDEX calibrations_by_display ON calibrations (display_id, measured_at);
+constexpr char rest_v1[] = R"sql(
 
 -- Observers by code only: the file never holds a person's name.
 CREATE TABLE observers (
@@ -138,67 +115,16 @@ JOIN observers o ON o.id = s.observer_id
 JOIN protocols p ON p.id = s.protocol_id;
 )sql";
 
+constexpr auto schema_v1 = sql::join(sql::schema_history, protocols_v1, sql::displays, sql::calibrations, rest_v1);
+
 // Version 2: the photometer readings behind a calibration and the checks of a
 // calibration against fresh readings (docs/calibration.md). Calibrations
 // become append-only in the file itself, as they always were by convention.
-constexpr std::string_view schema_v2 = R"sql(
--- The photometer readings a calibration was fitted to, in the order they were
--- measured (or listed in the imported file): the evidence behind its fit_json.
-CREATE TABLE calibration_readings (
-    id              INTEGER PRIMARY KEY,
-    calibration_id  INTEGER NOT NULL REFERENCES calibrations(id),
-    seq             INTEGER NOT NULL CHECK (seq >= 0),          -- 0, 1, 2, ... in measuring order
-    patch           TEXT NOT NULL CHECK (length(patch) > 0),   -- "black", "grey-128", "red-064", ...
-    channel         TEXT NOT NULL CHECK (channel IN ('red', 'green', 'blue', 'grey', 'other')),
-    level           REAL NOT NULL CHECK (level BETWEEN 0 AND 1),  -- drive of the lit channel(s)
-    code            INTEGER CHECK (code >= 0),                  -- the integer code value sent; NULL for imports
-    bits            INTEGER CHECK (bits BETWEEN 1 AND 16),      -- bits per channel of code
-    drive_r         REAL NOT NULL CHECK (drive_r BETWEEN 0 AND 1),  -- the patch's drive levels
-    drive_g         REAL NOT NULL CHECK (drive_g BETWEEN 0 AND 1),
-    drive_b         REAL NOT NULL CHECK (drive_b BETWEEN 0 AND 1),
-    luminance_cd_m2 REAL NOT NULL CHECK (luminance_cd_m2 >= 0), -- the reading: Y, cd/m2
-    xyz_x_cd_m2     REAL,                                       -- CIE 1931 X on the same scale as Y; NULL if not read
-    xyz_z_cd_m2     REAL,                                       -- CIE 1931 Z likewise
-    source_line     INTEGER CHECK (source_line > 0),            -- line of the readings file; NULL when typed
-    CHECK ((code IS NULL) = (bits IS NULL)),
-    CHECK ((xyz_x_cd_m2 IS NULL) = (xyz_z_cd_m2 IS NULL)),
-    UNIQUE (calibration_id, seq)
-);
-
--- A calibration re-measured on a few patches and compared with its model:
--- pass or fail, with every tolerance, value and patch in results_json.
-CREATE TABLE calibration_checks (
-    id             INTEGER PRIMARY KEY,
-    calibration_id INTEGER NOT NULL REFERENCES calibrations(id),
-    checked_at     TEXT NOT NULL,                 -- ISO 8601 date (or date-time) of the measurement
-    passed         INTEGER NOT NULL CHECK (passed IN (0, 1)),
-    results_json   TEXT NOT NULL CHECK (json_valid(results_json)),
-    source         TEXT NOT NULL,                 -- "measured", "readings FILE", ...
-    recorded_at    TEXT NOT NULL
-);
-CREATE INDEX calibration_checks_by_calibration ON calibration_checks (calibration_id, checked_at);
-
--- Nothing stored is lost: calibrations, their readings and their checks are
--- never changed or deleted (a new calibration is a new row).
-CREATE TRIGGER calibrations_append_only_update BEFORE UPDATE ON calibrations
-BEGIN SELECT RAISE(ABORT, 'calibrations are append-only: a stored calibration cannot be changed'); END;
-CREATE TRIGGER calibrations_append_only_delete BEFORE DELETE ON calibrations
-BEGIN SELECT RAISE(ABORT, 'calibrations are append-only: a stored calibration cannot be deleted'); END;
-CREATE TRIGGER calibration_readings_append_only_update BEFORE UPDATE ON calibration_readings
-BEGIN SELECT RAISE(ABORT, 'calibration readings are append-only: a stored reading cannot be changed'); END;
-CREATE TRIGGER calibration_readings_append_only_delete BEFORE DELETE ON calibration_readings
-BEGIN SELECT RAISE(ABORT, 'calibration readings are append-only: a stored reading cannot be deleted'); END;
-CREATE TRIGGER calibration_checks_append_only_update BEFORE UPDATE ON calibration_checks
-BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be changed'); END;
-CREATE TRIGGER calibration_checks_append_only_delete BEFORE DELETE ON calibration_checks
-BEGIN SELECT RAISE(ABORT, 'calibration checks are append-only: a stored check cannot be deleted'); END;
-)sql";
+constexpr auto schema_v2 = sql::join(sql::calibration_readings, sql::calibration_checks, sql::calibrations_append_only);
 
 // Version 3: the raw transcript of an instrument's readings of each patch
 // (`calibrate measure --instrument`), kept with the readings as evidence.
-constexpr std::string_view schema_v3 = R"sql(
-ALTER TABLE calibration_readings ADD COLUMN transcript TEXT;  -- what the instrument said; NULL when typed or imported
-)sql";
+constexpr std::string_view schema_v3 = sql::calibration_readings_transcript;
 
 // Version 4: what the display showed of each condition's stimuli, worked out
 // before the first trial (docs/running.md, "Displayability"), and whether the
@@ -230,8 +156,8 @@ WHERE instr(o.value, '=') > 0;
 )sql";
 
 constexpr std::array<Migration, 5> migrations = {
-    Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", schema_v1},
-    Migration{2, "calibration readings and checks; calibrations append-only", schema_v2},
+    Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", sql::text(schema_v1)},
+    Migration{2, "calibration readings and checks; calibrations append-only", sql::text(schema_v2)},
     Migration{3, "instrument transcripts of calibration readings", schema_v3},
     Migration{4, "sessions.displayability_json", schema_v4},
     Migration{5, "view trial_settings: each trial's overrides, typed and unquoted", schema_v5},

@@ -15,7 +15,7 @@ status=$?
 if [ "$status" -eq 3 ]; then cat "$outdir/render.log"; exit 77; fi
 [ "$status" -eq 0 ] || { cat "$outdir/render.log"; echo "render failed with status $status"; exit 1; }
 
-# run_under_xvfb.sh runs one program without arguments: write the command to a script.
+# The command goes in a script, so that COMMON and VIEW_EXTRA keep their shell quoting.
 cat >"$outdir/view.sh" <<SCRIPT
 #!/usr/bin/env bash
 exec "$atonlab" view "$scene" $common $view_extra --frames 3 --screenshot "$outdir/view.png"

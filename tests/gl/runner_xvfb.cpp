@@ -1,6 +1,6 @@
 // The full-screen runner as a person uses it, under Xvfb (CTest GL.runner.*,
-// run by tests/gl/run_runner_under_xvfb.sh on a 640x360 screen whose pixels
-// Xvfb keeps in a file). `atonlab run` opens full screen on the virtual
+// run by tests/gl/run_under_xvfb.sh --framebuffer-file on a 640x360 screen
+// whose pixels Xvfb keeps in a file). `atonlab run` opens full screen on the virtual
 // monitor, paced by --software-vsync 60 (Xvfb has no vertical blank); keys
 // are real X key events sent through the XTEST extension by xdotool, each
 // sent when the runner's --trace says it waits for one (no sleeps).
@@ -492,7 +492,7 @@ Xwd read_xwd(const fs::path& path) {
 
 TEST_F(runner, TheScreenShowsTheCodesTheHeadlessRendererMakes) {
     const char* screen_file = std::getenv("ATONLAB_XVFB_SCREEN_FILE");
-    if (!screen_file) GTEST_SKIP() << "ATONLAB_XVFB_SCREEN_FILE unset (run_runner_under_xvfb.sh sets it)";
+    if (!screen_file) GTEST_SKIP() << "ATONLAB_XVFB_SCREEN_FILE unset (run_under_xvfb.sh --framebuffer-file sets it)";
     const fs::path protocol = kData / "screen_stall.toml";
     const fs::path shots = dir_.path() / "shots";
     // Trial 0 is all this needs: a script with one answer ends both runs after

@@ -2,7 +2,7 @@
 // command calls), to prove the bench works and that what it writes is sane:
 // every bench present, every time and error finite and non-negative, the
 // defaults marked, the Markdown and the machine description written. No
-// timing is asserted (STYLE.md: timing lives in benchmarks).
+// timing is asserted (timing lives in bench/, never in a pass/fail test).
 #include <gtest/gtest.h>
 
 #include <cmath>

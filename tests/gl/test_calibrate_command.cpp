@@ -49,22 +49,8 @@ using store::test_support::TempDir;
 
 const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data";
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-/// Runs `atonlab ARGS...` with stdin from /dev/null.
-Result atonlab(const std::vector<std::string>& args, const fs::path& dir) {
-    const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-    std::vector<std::string> argv{ATONLAB_BINARY};
-    argv.insert(argv.end(), args.begin(), args.end());
-    Result r;
-    r.code = test::run_to_files(std::move(argv), out, err, /*stdin_null=*/true);
-    r.out = file_bytes(out);
-    r.err = file_bytes(err);
-    return r;
-}
+using Result = test::Captured;
+using test::atonlab;
 
 bool contains(const std::string& s, const std::string& what) {
     return s.find(what) != std::string::npos;

@@ -135,20 +135,8 @@ INSTANTIATE_TEST_SUITE_P(Displayability, Examples, ::testing::ValuesIn(examples_
                              return name;
                          });
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-Result atonlab(std::vector<std::string> args, const fs::path& dir, const std::string& tag) {
-    args.insert(args.begin(), ATONLAB_BINARY);
-    const fs::path out = dir / (tag + ".out"), err = dir / (tag + ".err");
-    Result r;
-    r.code = test::wait_for(test::spawn_to_files(std::move(args), out, err, false, false));
-    r.out = file_bytes(out);
-    r.err = file_bytes(err);
-    return r;
-}
+using Result = test::Captured;
+using test::atonlab;
 
 bool contains(const std::string& s, const std::string& part) {
     return s.find(part) != std::string::npos;

@@ -47,20 +47,8 @@ using store::test_support::TempDir;
 const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data";
 const fs::path kTiny = kData / "run/tiny_2afc.toml";
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-Result atonlab(std::vector<std::string> args, const fs::path& dir, const std::string& tag = "r") {
-    args.insert(args.begin(), ATONLAB_BINARY);
-    const fs::path out = dir / (tag + ".out"), err = dir / (tag + ".err");
-    Result r;
-    r.code = test::wait_for(test::spawn_to_files(std::move(args), out, err, false, false));
-    r.out = file_bytes(out);
-    r.err = file_bytes(err);
-    return r;
-}
+using Result = test::Captured;
+using test::atonlab;
 
 Result run_tiny(const fs::path& db, const fs::path& dir, const std::string& tag = "r",
                 const fs::path& protocol = kTiny) {

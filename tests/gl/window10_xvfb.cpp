@@ -1,7 +1,8 @@
 // 10-bit output (docs/display-calibration.md, "10-bit output"): under an Xvfb
-// screen of depth 30 (tests/gl/run_under_xvfb30.sh), a full-screen window gets
-// a 10-bit framebuffer; the GPU display encoder's 10-bit codes for an sRGB and
-// a PQ (1000 cd/m²) grey ramp are drawn into it, and the codes read back from
+// screen of depth 30 (tests/gl/run_under_xvfb.sh --screen 1024x64x30
+// --framebuffer-file), a full-screen window gets a 10-bit framebuffer; the
+// GPU display encoder's 10-bit codes for an sRGB and a PQ (1000 cd/m²) grey
+// ramp are drawn into it, and the codes read back from
 // the back buffer (glReadPixels) and from the X server's screen after the swap
 // (Xvfb's -fbdir file) equal the encoder's, every pixel. Skips, saying why,
 // when there is no display, the screen is not 10-bit or GL offers no 10-bit
@@ -160,7 +161,7 @@ protected:
         gl::finish();
         const char* file = std::getenv("ATONLAB_XVFB_SCREEN_FILE");
         if (!file) {
-            ADD_FAILURE() << "ATONLAB_XVFB_SCREEN_FILE unset: run under tests/gl/run_under_xvfb30.sh";
+            ADD_FAILURE() << "ATONLAB_XVFB_SCREEN_FILE unset: run under tests/gl/run_under_xvfb.sh --framebuffer-file";
             return;
         }
         // The X server copies the swapped frame into its screen asynchronously.

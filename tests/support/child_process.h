@@ -1,12 +1,15 @@
 #pragma once
 // Running a child process from a test (the atonlab binary, xdotool, ...):
-// stdout and stderr to files, an exit status as a shell reports it.
+// stdout and stderr to files, an exit status as a shell reports it; and the
+// whole run captured (run_captured, and atonlab() where the test's build names
+// the binary in ATONLAB_BINARY).
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace atonlab::test {
@@ -55,5 +58,23 @@ inline int run_to_files(std::vector<std::string> argv, const std::filesystem::pa
                         const std::filesystem::path& err, bool stdin_null = false) {
     return wait_for(spawn_to_files(std::move(argv), out, err, stdin_null));
 }
+
+/// What a child printed and how it ended.
+struct Captured {
+    int code = -1;  ///< status_code
+    std::string out, err;
+};
+
+/// Runs argv with stdin from /dev/null, stdout and stderr to DIR/TAG.out and
+/// DIR/TAG.err (left there to look at after a failure), and waits for it.
+Captured run_captured(std::vector<std::string> argv, const std::filesystem::path& dir, const std::string& tag = "r");
+
+#ifdef ATONLAB_BINARY
+/// `atonlab ARGS...`, the binary the test's build names, as run_captured.
+inline Captured atonlab(std::vector<std::string> args, const std::filesystem::path& dir, const std::string& tag = "r") {
+    args.insert(args.begin(), ATONLAB_BINARY);
+    return run_captured(std::move(args), dir, tag);
+}
+#endif
 
 }  // namespace atonlab::test

@@ -1,6 +1,6 @@
 // What the store does when the world fails it, and the proof that nothing
-// already stored is lost (STYLE.md "Tests": SQLite's own disk-full and I/O-error
-// tests are the model): a full disk (PRAGMA max_page_count), a real write error
+// already stored is lost (SQLite's own disk-full and I/O-error tests are the
+// model): a full disk (PRAGMA max_page_count), a real write error
 // from the OS (RLIMIT_FSIZE), a write-protected file, a file from a newer
 // atonlab, a file that is not SQLite, an SQLite file that is not a study, and a
 // missing directory.
