@@ -11,8 +11,10 @@
 #include <map>
 #include <set>
 
+#include "atonlab/common/error.h"
+#include "atonlab/display/display_model.h"
+#include "atonlab/display/fit_json.h"
 #include "atonlab/store/error.h"
-#include "atonlab/store/json.h"
 #include "atonlab/store/sha256.h"
 #include "csv.h"
 #include "gnuplot.h"
@@ -446,12 +448,7 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
                             c.id, c.source));
             continue;
         }
-        std::string model;
-        try {
-            model = store::JsonReader(c.fit_json).string("$.model").value_or("");
-        } catch (const store::StoreError&) {
-        }
-        const bool nominal = model == "nominal";
+        const bool nominal = display::fit_json_model(c.fit_json).value_or("") == "nominal";
         std::string title = fmt::format("Display {} ({}): luminance of grey", c.display_name, c.measured_at);
         std::string body = "reset\nset datafile separator '\\t'\nset grid\nset key top left box opaque\n";
         std::string top = "plot ";
@@ -557,23 +554,6 @@ bool has_display_timing(const Dataset& data, const StudyResults& results) {
     return false;
 }
 
-namespace {
-
-double srgb_decode(double v) {
-    // IEC 61966-2-1 (K2012 eq 3.13), as docs/display-calibration.md's srgb channel.
-    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
-double pq_eotf_cd_m2(double n) {
-    // SMPTE ST 2084:2014 (docs/display-calibration.md "SMPTE ST 2084 (PQ)").
-    const double m1 = 2610.0 / 16384.0, m2 = 2523.0 / 4096.0 * 128.0;
-    const double c1 = 3424.0 / 4096.0, c2 = 2413.0 / 4096.0 * 32.0, c3 = 2392.0 / 4096.0 * 32.0;
-    const double p = std::pow(std::clamp(n, 0.0, 1.0), 1.0 / m2);
-    return 10000.0 * std::pow(std::max(p - c1, 0.0) / (c2 - c3 * p), 1.0 / m1);
-}
-
-}  // namespace
-
 std::string file_slug(const std::string& name) {
     std::string out;
     for (const char ch : name) {
@@ -620,44 +600,14 @@ std::map<std::string, std::string> condition_slugs(const StudyResults& results) 
 }
 
 std::optional<double> model_grey_luminance_cd_m2(const std::string& fit_json, double v) {
+    // The display model the calibration holds (docs/calibration.md "fit_json"), read and
+    // evaluated by the display library: grey drives all three channels, which add.
     try {
-        const store::JsonReader j(fit_json, "fit_json");
-        // A measured calibration keeps its display model under "display"
-        // (docs/calibration.md "fit_json"); the runner's nominal model at the top.
-        const std::string root = j.array_length("$.display.channels") > 0 ? "$.display" : "$";
-        const std::size_t n = j.array_length(root + ".channels");
-        if (n == 0) return std::nullopt;
+        const display::DisplayModel model = display::display_model_from_fit_json(fit_json, "");
         double sum = 0.0;
-        for (std::size_t c = 0; c < n; ++c) {
-            const std::string at = fmt::format("{}.channels[{}]", root, c);
-            const std::string kind = j.string(at + ".transfer").value_or("");
-            if (kind == "srgb" || kind == "pq") {
-                const auto black = j.number(at + ".black_cd_m2");
-                const auto white = j.number(at + ".white_cd_m2");
-                if (!black || !white) return std::nullopt;
-                if (kind == "srgb") {
-                    sum += *black + (*white - *black) * srgb_decode(v);
-                } else {
-                    // docs/display-calibration.md: clamp(w_c EOTF(V), black_c, white_c); w_c is white_c / peak.
-                    const auto peak = j.number(root + ".peak_cd_m2");
-                    if (!peak || *peak <= 0.0) return std::nullopt;
-                    sum += std::clamp(*white / *peak * pq_eotf_cd_m2(v), *black, *white);
-                }
-            } else if (kind == "gog") {
-                // Berns' gain-offset-gamma with black offset: a + (b + k V)^gamma where b + k V > 0, else a.
-                const auto a = j.number(at + ".a");
-                const auto b = j.number(at + ".b");
-                const auto k = j.number(at + ".k");
-                const auto g = j.number(at + ".gamma");
-                if (!a || !b || !k || !g) return std::nullopt;
-                const double base = *b + *k * v;
-                sum += *a + (base > 0.0 ? std::pow(base, *g) : 0.0);
-            } else {
-                return std::nullopt;
-            }
-        }
+        for (int c = 0; c < 3; ++c) sum += model.channel_luminance_cd_m2(c, v);
         return std::isfinite(sum) ? std::optional<double>(sum) : std::nullopt;
-    } catch (const store::StoreError&) {
+    } catch (const InputError&) {
         return std::nullopt;
     }
 }

@@ -18,7 +18,7 @@
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
-#include "calibration_policy.h"
+#include "calibrate/calibration_policy.h"
 #include "commands.h"
 #include "displayability.h"
 #include "run_session.h"
@@ -89,7 +89,7 @@ int run_check(const CheckOptions& o) {
         throw InputError(SourceLocation{protocol.scene.string(), 0, 0, ""},
                          fmt::format("cannot read the scene template: {}.", scene.error));
 
-    std::optional<stimuli::DisplayModel> model;
+    std::optional<display::DisplayModel> model;
     if (!o.db.empty()) {
         try {
             const store::Store study = store::Store::open_read_only(o.db);
