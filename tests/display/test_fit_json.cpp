@@ -28,7 +28,9 @@ void expect_same_model(const DisplayModel& a, const DisplayModel& b) {
             EXPECT_EQ(x.black_cd_m2, y.black_cd_m2);
             EXPECT_EQ(x.white_cd_m2, y.white_cd_m2);
         }
-        if (x.kind == TransferKind::pq) EXPECT_EQ(x.pq_weight, y.pq_weight);
+        if (x.kind == TransferKind::pq) {
+            EXPECT_EQ(x.pq_weight, y.pq_weight);
+        }
         ASSERT_EQ(x.lut.size(), y.lut.size());
         for (std::size_t i = 0; i < x.lut.size(); ++i) {
             EXPECT_EQ(x.lut[i].drive, y.lut[i].drive);
