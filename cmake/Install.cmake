@@ -1,6 +1,6 @@
 # `cmake --install build --prefix P` (docs/architecture.md "Installing the libraries"):
 # the libraries a simulator links (static), their headers, a CMake package
-# (find_package(atonlab) -> atonlab::stimuli, atonlab::protocols, atonlab::store,
+# (find_package(atonlab) -> atonlab::display, atonlab::stimuli, atonlab::protocols, atonlab::store,
 # atonlab::analysis, atonlab::common, atonlab::present, atonlab::bench) and a
 # pkg-config file (atonlab.pc), all relocatable; and the `atonlab` program.
 # Components: "development" (libraries, headers, package files) and "runtime" (the
@@ -8,7 +8,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(atonlab_installed_libraries stimuli protocols store analysis common present bench)
+set(atonlab_installed_libraries display stimuli protocols store analysis common present bench)
 set(atonlab_installed_targets)
 foreach(lib IN LISTS atonlab_installed_libraries)
   set_target_properties(atonlab_${lib} PROPERTIES EXPORT_NAME ${lib})
@@ -24,7 +24,7 @@ install(TARGETS ${atonlab_installed_targets} atonlab_policy atonlab_warnings ato
         EXPORT atonlabTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(dir IN ITEMS stimuli protocols store analysis common bench runner)
+foreach(dir IN ITEMS display stimuli protocols store analysis common bench runner)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           COMPONENT development)
 endforeach()

@@ -18,13 +18,14 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/rhythm.h"
 
 namespace st = atonlab::stimuli;
+namespace d = atonlab::display;
 
 int main(int argc, char** argv) {
     int frames = 30;
@@ -62,7 +63,7 @@ int main(int argc, char** argv) {
         buoy.name = "buoy";
         buoy.position_m = {-20.0, 2.0, -800.0};
         buoy.intensity_cd = 120.0;
-        buoy.rgb_per_cd = *st::iala_colour_rgb("red");
+        buoy.rgb_per_cd = *d::iala_colour_rgb("red");
         const st::Rhythm fl = st::parse_rhythm("Fl R 3s");
         buoy.rhythm = fl.channels.at(0).knots;
         buoy.rhythm_period_s = fl.period_s;

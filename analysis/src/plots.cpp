@@ -11,8 +11,10 @@
 #include <map>
 #include <set>
 
+#include "atonlab/common/error.h"
+#include "atonlab/display/display_model.h"
+#include "atonlab/display/fit_json.h"
 #include "atonlab/store/error.h"
-#include "atonlab/store/json.h"
 #include "atonlab/store/sha256.h"
 #include "csv.h"
 #include "gnuplot.h"
@@ -446,12 +448,7 @@ void calibration_figures(Drawer& d, const Dataset& data, std::vector<std::string
                             c.id, c.source));
             continue;
         }
-        std::string model;
-        try {
-            model = store::string_at(store::parse_json(c.fit_json), "/model").value_or("");
-        } catch (const store::StoreError&) {
-        }
-        const bool nominal = model == "nominal";
+        const bool nominal = display::fit_json_model(c.fit_json).value_or("") == "nominal";
         std::string title = fmt::format("Display {} ({}): luminance of grey", c.display_name, c.measured_at);
         std::string body = "reset\nset datafile separator '\\t'\nset grid\nset key top left box opaque\n";
         std::string top = "plot ";
@@ -557,23 +554,6 @@ bool has_display_timing(const Dataset& data, const StudyResults& results) {
     return false;
 }
 
-namespace {
-
-double srgb_decode(double v) {
-    // IEC 61966-2-1 (K2012 eq 3.13), as docs/display-calibration.md's srgb channel.
-    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
-double pq_eotf_cd_m2(double n) {
-    // SMPTE ST 2084:2014 (docs/display-calibration.md "SMPTE ST 2084 (PQ)").
-    const double m1 = 2610.0 / 16384.0, m2 = 2523.0 / 4096.0 * 128.0;
-    const double c1 = 3424.0 / 4096.0, c2 = 2413.0 / 4096.0 * 32.0, c3 = 2392.0 / 4096.0 * 32.0;
-    const double p = std::pow(std::clamp(n, 0.0, 1.0), 1.0 / m2);
-    return 10000.0 * std::pow(std::max(p - c1, 0.0) / (c2 - c3 * p), 1.0 / m1);
-}
-
-}  // namespace
-
 std::string file_slug(const std::string& name) {
     std::string out;
     for (const char ch : name) {
@@ -620,43 +600,14 @@ std::map<std::string, std::string> condition_slugs(const StudyResults& results) 
 }
 
 std::optional<double> model_grey_luminance_cd_m2(const std::string& fit_json, double v) {
+    // The display model the calibration holds (docs/calibration.md "fit_json"), read and
+    // evaluated by the display library: grey drives all three channels, which add.
     try {
-        const nlohmann::json j = store::parse_json(fit_json, "fit_json");
-        // A measured calibration keeps its display model under "display"
-        // (docs/calibration.md "fit_json"); the runner's nominal model at the top.
-        const nlohmann::json& model = store::array_at(j, "/display/channels").empty() ? j : j.at("display");
-        const nlohmann::json& channels = store::array_at(model, "/channels");
-        if (channels.empty()) return std::nullopt;
+        const display::DisplayModel model = display::display_model_from_fit_json(fit_json, "");
         double sum = 0.0;
-        for (const nlohmann::json& ch : channels) {
-            const std::string kind = store::string_at(ch, "/transfer").value_or("");
-            if (kind == "srgb" || kind == "pq") {
-                const auto black = store::number_at(ch, "/black_cd_m2");
-                const auto white = store::number_at(ch, "/white_cd_m2");
-                if (!black || !white) return std::nullopt;
-                if (kind == "srgb") {
-                    sum += *black + (*white - *black) * srgb_decode(v);
-                } else {
-                    // docs/display-calibration.md: clamp(w_c EOTF(V), black_c, white_c); w_c is white_c / peak.
-                    const auto peak = store::number_at(model, "/peak_cd_m2");
-                    if (!peak || *peak <= 0.0) return std::nullopt;
-                    sum += std::clamp(*white / *peak * pq_eotf_cd_m2(v), *black, *white);
-                }
-            } else if (kind == "gog") {
-                // Berns' gain-offset-gamma with black offset: a + (b + k V)^gamma where b + k V > 0, else a.
-                const auto a = store::number_at(ch, "/a");
-                const auto b = store::number_at(ch, "/b");
-                const auto k = store::number_at(ch, "/k");
-                const auto g = store::number_at(ch, "/gamma");
-                if (!a || !b || !k || !g) return std::nullopt;
-                const double base = *b + *k * v;
-                sum += *a + (base > 0.0 ? std::pow(base, *g) : 0.0);
-            } else {
-                return std::nullopt;
-            }
-        }
+        for (int c = 0; c < 3; ++c) sum += model.channel_luminance_cd_m2(c, v);
         return std::isfinite(sum) ? std::optional<double>(sum) : std::nullopt;
-    } catch (const store::StoreError&) {
+    } catch (const atonlab::InputError&) {  // common/error.h (analysis::InputError is the CSV reader's)
         return std::nullopt;
     }
 }

@@ -15,6 +15,7 @@
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 void bench_cie_veil(Bench& b) {
     const DisplayGeometry d = b.quick() ? DisplayGeometry{480, 270, 0.598 / 4, 0.9} : default_display();

@@ -7,15 +7,16 @@
 #include <numbers>
 #include <random>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/display_threshold.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/rhythm.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 void Bench::add(Row r) {
     if (options.verbose) {

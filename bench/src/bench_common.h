@@ -33,7 +33,7 @@ struct Bench {
 // ---- scenes ------------------------------------------------------------------
 
 /// The display atonlab's scenes default to (1920×1080, 0.598 m at 0.9 m: 50.4 px/°).
-stimuli::DisplayGeometry default_display();
+display::DisplayGeometry default_display();
 
 /// How the lights of the K2012 table 6.2 scene are placed.
 enum class Layout {

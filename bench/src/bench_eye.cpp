@@ -20,6 +20,7 @@
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <iterator>
 #include <memory>
 
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -20,6 +20,7 @@
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

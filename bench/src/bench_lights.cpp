@@ -18,6 +18,7 @@
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 void bench_lights(Bench& b) {
     const std::vector<int> counts =

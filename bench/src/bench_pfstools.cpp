@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/tonemap.h"
@@ -23,6 +23,7 @@
 namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

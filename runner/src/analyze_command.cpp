@@ -28,10 +28,10 @@
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/analysis/study_analysis.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/image_io.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
 #include "commands.h"
@@ -139,8 +139,8 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     fs::remove(exr, ec);
     const stimuli::ImageRGBA32F& hdr = img.image;
     if (hdr.width <= 0 || hdr.height <= 0) return "the image is empty";
-    stimuli::ToneMapSettings tm;
-    if (const auto op = stimuli::tone_operator_from_name(c.tone_operator)) tm.tone_operator = *op;
+    display::ToneMapSettings tm;
+    if (const auto op = display::tone_operator_from_name(c.tone_operator)) tm.tone_operator = *op;
     const double adaptation = c.adaptation_cd_m2.value_or(img.meta.adaptation_cd_m2.value_or(1.0));
     const double crop_deg = 6.0;
     const int half = img.meta.degrees_per_pixel > 0.0
@@ -187,7 +187,7 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         for (int y = 0; y < t.h; ++y)
             for (int x = 0; x < t.w; ++x) {
                 const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
-                glm::dvec3 d = stimuli::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+                glm::dvec3 d = display::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
                 for (int k = 0; k < 3; ++k) {
                     d[k] = std::clamp(d[k], 0.0, 1.0);
                     channel[static_cast<std::size_t>(k)].push_back(d[k]);
@@ -246,12 +246,12 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
             for (int x = 0; x < t.w; ++x) {
                 const glm::dvec3& d = m.v[static_cast<std::size_t>(y) * t.w + x];
                 float* q = &rgb[(static_cast<std::size_t>(y) * width + left + x) * 3];
-                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(stimuli::srgb_encode(d[k]));
+                for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(display::srgb_encode(d[k]));
                 if (!stretched_row) continue;
                 float* r = &rgb[(static_cast<std::size_t>(y + row + gap) * width + left + x) * 3];
                 for (int k = 0; k < 3; ++k) {
                     const double stretched = m.background[k] + m.stretch * (d[k] - m.background[k]);
-                    r[k] = static_cast<float>(stimuli::srgb_encode(std::clamp(stretched, 0.0, 1.0)));
+                    r[k] = static_cast<float>(display::srgb_encode(std::clamp(stretched, 0.0, 1.0)));
                 }
             }
         }
@@ -269,7 +269,7 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
         "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).{}",
         c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
-        stimuli::tone_operator_name(tm.tone_operator), adaptation,
+        display::tone_operator_name(tm.tone_operator), adaptation,
         stretched_row
             ? fmt::format(" Top row: as displayed. Bottom row: the same frames, each channel stretched about its "
                           "background (the tile's median) by {} (left to right), so that a dim light and its glare "

@@ -19,7 +19,7 @@
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
-#include "calibration_policy.h"
+#include "calibrate/calibration_policy.h"
 #include "commands.h"
 #include "displayability.h"
 #include "run_session.h"
@@ -87,7 +87,7 @@ int run_check(const CheckOptions& o) {
     for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
     const std::string scene_text = files::read_text(protocol.scene, "scene template");
 
-    std::optional<stimuli::DisplayModel> model;
+    std::optional<display::DisplayModel> model;
     if (!o.db.empty()) {
         try {
             const store::Store study = store::Store::open_read_only(o.db);

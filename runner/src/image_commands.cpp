@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
@@ -114,9 +114,9 @@ int run_tonemap(const TonemapOptions& o) {
         out = scene.output;
         if (out.adaptation.mode == stimuli::AdaptationMode::fixed) scene_adaptation = out.adaptation.fixed_cd_m2;
     }
-    stimuli::ToneMapSettings& tm = out.tonemap;
+    display::ToneMapSettings& tm = out.tonemap;
     if (o.tone_operator) {
-        const auto op = stimuli::tone_operator_from_name(*o.tone_operator);
+        const auto op = display::tone_operator_from_name(*o.tone_operator);
         if (!op)
             throw InputError(option("--operator"),
                              fmt::format("unknown operator '{}'; one of empirical, perceptual, reinhard, kakimoto, "
@@ -131,20 +131,20 @@ int run_tonemap(const TonemapOptions& o) {
             throw InputError(option("--black-cd-m2"), "the black must be at least 0 and below the peak (cd/m²)");
         const std::string transfer = o.display.value_or(out.display.name == "PQ" ? "pq" : "srgb");
         if (transfer == "srgb")
-            out.display = stimuli::DisplayModel::srgb(peak, black);
+            out.display = display::DisplayModel::srgb(peak, black);
         else if (transfer == "pq")
-            out.display = stimuli::DisplayModel::pq(peak, black);
+            out.display = display::DisplayModel::pq(peak, black);
         else
             throw InputError(option("--display"), fmt::format("must be srgb or pq, not '{}'", transfer));
         tm.display_peak_cd_m2 = peak;
     }
-    out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == stimuli::Dither::spatiotemporal)
-                            ? stimuli::Dither::spatiotemporal
-                            : stimuli::Dither::none;
+    out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == display::Dither::spatiotemporal)
+                            ? display::Dither::spatiotemporal
+                            : display::Dither::none;
     out.encode.bits = 8;  // the PNG holds 8-bit codes
     tm.blueshift = on_off(o.blueshift, "--blueshift", tm.blueshift);
     if (o.hue_preservation) {
-        const auto h = stimuli::hue_preservation_from_name(*o.hue_preservation);
+        const auto h = display::hue_preservation_from_name(*o.hue_preservation);
         if (!h)
             throw InputError(option("--hue-preservation"),
                              fmt::format("must be none, xyY or rgb, not '{}'", *o.hue_preservation));
@@ -186,17 +186,17 @@ int run_tonemap(const TonemapOptions& o) {
         // Reinhard et al. 2002 eq 4's L_white as the scaled luminance (eq 2) of the brightest pixel.
         tm.reinhard_white_relative = max_l > 0 ? tm.reinhard_key * max_l / adaptation : 1.0;
     }
-    stimuli::validate_tonemap_settings(tm);
+    display::validate_tonemap_settings(tm);
 
     std::vector<float> codes(static_cast<std::size_t>(hdr.width) * hdr.height * 3);
     std::size_t clipped = 0;
     for (int y = 0; y < hdr.height; ++y)
         for (int x = 0; x < hdr.width; ++x) {
             const float* p = hdr.pixel(x, y);
-            const glm::dvec3 rel = stimuli::tonemap_pixel({p[0], p[1], p[2]}, adaptation, tm);
+            const glm::dvec3 rel = display::tonemap_pixel({p[0], p[1], p[2]}, adaptation, tm);
             if (rel.r > 1 || rel.g > 1 || rel.b > 1) ++clipped;
             // The dither pattern's rows count from the bottom, as on the GPU (frame 0).
-            const glm::ivec3 c = stimuli::encode_pixel(out.display, rel, {x, hdr.height - 1 - y}, 0, out.encode);
+            const glm::ivec3 c = display::encode_pixel(out.display, rel, {x, hdr.height - 1 - y}, 0, out.encode);
             float* q = &codes[(static_cast<std::size_t>(y) * hdr.width + x) * 3];
             for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(c[k] / 255.0);
         }
@@ -208,15 +208,15 @@ int run_tonemap(const TonemapOptions& o) {
                 o.adaptation_cd_m2 ? "given"
                 : scene_adaptation ? "the scene's fixed level"
                                    : "log-average, K2012 eq 4.15",
-                std::string(stimuli::tone_operator_name(tm.tone_operator)).c_str(),
-                tm.tone_operator == stimuli::ToneOperator::reinhard
+                std::string(display::tone_operator_name(tm.tone_operator)).c_str(),
+                tm.tone_operator == display::ToneOperator::reinhard
                     ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative).c_str()
                     : "",
-                std::string(stimuli::hue_preservation_name(tm.hue_preservation)).c_str(), tm.blueshift ? "on" : "off");
+                std::string(display::hue_preservation_name(tm.hue_preservation)).c_str(), tm.blueshift ? "on" : "off");
     std::printf(
         "  display=%s peak_cd_m2=%g black_cd_m2=%g bits=8 dither=%s; %zu pixels above display white (clipped)\n",
         out.display.name.c_str(), out.display.peak_cd_m2, out.display.black_cd_m2,
-        out.encode.dither == stimuli::Dither::none ? "off" : "on", clipped);
+        out.encode.dither == display::Dither::none ? "off" : "on", clipped);
     return 0;
 }
 

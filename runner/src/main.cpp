@@ -11,7 +11,7 @@
 #include "atonlab/common/read_file.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
-#include "calibrate_command.h"
+#include "calibrate/calibrate_command.h"
 #include "commands.h"
 #include "image_commands.h"
 #include "light_command.h"

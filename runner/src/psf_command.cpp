@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <system_error>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -121,10 +121,10 @@ int run_psf(const PsfOptions& o) {
             SourceLocation{o.scene.empty() ? "--pupil-mm" : o.scene, 0, 0, e.where() ? e.where()->key : std::string()},
             e.message());
     }
-    auto spd = stimuli::named_spectrum(o.spd);
+    auto spd = display::named_spectrum(o.spd);
     if (!spd) {
         std::string names;
-        for (const auto& n : stimuli::spectrum_names()) names += (names.empty() ? "" : ", ") + n;
+        for (const auto& n : display::spectrum_names()) names += (names.empty() ? "" : ", ") + n;
         throw InputError(SourceLocation{"--spd", 0, 0, ""},
                          fmt::format("unknown spectrum \"{}\"; named spectra are {}.", o.spd, names));
     }

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <system_error>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -94,12 +94,12 @@ int run_render(const RenderOptions& o) {
     meta.strings["tonemap"] = fmt::format(
         "operator={} adaptation={} adapted_cd_m2={:.6g} blueshift={} hue_preservation={} display={} peak_cd_m2={} "
         "black_cd_m2={} bits={}{}",
-        stimuli::tone_operator_name(scene.output.tonemap.tone_operator),
+        display::tone_operator_name(scene.output.tonemap.tone_operator),
         scene.output.adaptation.mode == stimuli::AdaptationMode::dynamic ? "dynamic" : "fixed", adapted,
         scene.output.tonemap.blueshift
-            ? std::string(stimuli::blueshift_luminance_name(scene.output.tonemap.blueshift_luminance))
+            ? std::string(display::blueshift_luminance_name(scene.output.tonemap.blueshift_luminance))
             : std::string("off"),
-        stimuli::hue_preservation_name(scene.output.tonemap.hue_preservation), scene.output.display.name,
+        display::hue_preservation_name(scene.output.tonemap.hue_preservation), scene.output.display.name,
         scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2, scene.output.encode.bits,
         scene.output.ldr_glare ? " ldr_glare" : "");
     std::string glare_note;

@@ -36,18 +36,20 @@
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/rhythm.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/fit_json.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
-#include "calibration_policy.h"
+#include "calibrate/calibration_policy.h"
 #include "displayability.h"
-#include "profile_location.h"
+#include "calibrate/profile_location.h"
 #include "session_display.h"
 
 namespace atonlab::runner {
 
 namespace p = atonlab::protocols;
 namespace s = atonlab::stimuli;
+namespace d = atonlab::display;
 namespace st = atonlab::store;
 
 namespace {
@@ -273,10 +275,10 @@ void StimulusRenderer::encode_scene(const s::Scene& sc, double time_s) {
     display_.reset_adaptation();
     if (const gl::Texture2D* glare = frame_.glare_texture();
         glare && os.ldr_glare && (sc.glare.model != s::GlareModel::none || s::any_light_glare(sc))) {
-        const s::ToneMapSettings& tm = os.tonemap;
+        const d::ToneMapSettings& tm = os.tonemap;
         const double white = tm.white_cd_m2
                                  ? *tm.white_cd_m2
-                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / s::display_adaptation_cd_m2(tm);
+                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / d::display_adaptation_cd_m2(tm);
         display_.process_ldr(frame_.hdr_texture(), *glare, os, 0, 1.0 / white);
     } else {
         display_.process(frame_.hdr_texture(), os, 0.0, 0);
@@ -360,7 +362,7 @@ namespace {
 /// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
 /// (row 0 at the top) for the codes given: the display model's luminance,
 /// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
-std::vector<float> emitted_window(const s::EncodedImage& codes, const s::DisplayModel& display, int x0, int y0, int n) {
+std::vector<float> emitted_window(const s::EncodedImage& codes, const d::DisplayModel& display, int x0, int y0, int n) {
     std::map<std::uint64_t, float> emitted;
     std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
     for (int v = 0; v < n; ++v) {
@@ -376,7 +378,7 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const s::Display
             const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
                                     (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
             auto [it, fresh] = emitted.try_emplace(k, 0.0f);
-            if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(display, code, codes.bits));
+            if (fresh) it->second = static_cast<float>(d::displayed_luminance_cd_m2(display, code, codes.bits));
             out[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)] = it->second;
         }
     }
@@ -838,17 +840,7 @@ std::optional<std::uint64_t> logged_observer_seed(const std::vector<st::TrialRec
 /// nominal display model (the geometry is the protocol's). Reused when the
 /// latest row of that display says the same.
 st::CalibrationId record_display(st::Store& store, const s::Scene& scene, const std::filesystem::path& scene_file) {
-    const s::DisplayModel& d = scene.output.display;
-    std::string channels;
-    for (const s::ChannelTransfer& ch : d.channels) {
-        const char* kind = ch.kind == s::TransferKind::srgb  ? "srgb"
-                           : ch.kind == s::TransferKind::gog ? "gog"
-                           : ch.kind == s::TransferKind::lut ? "lut"
-                                                             : "pq";
-        channels +=
-            fmt::format("{}{{\"transfer\":\"{}\",\"black_cd_m2\":{},\"white_cd_m2\":{}}}", channels.empty() ? "" : ",",
-                        kind, json_number(ch.min_cd_m2()), json_number(ch.max_cd_m2()));
-    }
+    const d::DisplayModel& d = scene.output.display;
     st::Calibration c;
     c.display_name = d.name.empty() ? "display" : d.name;
     c.width_px = scene.display.width_px;
@@ -856,10 +848,7 @@ st::CalibrationId record_display(st::Store& store, const s::Scene& scene, const 
     c.width_m = scene.display.width_m;
     c.height_m = scene.display.height_m();
     c.viewing_distance_m = scene.display.viewing_distance_m;
-    c.fit_json = fmt::format(
-        "{{\"model\":\"nominal\",\"peak_cd_m2\":{},\"black_cd_m2\":{},\"bits\":{},\"dither\":{},\"channels\":[{}]}}",
-        json_number(d.peak_cd_m2), json_number(d.black_cd_m2), scene.output.encode.bits,
-        scene.output.encode.dither == s::Dither::spatiotemporal ? "true" : "false", channels);
+    c.fit_json = d::nominal_fit_json(d, scene.output.encode);
     c.source = fmt::format("the [display] table of the scene {} (not measured)", scene_file.string());
     if (const auto last = store.latest_calibration(c.display_name)) {
         if (last->width_px == c.width_px && last->height_px == c.height_px && last->width_m == c.width_m &&

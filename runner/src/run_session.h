@@ -101,7 +101,7 @@ public:
 
     /// Encode every frame for this display model instead of the scene's (the
     /// display's measured calibration: calibration_policy.h). Set before the first frame.
-    void use_display_model(stimuli::DisplayModel model) { display_model_ = std::move(model); }
+    void use_display_model(display::DisplayModel model) { display_model_ = std::move(model); }
 
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
@@ -122,7 +122,7 @@ private:
 
     std::string scene_text_;
     std::filesystem::path scene_file_;
-    std::optional<stimuli::DisplayModel> display_model_;  ///< use_display_model()
+    std::optional<display::DisplayModel> display_model_;  ///< use_display_model()
     double window_radius_deg_;
     double interval_s_;
     std::size_t capacity_;

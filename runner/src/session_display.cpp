@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "atonlab/runner/screen_presenter.h"
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/image_io.h"
 #include "run_session.h"
@@ -18,6 +18,7 @@ namespace atonlab::runner {
 
 namespace p = atonlab::protocols;
 namespace s = atonlab::stimuli;
+namespace d = atonlab::display;
 
 namespace {
 
@@ -51,17 +52,17 @@ SessionDisplay::SessionDisplay(Presenter& presenter, StimulusRenderer& renderer,
       protocol_(protocol),
       options_(options),
       clock_offset_s_(clock_origin_s - presenter.now_s()) {
-    const s::DisplayModel& display = display_scene.output.display;
+    const d::DisplayModel& display = display_scene.output.display;
     bits_ = display_scene.output.encode.bits;
     // Text is drawn after display encoding, at the code that makes the display
     // model emit the luminance asked for (a neutral grey; no dither).
     const int max_code = (1 << bits_) - 1;
-    const double white = s::displayed_luminance_cd_m2(display, glm::ivec3(max_code), bits_);
+    const double white = d::displayed_luminance_cd_m2(display, glm::ivec3(max_code), bits_);
     auto ink_for = [&](double L_cd_m2, double& shown) {
         const double rel = std::clamp(L_cd_m2 / white, 0.0, 1.0);
         const glm::ivec3 c =
-            s::encode_pixel(display, glm::dvec3(rel), glm::ivec2(0), 0, s::EncodeSettings{bits_, s::Dither::none, 0});
-        shown = s::displayed_luminance_cd_m2(display, c, bits_);
+            d::encode_pixel(display, glm::dvec3(rel), glm::ivec2(0), 0, d::EncodeSettings{bits_, d::Dither::none, 0});
+        shown = d::displayed_luminance_cd_m2(display, c, bits_);
         return Code3{static_cast<std::uint16_t>(c.r), static_cast<std::uint16_t>(c.g), static_cast<std::uint16_t>(c.b)};
     };
     text_ink_ = ink_for(protocol.screens.text_cd_m2, text_luminance_cd_m2_);

@@ -26,8 +26,8 @@
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
-#include "calibration_policy.h"
-#include "calibration_record.h"
+#include "calibrate/calibration_policy.h"
+#include "calibrate/calibration_record.h"
 #include "view_controls.h"
 
 namespace atonlab::runner {

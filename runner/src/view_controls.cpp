@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "atonlab/stimuli/glare_stage.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 
 namespace atonlab::runner {
 namespace {
@@ -117,11 +117,11 @@ std::string ViewControls::press(ViewKey key, double adapted_cd_m2) {
             return fmt::format("glare {}", stimuli::glare_model_name(s.glare.model));
         }
         case ViewKey::tonemap_cycle: {
-            const std::vector<std::string> names = stimuli::tone_operator_names();
-            const std::string current(stimuli::tone_operator_name(s.output.tonemap.tone_operator));
+            const std::vector<std::string> names = display::tone_operator_names();
+            const std::string current(display::tone_operator_name(s.output.tonemap.tone_operator));
             auto it = std::find(names.begin(), names.end(), current);
             const std::string& next = it == names.end() || it + 1 == names.end() ? names.front() : *(it + 1);
-            s.output.tonemap.tone_operator = *stimuli::tone_operator_from_name(next);
+            s.output.tonemap.tone_operator = *display::tone_operator_from_name(next);
             return "tone mapper " + next;
         }
         case ViewKey::blueshift:
@@ -202,7 +202,7 @@ std::string ViewControls::status() const {
     const bool dynamic = s.output.adaptation.mode == stimuli::AdaptationMode::dynamic;
     return fmt::format(
         "glare {}, tone {}, adaptation {}, t {:.2f} s{}, camera [{:.1f}, {:.1f}, {:.1f}] m yaw {:.1f}° pitch {:.1f}°",
-        stimuli::glare_model_name(s.glare.model), stimuli::tone_operator_name(s.output.tonemap.tone_operator),
+        stimuli::glare_model_name(s.glare.model), display::tone_operator_name(s.output.tonemap.tone_operator),
         dynamic ? std::string("dynamic") : fmt::format("{:.4g} cd/m²", s.output.adaptation.fixed_cd_m2), time_s_,
         playing_ ? "" : " (paused)", s.camera.position_m.x, s.camera.position_m.y, s.camera.position_m.z,
         s.camera.yaw_deg, s.camera.pitch_deg);

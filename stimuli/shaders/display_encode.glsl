@@ -1,4 +1,4 @@
-// Display encoding: the GPU twin of encode_pixel() in stimuli/src/display_model.cpp
+// Display encoding: the GPU twin of encode_pixel() in display/src/display_model.cpp
 // (docs/display-calibration.md). Functions only; include it and pass a DisplayParams.
 //
 // - DisplayParams has the layout of GpuDisplayParams (display_model.h) under both

@@ -1,4 +1,4 @@
-// Tone mapping (K2012 §4.4): the GLSL twin of stimuli/src/tonemap.cpp. Functions only: no
+// Tone mapping (K2012 §4.4): the GLSL twin of display/src/tonemap.cpp. Functions only: no
 // main, no bindings. Include it, declare a block holding a ToneMapParams (filled on the CPU
 // by tonemap_gpu_params(), tonemap.h, whose ToneMapGpuParams has this exact layout) and call
 //   vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p)

@@ -11,7 +11,7 @@
 namespace atonlab::stimuli {
 
 void validate_output_settings(const OutputSettings& s) {
-    validate_tonemap_settings(s.tonemap);
+    display::validate_tonemap_settings(s.tonemap);
     s.display.validate(SourceLocation{"", 0, 0, "display"});
     if (s.encode.bits < 1 || s.encode.bits > 16)
         throw InputError(SourceLocation{"", 0, 0, "tonemap.bits"},
@@ -42,8 +42,8 @@ struct DisplayPipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     gl::Buffer partials{kPartialGroups * sizeof(double), nullptr, gl::BufferUsage::dynamic_draw};
     gl::Buffer state{4 * sizeof(double), nullptr, gl::BufferUsage::dynamic_read};
-    gl::Buffer tone_block{sizeof(ToneMapGpuParams), nullptr, gl::BufferUsage::dynamic_draw};
-    gl::Buffer display_block{sizeof(GpuDisplayParams), nullptr, gl::BufferUsage::dynamic_draw};
+    gl::Buffer tone_block{sizeof(display::ToneMapGpuParams), nullptr, gl::BufferUsage::dynamic_draw};
+    gl::Buffer display_block{sizeof(display::GpuDisplayParams), nullptr, gl::BufferUsage::dynamic_draw};
     gl::Buffer lut, codes;
     int width = 0, height = 0, bits = 8;
 
@@ -53,11 +53,11 @@ struct DisplayPipeline::Impl {
         state.upload(0, sizeof(zero), zero);
     }
     void upload_settings(const OutputSettings& s) {
-        const ToneMapGpuParams tp = tonemap_gpu_params(s.tonemap);
+        const display::ToneMapGpuParams tp = display::tonemap_gpu_params(s.tonemap);
         tone_block.upload(0, sizeof(tp), &tp);
-        const GpuDisplayParams dp = gpu_display_params(s.display, s.encode);
+        const display::GpuDisplayParams dp = display::gpu_display_params(s.display, s.encode);
         display_block.upload(0, sizeof(dp), &dp);
-        std::vector<double> knots = gpu_display_lut(s.display);
+        std::vector<double> knots = display::gpu_display_lut(s.display);
         if (knots.empty()) knots.push_back(0.0);
         if (!lut || lut.size() < knots.size() * sizeof(double))
             lut = gl::Buffer(knots.size() * sizeof(double), knots.data(), gl::BufferUsage::dynamic_draw);
@@ -129,9 +129,9 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
     m.final_pass.set("fixed_mode", dynamic ? 0 : 1);
     m.final_pass.set("fixed_cd_m2", s.adaptation.fixed_cd_m2);
     m.final_pass.set("dt_s", dt_s);
-    m.final_pass.set("tau_rod_s", static_cast<float>(kTauRodS));
-    m.final_pass.set("tau_cone_s", static_cast<float>(kTauConeS));
-    m.final_pass.set("rod_sigma_cd_m2", static_cast<float>(kRodSigmaCdM2));
+    m.final_pass.set("tau_rod_s", static_cast<float>(display::kTauRodS));
+    m.final_pass.set("tau_cone_s", static_cast<float>(display::kTauConeS));
+    m.final_pass.set("rod_sigma_cd_m2", static_cast<float>(display::kRodSigmaCdM2));
     m.final_pass.use();
     glDispatchCompute(1, 1, 1);
     hdr.bind(0);

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 
 namespace atonlab::stimuli {
 
-glm::dvec3 continuous_codes(const DisplayModel& display, glm::dvec3 relative_rgb, int bits) {
+glm::dvec3 continuous_codes(const display::DisplayModel& display, glm::dvec3 relative_rgb, int bits) {
     const double max_code = static_cast<double>((1 << std::clamp(bits, 1, 16)) - 1);
     glm::dvec3 out(0.0);
     for (int c = 0; c < 3; ++c) {
@@ -23,7 +23,7 @@ glm::dvec3 continuous_codes(const DisplayModel& display, glm::dvec3 relative_rgb
 double invisible_luminance_cd_m2(const OutputSettings& out, double adaptation_cd_m2, double floor_cd_m2,
                                  glm::dvec3 rgb_per_cd, double codes) {
     constexpr double kSmallest = 1e-12, kLargest = 1e12;
-    const double y = luminance_of_linear_rgb(rgb_per_cd);
+    const double y = display::luminance_of_linear_rgb(rgb_per_cd);
     if (!(y > 0) || !(codes > 0)) return 0.0;
     const glm::dvec3 colour = rgb_per_cd / y;
     const int bits = out.encode.bits;
@@ -37,14 +37,14 @@ double invisible_luminance_cd_m2(const OutputSettings& out, double adaptation_cd
     std::vector<glm::dvec3> base(backgrounds.size());
     for (std::size_t i = 0; i < backgrounds.size(); ++i)
         base[i] = continuous_codes(
-            out.display, tonemap_pixel(glm::dvec3(backgrounds[i]), adaptation_cd_m2, out.tonemap), bits);
+            out.display, display::tonemap_pixel(glm::dvec3(backgrounds[i]), adaptation_cd_m2, out.tonemap), bits);
 
     // Checks the worst background first: where the last failure happened.
     std::size_t worst = 0;
     auto moves_too_far = [&](double dy) {
         auto check = [&](std::size_t i) {
             const glm::dvec3 c = continuous_codes(
-                out.display, tonemap_pixel(glm::dvec3(backgrounds[i]) + dy * colour, adaptation_cd_m2, out.tonemap),
+                out.display, display::tonemap_pixel(glm::dvec3(backgrounds[i]) + dy * colour, adaptation_cd_m2, out.tonemap),
                 bits);
             const glm::dvec3 d = glm::abs(c - base[i]);
             return std::max({d.r, d.g, d.b}) > codes;

@@ -158,9 +158,9 @@ std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const
 
     std::string key;
     auto bytes = [&key](const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); };
-    const ToneMapGpuParams tp = tonemap_gpu_params(out.tonemap);
-    const GpuDisplayParams dp = gpu_display_params(out.display, out.encode);
-    const std::vector<double> lut = gpu_display_lut(out.display);
+    const display::ToneMapGpuParams tp = display::tonemap_gpu_params(out.tonemap);
+    const display::GpuDisplayParams dp = display::gpu_display_params(out.display, out.encode);
+    const std::vector<double> lut = display::gpu_display_lut(out.display);
     const double state[3] = {out.adaptation.fixed_cd_m2, floor_cd_m2, k.threshold_codes};
     bytes(&tp, sizeof(tp));
     bytes(&dp, sizeof(dp));

@@ -186,7 +186,7 @@ GlareKernel glare_kernel_from_radial(const RadialDensity& density, const Spectra
             glm::dvec3 xyz{0.0};
             const double area_sr = deg2_to_sr / (ppd * ppd) / (s * s);
             for (std::size_t l = 0; l < ns; ++l) xyz += samples.xyz_weight[l] * per_lambda[l] * area_sr;
-            const glm::dvec3 rgb = glm::max(xyz_to_linear_rgb(xyz), glm::dvec3(0.0));
+            const glm::dvec3 rgb = glm::max(display::xyz_to_linear_rgb(xyz), glm::dvec3(0.0));
             const int offsets[8][2] = {{i, j}, {j, i}, {-i, j}, {-j, i}, {i, -j}, {j, -i}, {-i, -j}, {-j, -i}};
             for (const auto& o : offsets) energy[static_cast<std::size_t>(o[1] + h) * m + (o[0] + h)] = rgb;
         }
@@ -205,7 +205,7 @@ GlareKernel glare_kernel_from_radial(const RadialDensity& density, const Spectra
         }
         total_xyz += samples.xyz_weight[l] * integral;
     }
-    window_and_normalise(k, energy, glm::max(xyz_to_linear_rgb(total_xyz), glm::dvec3(0.0)), window);
+    window_and_normalise(k, energy, glm::max(display::xyz_to_linear_rgb(total_xyz), glm::dvec3(0.0)), window);
     return k;
 }
 

@@ -153,9 +153,9 @@ double glare_psf_degrees_per_texel(const GlareSettings& glare) {
 
 namespace {
 
-Spectrum spd_for(const std::string& name) {
-    if (name.empty()) return d65_spectrum();
-    if (auto s = named_spectrum(name)) return *s;
+display::Spectrum spd_for(const std::string& name) {
+    if (name.empty()) return display::d65_spectrum();
+    if (auto s = display::named_spectrum(name)) return *s;
     throw InputError(SourceLocation{"", 0, 0, "spd"}, fmt::format("unknown spectrum \"{}\".", name));
 }
 
@@ -174,13 +174,13 @@ ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) {
                     const float* p = img.image.pixel(x, y);
-                    lum.push_back(luminance_of_linear_rgb({p[0], p[1], p[2]}));
+                    lum.push_back(display::luminance_of_linear_rgb({p[0], p[1], p[2]}));
                 }
         } else {
             const std::vector<float> rgb = read_png_rgb(path, w, h);
             for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
                 lum.push_back(
-                    luminance_of_linear_rgb({srgb_decode(rgb[i]), srgb_decode(rgb[i + 1]), srgb_decode(rgb[i + 2])}));
+                    display::luminance_of_linear_rgb({display::srgb_decode(rgb[i]), display::srgb_decode(rgb[i + 1]), display::srgb_decode(rgb[i + 2])}));
         }
     } catch (const InputError& e) {
         throw InputError(SourceLocation{"", 0, 0, "aperture_image"},

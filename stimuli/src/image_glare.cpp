@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "atonlab/stimuli/cie_glare.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -45,7 +45,7 @@ GlareKernel image_glare_kernel(const GlareSettings& glare, double adaptation_cd_
         throw InputError(SourceLocation{"", 0, 0, "degrees_per_pixel"},
                          fmt::format("the degrees per pixel must be a positive number, not {}.", degrees_per_pixel));
     const double ppd = 1.0 / degrees_per_pixel;
-    const SpectralSamples samples = spectral_samples(d65_spectrum(), glare.spectral_samples);
+    const SpectralSamples samples = spectral_samples(display::d65_spectrum(), glare.spectral_samples);
     Scene scene;  // the pupil (eq 3.15) and Spencer's vision class follow the adaptation
     scene.adaptation_cd_m2 = adaptation_cd_m2;
     scene.glare = glare;

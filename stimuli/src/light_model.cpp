@@ -6,7 +6,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "atonlab/stimuli/atmosphere.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 
 namespace atonlab::stimuli {
 
@@ -42,12 +42,9 @@ LightAtEye evaluate_light(const Light& light, const ProfileTables& profiles, glm
     return s;
 }
 
-double illuminance_lux(const LightAtEye& s) { return luminance_of_linear_rgb(s.illuminance_rgb_lux); }
+double illuminance_lux(const LightAtEye& s) { return display::luminance_of_linear_rgb(s.illuminance_rgb_lux); }
 
 glm::dquat Camera::orientation() const { return orientation_from_yaw_pitch_roll(yaw_deg, pitch_deg, roll_deg); }
 
-double DisplayGeometry::fov_x_rad() const { return 2.0 * std::atan(0.5 * width_m / viewing_distance_m); }
-double DisplayGeometry::fov_y_rad() const { return 2.0 * std::atan(0.5 * height_m() / viewing_distance_m); }
-double DisplayGeometry::pixels_per_degree_at_centre() const { return focal_px() * std::numbers::pi / 180.0; }
 
 }  // namespace atonlab::stimuli

@@ -20,7 +20,7 @@ void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
         // The scene as an LDR renderer shows it: exposure to the linear
         // operator's white (the adaptation luminance at the display's own
         // adaptation level), clipped; the glare is tone-mapped and added.
-        const double white = linear_white_cd_m2(out.adaptation.fixed_cd_m2, out.tonemap);
+        const double white = display::linear_white_cd_m2(out.adaptation.fixed_cd_m2, out.tonemap);
         display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index_, 1.0 / (white * frame_.pre_exposure()));
     } else {
         display_.process(frame_.hdr_texture(), out, dt_s, frame_index_, frame_.pre_exposure());

@@ -10,7 +10,7 @@
 
 namespace atonlab::stimuli {
 
-SpectralSamples spectral_samples(const Spectrum& spd, int count) {
+SpectralSamples spectral_samples(const display::Spectrum& spd, int count) {
     if (count < 1)
         throw InputError(SourceLocation{"", 0, 0, "spectral_samples"},
                          fmt::format("the number of spectral samples must be at least 1, not {}.", count));
@@ -19,7 +19,7 @@ SpectralSamples spectral_samples(const Spectrum& spd, int count) {
     double y_total = 0;
     for (int i = 0; i < count; ++i) {
         const double lambda = SpectralSamples::kFirstNm + (i + 0.5) * width;
-        const glm::dvec3 w = cie1931_cmf(lambda) * spd.at(lambda) * width;
+        const glm::dvec3 w = display::cie1931_cmf(lambda) * spd.at(lambda) * width;
         s.wavelength_nm.push_back(lambda);
         s.xyz_weight.push_back(w);
         y_total += w.y;
@@ -38,7 +38,7 @@ glm::dvec3 RgbPsf::channel_sums() const {
 }
 
 double RgbPsf::luminance_sum() const {
-    return luminance_of_linear_rgb(channel_sums());
+    return display::luminance_of_linear_rgb(channel_sums());
 }
 
 MonoPsf mono_psf_from_spectrum(const ComplexImage<double>& F, double degrees_per_texel, double wavelength_nm) {
@@ -194,7 +194,7 @@ RgbPsf finish_rgb(int n, double degrees_per_texel, const std::vector<glm::dvec3>
     out.n = n;
     out.degrees_per_texel = degrees_per_texel;
     out.rgb.resize(xyz.size());
-    for (std::size_t i = 0; i < xyz.size(); ++i) out.rgb[i] = glm::max(xyz_to_linear_rgb(xyz[i]), glm::dvec3(0.0));
+    for (std::size_t i = 0; i < xyz.size(); ++i) out.rgb[i] = glm::max(display::xyz_to_linear_rgb(xyz[i]), glm::dvec3(0.0));
     const double y = out.luminance_sum();
     if (y > 0)
         for (auto& v : out.rgb) v /= y;

@@ -102,7 +102,7 @@ void GpuPsfGenerator::Impl::spectral_stage(const SpectralSamples& samples) {
         spectral.set(fmt::format("weight[{}]", s), static_cast<float>(w.x), static_cast<float>(w.y),
                      static_cast<float>(w.z));
     }
-    const glm::mat3 xyz_to_rgb(rec709_xyz_to_rgb());
+    const glm::mat3 xyz_to_rgb(display::rec709_xyz_to_rgb());
     spectral.set_mat3("xyz_to_rgb", &xyz_to_rgb[0][0]);
     spectral.use();
     glDispatchCompute(groups_for(texels), 1, 1);

@@ -31,8 +31,8 @@
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
-#include "atonlab/stimuli/calibration.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/calibration.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/glare_kernel.h"
@@ -42,6 +42,7 @@
 #include "atonlab/stimuli/rhythm.h"
 
 namespace atonlab::stimuli {
+using namespace display;  // colour, the display model, calibration files, tone mapping (display/)
 namespace {
 
 constexpr std::string_view kSetFile = "--set";

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 
 namespace atonlab::stimuli {
 
@@ -76,11 +76,11 @@ glm::dvec2 uv_prime(glm::dvec3 xyz) {
     return {4.0 * xyz.x / d, 9.0 * xyz.y / d};
 }
 
-glm::dvec3 displayed_xyz(const DisplayModel& display, glm::ivec3 code, int bits) {
-    const glm::dvec3 y = displayed_luminance_rgb(display, code, bits);
-    const glm::dvec3 weights = glm::dvec3(luminance_of_linear_rgb({1, 0, 0}), luminance_of_linear_rgb({0, 1, 0}),
-                                          luminance_of_linear_rgb({0, 0, 1}));
-    return linear_rgb_to_xyz(y / weights);
+glm::dvec3 displayed_xyz(const display::DisplayModel& display, glm::ivec3 code, int bits) {
+    const glm::dvec3 y = display::displayed_luminance_rgb(display, code, bits);
+    const glm::dvec3 weights = glm::dvec3(display::luminance_of_linear_rgb({1, 0, 0}), display::luminance_of_linear_rgb({0, 1, 0}),
+                                          display::luminance_of_linear_rgb({0, 0, 1}));
+    return display::linear_rgb_to_xyz(y / weights);
 }
 
 SignalColourCheck check_signal_colour(std::string_view colour, glm::dvec3 displayed, glm::dvec3 photopic) {

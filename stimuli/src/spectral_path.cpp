@@ -10,7 +10,7 @@
 #include <complex>
 #include <numbers>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::stimuli {
@@ -370,7 +370,7 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
             }
         }
         for (std::size_t i = 0; i < texels; ++i)
-            out.rgb.push_back(glm::max(xyz_to_linear_rgb({bx[i], by[i], bz[i]}), glm::dvec3(0.0)));
+            out.rgb.push_back(glm::max(display::xyz_to_linear_rgb({bx[i], by[i], bz[i]}), glm::dvec3(0.0)));
     }
     const double y = out.luminance_sum();
     if (y > 0)

@@ -31,7 +31,7 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 
@@ -129,16 +129,16 @@ const std::vector<std::string> kGeometry = {"--width-px", "1920",  "--height-px"
 
 /// The stored model, read from fit_json as docs/calibration.md lays it out
 /// (independently of the runner's own reader).
-stimuli::DisplayModel stored_model(const store::Calibration& c) {
+display::DisplayModel stored_model(const store::Calibration& c) {
     const nlohmann::json j = store::parse_json(c.fit_json);
-    std::array<stimuli::GogParams, 3> p{};
+    std::array<display::GogParams, 3> p{};
     for (int ch = 0; ch < 3; ++ch) {
         auto v = [&](const char* k) {
             return store::number_at(j, fmt::format("/display/channels/{}/{}", ch, k)).value();
         };
         p[static_cast<std::size_t>(ch)] = {v("a"), v("b"), v("k"), v("gamma")};
     }
-    return stimuli::DisplayModel::gog(p);
+    return display::DisplayModel::gog(p);
 }
 
 /// The effective gamma of a law: least-squares slope of log10(L(V) − L(0)) on
@@ -239,11 +239,11 @@ protected:
     fs::path db() const { return dir_.path() / "study.db"; }
 
     /// Every patch and 200 random code triples: the stored model against the truth.
-    double worst_relative_error(const stimuli::DisplayModel& m) const {
+    double worst_relative_error(const display::DisplayModel& m) const {
         double worst = 0.0;
         auto at = [&](int r, int g, int b) {
             const double want = truth_cd_m2(r, g, b);
-            const double got = stimuli::displayed_luminance_cd_m2(m, {r, g, b}, 8);
+            const double got = display::displayed_luminance_cd_m2(m, {r, g, b}, 8);
             worst = std::max(worst, std::abs(got - want) / want);
         };
         for (const PatchCodes& p : patches_) at(p.r, p.g, p.b);
@@ -269,7 +269,7 @@ TEST_F(CalibrateCommand, ExactReadingsGiveBackTheDisplaysLaw) {
     ASSERT_TRUE(cal.has_value());
     EXPECT_EQ(cal->width_px, 1920);
     EXPECT_NEAR(cal->height_m, 0.598 * 1080 / 1920, 1e-12);  // square pixels
-    const stimuli::DisplayModel m = stored_model(*cal);
+    const display::DisplayModel m = stored_model(*cal);
     // GOG data fitted with a GOG law: what is left is the optimiser's tolerance.
     EXPECT_LT(worst_relative_error(m), 2e-3);
     EXPECT_NEAR(m.black_cd_m2, kTruth[0].a + kTruth[1].a + kTruth[2].at(0.0), 1e-3 * m.black_cd_m2);
@@ -304,7 +304,7 @@ TEST_F(CalibrateCommand, NoisyReadingsAreRecoveredAndChecked) {
         cal = s.latest_calibration("lab-lcd").value();
     }
     EXPECT_EQ(cal.measured_at, "2024-05-01");
-    const stimuli::DisplayModel m = stored_model(cal);
+    const display::DisplayModel m = stored_model(cal);
     EXPECT_LT(worst_relative_error(m), 0.03);
     EXPECT_NEAR(m.black_cd_m2, truth_cd_m2(0, 0, 0), 0.03 * truth_cd_m2(0, 0, 0));
     EXPECT_NEAR(m.peak_cd_m2, truth_cd_m2(255, 255, 255), 0.03 * truth_cd_m2(255, 255, 255));

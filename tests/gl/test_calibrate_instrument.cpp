@@ -30,7 +30,7 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 
@@ -112,16 +112,16 @@ std::vector<PatchCodes> list_patches(const std::vector<std::string>& extra, cons
 const std::vector<std::string> kGeometry = {"--width-px", "320", "--height-px",          "180",
                                             "--width-m",  "0.1", "--viewing-distance-m", "0.9"};
 
-stimuli::DisplayModel stored_model(const store::Calibration& c) {
+display::DisplayModel stored_model(const store::Calibration& c) {
     const nlohmann::json j = store::parse_json(c.fit_json);
-    std::array<stimuli::GogParams, 3> p{};
+    std::array<display::GogParams, 3> p{};
     for (int ch = 0; ch < 3; ++ch) {
         auto v = [&](const char* k) {
             return store::number_at(j, fmt::format("/display/channels/{}/{}", ch, k)).value();
         };
         p[static_cast<std::size_t>(ch)] = {v("a"), v("b"), v("k"), v("gamma")};
     }
-    return stimuli::DisplayModel::gog(p);
+    return display::DisplayModel::gog(p);
 }
 
 class CalibrateVirtual : public ::testing::Test {
@@ -162,7 +162,7 @@ TEST_F(CalibrateVirtual, NoiseFreeMeasureRecoversEveryPatchAndGamma) {
     EXPECT_TRUE(contains(cal->source, "virtual instrument")) << cal->source;
     const auto readings = s.calibration_readings(cal->id);
     ASSERT_EQ(readings.size(), patches_.size());
-    const stimuli::DisplayModel model = stored_model(*cal);
+    const display::DisplayModel model = stored_model(*cal);
     for (std::size_t i = 0; i < readings.size(); ++i) {
         const PatchCodes& p = patches_[i];
         const auto want = kDisplay.xyz(p.r, p.g, p.b);
@@ -175,7 +175,7 @@ TEST_F(CalibrateVirtual, NoiseFreeMeasureRecoversEveryPatchAndGamma) {
         ASSERT_TRUE(readings[i].transcript.has_value());
         EXPECT_TRUE(contains(*readings[i].transcript, "Result is XYZ")) << *readings[i].transcript;
         // The bound: the fitted model predicts every patch within 0.2 %.
-        const double fitted = stimuli::displayed_luminance_cd_m2(model, {p.r, p.g, p.b}, 8);
+        const double fitted = display::displayed_luminance_cd_m2(model, {p.r, p.g, p.b}, 8);
         EXPECT_NEAR(fitted, want[1], 2e-3 * want[1]) << p.name;
     }
     // The grey ramp's effective γ is the law's γ (L − L(0) = (peak − black) V^γ exactly), within 0.5 %.

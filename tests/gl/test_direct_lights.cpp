@@ -11,7 +11,7 @@
 #include <glm/gtx/quaternion.hpp>
 
 #include "atonlab/stimuli/atmosphere.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/light_model.h"
@@ -21,6 +21,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 // A small display with a realistic focal length: 320×240 px, f = 0.9·320/0.1 = 2880 px
 // (about 50 px per degree, like a 24" monitor at 90 cm).

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <numbers>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/disc.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/frame_renderer.h"
@@ -19,6 +19,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kBackground_cd_m2 = 0.2;

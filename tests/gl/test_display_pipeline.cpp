@@ -14,6 +14,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr int kW = 128, kH = 96;
 

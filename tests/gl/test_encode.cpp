@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/gl/objects.h"
 #include "gl_test_support.h"
 
@@ -23,6 +23,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 using GpuEncode = GLTest;
 
 constexpr int kWidth = 192;

@@ -23,6 +23,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 double relative_l2(const std::vector<double>& a, const std::vector<double>& b) {
     double num = 0, den = 0;

@@ -29,6 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 fs::path scratch(const std::string& name) {
     const fs::path dir =

@@ -26,6 +26,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 // 480 x 270 px on 0.15 m at 0.9 m: 50 px/deg, the lights 0.62° (31 px) apart.
 constexpr const char* kScene = R"(

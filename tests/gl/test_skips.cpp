@@ -24,13 +24,14 @@
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/rhythm.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "gl_test_support.h"
 
 namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 // 320×240 px at f = 576 px (10 px per degree): a grid of lights 32 px apart
 // whose 1° billboards (21 px) never overlap.

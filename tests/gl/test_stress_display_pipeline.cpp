@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/tonemap.h"
 #include "gl_test_support.h"
@@ -23,6 +23,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr int kW = 64, kH = 48;
 

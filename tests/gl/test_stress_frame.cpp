@@ -27,6 +27,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr double kBackground = 0.01;  // cd/m², uniform: a changed pixel is easy to spot
 

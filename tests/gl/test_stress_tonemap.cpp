@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/gl/objects.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "blueshift_modes.h"
 #include "gl_test_support.h"
 
@@ -28,6 +28,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr int kLums = 121;  // exact 0, then 1e-9 … 1e9 at 120 log-spaced points
 

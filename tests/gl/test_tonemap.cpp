@@ -1,5 +1,5 @@
 // The GLSL twin of the tone-mapping operators (shaders/tonemap.glsl) against the double
-// reference (stimuli/src/tonemap.cpp), for random HDR pixels over 1e-6 … 1e9 cd/m²
+// reference (display/src/tonemap.cpp), for random HDR pixels over 1e-6 … 1e9 cd/m²
 // (log-uniform), random chromaticities with the pure primaries among them, and adaptation
 // levels over 1e-6 … 1e6 cd/m², for every operator × hue preservation × blueshift.
 #include <epoxy/gl.h>
@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/gl/objects.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "blueshift_modes.h"
 #include "gl_test_support.h"
 
@@ -24,6 +24,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 // Pixels: rgb (cd/m²) and, in a, the adaptation luminance (cd/m²).
 std::vector<glm::vec4> random_pixels(std::size_t n, std::uint32_t seed) {

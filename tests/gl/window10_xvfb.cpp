@@ -26,6 +26,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 struct Screen10 {
     int width = 0, height = 0;

@@ -1,6 +1,6 @@
 #include "gl_test_support.h"
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/gl/objects.h"
 
@@ -59,7 +59,7 @@ glm::dvec3 image_illuminance_rgb_lux(const stimuli::ImageRGBA32F& img, double fo
 }
 
 double image_illuminance_lux(const stimuli::ImageRGBA32F& img, double focal_px) {
-    return stimuli::luminance_of_linear_rgb(image_illuminance_rgb_lux(img, focal_px));
+    return display::luminance_of_linear_rgb(image_illuminance_rgb_lux(img, focal_px));
 }
 
 }  // namespace atonlab::test

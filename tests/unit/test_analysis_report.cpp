@@ -19,6 +19,8 @@
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/analysis/study_analysis.h"
+#include "atonlab/display/display_model.h"
+#include "atonlab/display/fit_json.h"
 #include "atonlab/store/json.h"
 
 namespace atonlab::analysis {
@@ -445,6 +447,35 @@ TEST(AnalysisReport, NominalDisplayModelCurveIsTheSrgbCurve) {
     // Where b + k V <= 0 the channel emits its offset a alone.
     EXPECT_NEAR(*model_grey_luminance_cd_m2(gog, 0.0), 0.03 + std::pow(0.02, 2.2) + 0.05 + 0.02, 1e-12);
     EXPECT_FALSE(model_grey_luminance_cd_m2("not json", 0.5).has_value());
+}
+
+TEST(AnalysisReport, LutDisplayCurveIsTheModelsLuminanceAtTheLutPoints) {
+    // A measured-LUT display as the runner records it (display::nominal_fit_json). Its
+    // knots lie on 8-bit codes (k/255 for k = 0, 51, ..., 255), so at each the plotted
+    // grey curve must be the sum of the three channels' tabulated cd/m² (PCHIP passes
+    // through its knots) and what the model says the screen emits for that code.
+    const std::vector<double> drives = {0.0, 51.0 / 255.0, 102.0 / 255.0, 153.0 / 255.0, 204.0 / 255.0, 1.0};
+    const std::array<std::vector<double>, 3> cd_m2 = {{{0.03, 0.9, 3.7, 8.8, 14.1, 21.2},
+                                                       {0.09, 2.6, 12.4, 29.0, 48.8, 71.6},
+                                                       {0.01, 0.3, 1.2, 2.9, 4.8, 7.3}}};
+    std::array<std::vector<display::LutPoint>, 3> lut;
+    for (std::size_t c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < drives.size(); ++i) lut[c].push_back({drives[i], cd_m2[c][i]});
+    const display::DisplayModel model = display::DisplayModel::lut(lut, "booth-lut");
+    const std::string fit = display::nominal_fit_json(model, display::EncodeSettings{});
+    for (std::size_t i = 0; i < drives.size(); ++i) {
+        const double tabulated = cd_m2[0][i] + cd_m2[1][i] + cd_m2[2][i];
+        const auto plotted = model_grey_luminance_cd_m2(fit, drives[i]);
+        ASSERT_TRUE(plotted.has_value()) << fit;
+        EXPECT_NEAR(*plotted, tabulated, 1e-12 * tabulated) << "V = " << drives[i];
+        const int code = static_cast<int>(std::lround(drives[i] * 255.0));
+        EXPECT_NEAR(*plotted, display::displayed_luminance_cd_m2(model, glm::ivec3(code), 8), 1e-12 * tabulated);
+    }
+    // Between knots the curve is the model's interpolation, not a straight line.
+    const double mid = 0.5 * (drives[1] + drives[2]);
+    double model_mid = 0.0;
+    for (int c = 0; c < 3; ++c) model_mid += model.channel_luminance_cd_m2(c, mid);
+    EXPECT_EQ(*model_grey_luminance_cd_m2(fit, mid), model_mid);
 }
 
 }  // namespace

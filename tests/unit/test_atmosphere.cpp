@@ -11,6 +11,7 @@
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr double night = allard_threshold_night_lux;  // 2e-7 lux
 constexpr double day = allard_threshold_day_lux;      // 1e-3 lux

@@ -13,16 +13,16 @@
 
 #include "../store/store_test_support.h"
 #include "atonlab/protocols/protocol_file.h"
-#include "atonlab/stimuli/calibration.h"
+#include "atonlab/display/calibration.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
-#include "calibration_check.h"
-#include "calibration_patches.h"
-#include "calibration_policy.h"
-#include "calibration_record.h"
-#include "photometer_input.h"
+#include "calibrate/calibration_check.h"
+#include "calibrate/calibration_patches.h"
+#include "calibrate/calibration_policy.h"
+#include "calibrate/calibration_record.h"
+#include "calibrate/photometer_input.h"
 #include "view_controls.h"
 
 namespace atonlab::runner {
@@ -48,7 +48,7 @@ TEST(CalibratePatches, MeasurementSetHasBlackWhiteAndEvenRamps) {
     const int red[] = {32, 64, 96, 128, 159, 191, 223, 255};
     for (int i = 0; i < 8; ++i) {
         const Patch& r = p[17 + static_cast<std::size_t>(i)];
-        EXPECT_EQ(r.channel, stimuli::Channel::red);
+        EXPECT_EQ(r.channel, display::Channel::red);
         EXPECT_EQ(r.rgb, glm::ivec3(red[i], 0, 0));
     }
     EXPECT_EQ(p.back().name, "blue-255");
@@ -155,13 +155,13 @@ TEST(CalibrateInput, ReadingsFileByOrderAndName) {
 TEST(CalibrateInput, ArgyllXyzIsKeptOnTheLuminanceScale) {
     // display.ti3 line 32: "1 0 0 0 0.118813 0.125000 0.136125", normalised to white Y = 100,
     // LUMINANCE_XYZ_CDM2 Y = 120: absolute = value × 1.2.
-    const auto ms = stimuli::read_argyll_ti3(fs::path(ATONLAB_SOURCE_DIR) / "tests/data/calibration/display.ti3");
+    const auto ms = display::read_argyll_ti3(fs::path(ATONLAB_SOURCE_DIR) / "tests/data/calibration/display.ti3");
     ASSERT_TRUE(ms[0].xyz_cd_m2.has_value());
     EXPECT_NEAR(ms[0].xyz_cd_m2->x, 0.118813 * 1.2, 1e-12);
     EXPECT_NEAR(ms[0].xyz_cd_m2->y, ms[0].luminance_cd_m2, 1e-15);
     EXPECT_NEAR(ms[0].xyz_cd_m2->z, 0.136125 * 1.2, 1e-12);
     const auto csv =
-        stimuli::read_calibration_csv(fs::path(ATONLAB_SOURCE_DIR) / "tests/data/calibration/grey_ramp.csv");
+        display::read_calibration_csv(fs::path(ATONLAB_SOURCE_DIR) / "tests/data/calibration/grey_ramp.csv");
     EXPECT_FALSE(csv[0].xyz_cd_m2.has_value());
 }
 
@@ -169,20 +169,20 @@ TEST(CalibrateInput, ArgyllXyzIsKeptOnTheLuminanceScale) {
 
 /// A GOG display with b = 0 on every channel: L_c(V) = a_c + (k_c V)^γ, so the
 /// effective gamma of grey above black is exactly γ.
-stimuli::DisplayModel power_display(double gamma, double peak = 100.0, double black = 0.2) {
-    std::array<stimuli::GogParams, 3> p{};
+display::DisplayModel power_display(double gamma, double peak = 100.0, double black = 0.2) {
+    std::array<display::GogParams, 3> p{};
     const double w[3] = {0.2126, 0.7152, 0.0722};
     for (int c = 0; c < 3; ++c)
         p[static_cast<std::size_t>(c)] = {w[c] * black, 0.0, std::pow(w[c] * (peak - black), 1.0 / gamma), gamma};
-    return stimuli::DisplayModel::gog(p, "power");
+    return display::DisplayModel::gog(p, "power");
 }
 
-std::vector<PhotometerReading> readings_from(const stimuli::DisplayModel& truth, double scale = 1.0,
+std::vector<PhotometerReading> readings_from(const display::DisplayModel& truth, double scale = 1.0,
                                              double add_cd_m2 = 0.0) {
     std::vector<PhotometerReading> out;
     for (const Patch& p : check_patches()) {
         PhotometerReading r;
-        r.luminance_cd_m2 = scale * stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8) + add_cd_m2;
+        r.luminance_cd_m2 = scale * display::displayed_luminance_cd_m2(truth, p.rgb, 8) + add_cd_m2;
         out.push_back(r);
     }
     return out;
@@ -231,26 +231,26 @@ TEST(CalibrateCheck, ExactReadingsPassAndEachDriftFailsItsOwnTolerance) {
 
 // --- fit_json, geometry ------------------------------------------------------------------
 
-std::vector<stimuli::Measurement> synthetic_measurements(const stimuli::DisplayModel& truth) {
-    std::vector<stimuli::Measurement> out;
+std::vector<display::Measurement> synthetic_measurements(const display::DisplayModel& truth) {
+    std::vector<display::Measurement> out;
     int line = 1;
     for (const Patch& p : measurement_patches()) {
-        out.push_back(stimuli::Measurement{p.level(), p.channel, stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8),
+        out.push_back(display::Measurement{p.level(), p.channel, display::displayed_luminance_cd_m2(truth, p.rgb, 8),
                                            ++line, glm::dvec3(p.rgb) / 255.0, "synthetic"});
     }
     return out;
 }
 
 TEST(CalibrateRecord, FitJsonRoundTripsTheDisplayModel) {
-    const auto report = stimuli::fit_calibration(synthetic_measurements(power_display(2.3)));
-    const auto model = stimuli::display_from_calibration(report, "lab");
-    DisplayGeometry g{1920, 1080, 0.598, 0.336, 0.9};
+    const auto report = display::fit_calibration(synthetic_measurements(power_display(2.3)));
+    const auto model = display::display_from_calibration(report, "lab");
+    display::DisplayGeometry g{1920, 1080, 0.598, 0.9, 0.336};  // width, height px; width m; distance m; measured height m
     store::Calibration c;
     c.id = store::CalibrationId{3};
     c.display_name = "lab";
-    c.fit_json = measured_fit_json(report, model, g, "measured");
+    c.fit_json = display::measured_fit_json(report, model, g, "measured");
     EXPECT_TRUE(is_measured(c));
-    const stimuli::DisplayModel back = display_model_of(c);
+    const display::DisplayModel back = display_model_of(c);
     for (int ch = 0; ch < 3; ++ch) {
         const auto& a = model.channels[static_cast<std::size_t>(ch)].gog;
         const auto& b = back.channels[static_cast<std::size_t>(ch)].gog;
@@ -269,7 +269,7 @@ TEST(CalibrateRecord, PixelsPerDegreeAtTheCentre) {
     // One pixel of pitch p at distance d subtends 2 atan(p / 2d); choose d so that it is 1/60°.
     const double pitch = 0.5 / 1000.0;
     const double d = pitch / (2.0 * std::tan(std::numbers::pi / 180.0 / 120.0));
-    const DisplayGeometry g{1000, 500, 0.5, 0.25, d};
+    const display::DisplayGeometry g{1000, 500, 0.5, d, 0.25};
     EXPECT_NEAR(g.pixels_per_degree(), 60.0, 1e-9);
 }
 
@@ -326,10 +326,10 @@ TEST(CalibratePolicy, WarnsAndChoosesTheMeasuredCalibration) {
     EXPECT_TRUE(any_contains(s.warnings, "display \"lab\" has no calibration in study.db"));
 
     // A measured calibration, 40 days old, then a nominal row after it (still skipped).
-    const auto report = stimuli::fit_calibration(synthetic_measurements(power_display(2.2)));
-    const auto model = stimuli::display_from_calibration(report, "lab");
+    const auto report = display::fit_calibration(synthetic_measurements(power_display(2.2)));
+    const auto model = display::display_from_calibration(report, "lab");
     store::Calibration measured = nominal;
-    measured.fit_json = measured_fit_json(report, model, {1920, 1080, 0.598, 0.336, 0.9}, "measured");
+    measured.fit_json = display::measured_fit_json(report, model, {1920, 1080, 0.598, 0.9, 0.336}, "measured");
     measured.source = "measured";
     measured.measured_at = "2024-04-22T09:00:00Z";
     const store::CalibrationId id = db.put_calibration(measured);

@@ -21,14 +21,14 @@
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/analysis/study_analysis.h"
-#include "atonlab/stimuli/calibration.h"
+#include "atonlab/display/calibration.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/profiles.h"
-#include "calibration_check.h"
-#include "calibration_patches.h"
-#include "calibration_policy.h"
-#include "calibration_record.h"
-#include "profile_location.h"
+#include "calibrate/calibration_check.h"
+#include "calibrate/calibration_patches.h"
+#include "calibrate/calibration_policy.h"
+#include "calibrate/calibration_record.h"
+#include "calibrate/profile_location.h"
 
 namespace atonlab::runner {
 namespace {
@@ -38,21 +38,21 @@ using store::test_support::file_bytes;
 using store::test_support::TempDir;
 
 /// L = black + (peak - black) V^gamma on grey, split over R, G, B by Rec.709 weight.
-stimuli::DisplayModel power_display(double gamma, double peak = 100.0, double black = 0.2) {
-    std::array<stimuli::GogParams, 3> p{};
+display::DisplayModel power_display(double gamma, double peak = 100.0, double black = 0.2) {
+    std::array<display::GogParams, 3> p{};
     const double w[3] = {0.2126, 0.7152, 0.0722};
     for (int c = 0; c < 3; ++c)
         p[static_cast<std::size_t>(c)] = {w[c] * black, 0.0, std::pow(w[c] * (peak - black), 1.0 / gamma), gamma};
-    return stimuli::DisplayModel::gog(p, "power");
+    return display::DisplayModel::gog(p, "power");
 }
 
 /// A measured calibration of `truth` (every measurement patch read exactly).
-store::Calibration measured(const std::string& display, const stimuli::DisplayModel& truth, const std::string& date) {
-    std::vector<stimuli::Measurement> ms;
+store::Calibration measured(const std::string& display, const display::DisplayModel& truth, const std::string& date) {
+    std::vector<display::Measurement> ms;
     for (const Patch& p : measurement_patches())
-        ms.push_back(stimuli::Measurement{p.level(), p.channel, stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8), 0,
+        ms.push_back(display::Measurement{p.level(), p.channel, display::displayed_luminance_cd_m2(truth, p.rgb, 8), 0,
                                           glm::dvec3(p.rgb) / 255.0, "synthetic"});
-    const auto report = stimuli::fit_calibration(ms);
+    const auto report = display::fit_calibration(ms);
     store::Calibration c;
     c.display_name = display;
     c.width_px = 1920;
@@ -60,8 +60,8 @@ store::Calibration measured(const std::string& display, const stimuli::DisplayMo
     c.width_m = 0.598;
     c.height_m = 0.3364;
     c.viewing_distance_m = 0.9;
-    c.fit_json = measured_fit_json(report, stimuli::display_from_calibration(report, display),
-                                   {1920, 1080, 0.598, 0.3364, 0.9}, "measured");
+    c.fit_json = display::measured_fit_json(report, display::display_from_calibration(report, display),
+                                            {1920, 1080, 0.598, 0.9, 0.3364}, "measured");
     c.source = "measured";
     c.measured_at = date;
     return c;
@@ -80,13 +80,13 @@ std::vector<store::CalibrationReading> two_readings() {
 }
 
 /// A check of `cal` (stored in `file`) with every check patch read as `scale` times the truth.
-CheckOutcome check(store::Store& file, const store::Calibration& cal, const stimuli::DisplayModel& truth, double scale,
+CheckOutcome check(store::Store& file, const store::Calibration& cal, const display::DisplayModel& truth, double scale,
                    const std::string& date, const CheckTolerances& tol = {}) {
     std::vector<PhotometerReading> readings;
     for (const Patch& p : check_patches())
         {
         PhotometerReading r;
-        r.luminance_cd_m2 = scale * stimuli::displayed_luminance_cd_m2(truth, p.rgb, 8);
+        r.luminance_cd_m2 = scale * display::displayed_luminance_cd_m2(truth, p.rgb, 8);
         readings.push_back(r);
     }
     const CheckOutcome o = evaluate_check(display_model_of(cal), check_patches(), readings, tol);
@@ -113,7 +113,7 @@ protocols::Display booth(const std::string& name) {
 
 TEST(CalibrationProfiles, OneMeasurementServesTwoStudiesEachKeepingACopy) {
     TempDir dir;
-    const stimuli::DisplayModel truth = power_display(2.2);
+    const display::DisplayModel truth = power_display(2.2);
     store::CalibrationId in_profiles;
     {
         store::Profiles p = store::Profiles::create_or_open(dir / "profiles.sqlite");
@@ -181,7 +181,7 @@ TEST(CalibrationProfiles, AStudysOwnLaterCalibrationWinsAndOldStudiesKeepWorking
 
 TEST(CalibrationProfiles, FailedCheckInTheProfileFileWarns) {
     TempDir dir;
-    const stimuli::DisplayModel truth = power_display(2.2);
+    const display::DisplayModel truth = power_display(2.2);
     store::Profiles p = store::Profiles::create_or_open(dir / "profiles.sqlite");
     const store::CalibrationId id = p.displays().put_calibration(measured("booth-2", truth, "2024-05-01"));
     check(p.displays(), p.displays().calibration(id), truth, 0.9, "2024-05-15");  // the backlight lost 10 %
@@ -198,7 +198,7 @@ TEST(CalibrationProfiles, FailedCheckInTheProfileFileWarns) {
 
 TEST(CalibrationProfiles, DriftTableAndFigureHoldTheStoredChecks) {
     TempDir dir;
-    const stimuli::DisplayModel truth = power_display(2.2);
+    const display::DisplayModel truth = power_display(2.2);
     store::Profiles p = store::Profiles::create_or_open(dir / "profiles.sqlite");
     store::Store& f = p.displays();
     const store::Calibration cal = f.calibration(f.put_calibration(measured("booth-2", truth, "2024-05-01")));
@@ -213,8 +213,8 @@ TEST(CalibrationProfiles, DriftTableAndFigureHoldTheStoredChecks) {
     EXPECT_EQ(d[2].checked_at, "2024-07-01");
     const CheckOutcome* outcomes[] = {&c1, &c2, &c3};
     const double scales[] = {1.0, 0.97, 0.9};
-    const double white = stimuli::displayed_luminance_cd_m2(truth, glm::ivec3(255), 8);
-    const double black = stimuli::displayed_luminance_cd_m2(truth, glm::ivec3(0), 8);
+    const double white = display::displayed_luminance_cd_m2(truth, glm::ivec3(255), 8);
+    const double black = display::displayed_luminance_cd_m2(truth, glm::ivec3(0), 8);
     for (int i = 0; i < 3; ++i) {
         SCOPED_TRACE(i);
         const analysis::DriftPoint& x = d[static_cast<std::size_t>(i)];
@@ -271,7 +271,7 @@ TEST(CalibrationProfiles, DriftTableAndFigureHoldTheStoredChecks) {
 TEST(CalibrationProfiles, TheReportShowsTheChecksTheStudyHolds) {
     TempDir dir;
     const fs::path study = dir / "s.db";
-    const stimuli::DisplayModel truth = power_display(2.2);
+    const display::DisplayModel truth = power_display(2.2);
     store::CalibrationId id;
     {
         store::Store s = store::Store::create_or_open(study);
@@ -286,7 +286,7 @@ TEST(CalibrationProfiles, TheReportShowsTheChecksTheStudyHolds) {
     ASSERT_EQ(d.calibrations.size(), 1u);
     const auto& drift = d.calibrations[0].drift;
     ASSERT_EQ(drift.size(), 2u);
-    const double white = stimuli::displayed_luminance_cd_m2(truth, glm::ivec3(255), 8);
+    const double white = display::displayed_luminance_cd_m2(truth, glm::ivec3(255), 8);
     EXPECT_EQ(drift[0].checked_at, "2024-05-02");
     EXPECT_EQ(drift[1].peak_cd_m2, 0.9 * white);
     EXPECT_FALSE(drift[1].passed);

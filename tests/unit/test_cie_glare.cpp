@@ -17,6 +17,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 

@@ -10,6 +10,7 @@
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 ImageRGBA32F black(int w, int h) {
     ImageRGBA32F img;

@@ -22,6 +22,7 @@
 namespace fs = std::filesystem;
 using atonlab::InputError;
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

@@ -16,6 +16,7 @@ namespace {
 
 using atonlab::InputError;
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 double rad(double deg) {
     return deg * std::numbers::pi / 180.0;

@@ -15,6 +15,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 

@@ -6,12 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/scene_file.h"
 
 using atonlab::InputError;
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -24,6 +24,7 @@
 
 using atonlab::InputError;
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 namespace {
 

@@ -5,13 +5,14 @@
 
 #include <stdexcept>
 
-#include "atonlab/stimuli/colour.h"
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/colour.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/signal_colour.h"
 
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 std::vector<glm::dvec2> area(const char* name) {
     return *signal_colour_area(name);

@@ -6,7 +6,7 @@
 
 #include <cstdio>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/psf.h"
 #include "atonlab/stimuli/spectral_path.h"
 #include "input_error.h"
@@ -15,6 +15,7 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
+using namespace atonlab::display;
 
 constexpr int kN = 256;
 constexpr int kSamples = 30;  // GlareSettings::spectral_samples

@@ -20,6 +20,7 @@
 #include "atonlab/stimuli/scene.h"
 
 namespace atonlab::stimuli {
+using namespace atonlab::display;  // colour science, the tone-mapping CPU reference (display/)
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -19,13 +19,14 @@
 #include <vector>
 
 #include "atonlab/stimuli/atmosphere.h"
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/light_model.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
 
 namespace atonlab::stimuli {
+using namespace atonlab::display;  // colour science, the tone-mapping CPU reference (display/)
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

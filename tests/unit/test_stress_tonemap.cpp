@@ -20,11 +20,12 @@
 #include <random>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/tonemap.h"
 #include "blueshift_modes.h"
 
 namespace atonlab::stimuli {
+using namespace atonlab::display;  // colour science, the tone-mapping CPU reference (display/)
 namespace {
 
 constexpr std::array<ToneOperator, 6> kOperators = {ToneOperator::empirical, ToneOperator::perceptual,

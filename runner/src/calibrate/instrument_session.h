@@ -6,9 +6,9 @@
 #include <optional>
 #include <vector>
 
-#include "../calibration_patches.h"
-#include "../patch_screen.h"
-#include "../photometer_input.h"
+#include "calibration_patches.h"
+#include "patch_screen.h"
+#include "photometer_input.h"
 #include "instrument.h"
 
 namespace atonlab::runner {

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "../patch_screen.h"
+#include "patch_screen.h"
 #include "pty_process.h"
 #include "spotread_output.h"
 

@@ -7,8 +7,8 @@
 #include <map>
 #include <random>
 
-#include "../patch_screen.h"
-#include "atonlab/stimuli/calibration.h"
+#include "patch_screen.h"
+#include "atonlab/display/calibration.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::runner {
@@ -65,10 +65,10 @@ VirtualDisplayLaw VirtualDisplayLaw::gog(double peak_cd_m2, double black_cd_m2, 
 }
 
 VirtualDisplayLaw VirtualDisplayLaw::lut(const std::string& csv_path) {
-    const std::vector<stimuli::Measurement> ms = stimuli::read_calibration_csv(csv_path);
+    const std::vector<display::Measurement> ms = display::read_calibration_csv(csv_path);
     std::map<double, std::pair<double, int>> grey;  // level -> (sum, n): repeated levels are averaged
-    for (const stimuli::Measurement& m : ms)
-        if (m.channel == stimuli::Channel::grey) {
+    for (const display::Measurement& m : ms)
+        if (m.channel == display::Channel::grey) {
             auto& [sum, n] = grey[m.level];
             sum += m.luminance_cd_m2;
             ++n;

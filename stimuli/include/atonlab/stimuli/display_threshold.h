@@ -13,7 +13,7 @@ namespace atonlab::stimuli {
 /// The code value of each channel before dither and rounding: V · (2^bits − 1),
 /// V the drive that makes channel c emit relative_rgb[c] · L_c(1), clipped to
 /// [L_c(0), L_c(1)] (exactly what encode_pixel() quantises). NaN counts as 0.
-glm::dvec3 continuous_codes(const DisplayModel& display, glm::dvec3 relative_rgb, int bits);
+glm::dvec3 continuous_codes(const display::DisplayModel& display, glm::dvec3 relative_rgb, int bits);
 
 /// The largest luminance ΔY (cd/m²) of colour rgb_per_cd (linear Rec.709, any
 /// scale; normalised here to Y = 1) that, added to a uniform D65 background

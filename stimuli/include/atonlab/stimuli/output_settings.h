@@ -4,8 +4,8 @@
 // Plain settings (no GL), part of a Scene; DisplayPipeline carries them out.
 #include <cstdint>
 
-#include "atonlab/stimuli/display_model.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/display_model.h"
+#include "atonlab/display/tonemap.h"
 
 namespace atonlab::stimuli {
 
@@ -17,16 +17,16 @@ enum class AdaptationMode : std::uint8_t {
 struct AdaptationSettings {
     AdaptationMode mode = AdaptationMode::fixed;
     double fixed_cd_m2 = 0.001;                     ///< fixed mode (cd/m²)
-    double epsilon_cd_m2 = kLogAverageEpsilonCdM2;  ///< ε of eq 4.15 (cd/m²)
+    double epsilon_cd_m2 = display::kLogAverageEpsilonCdM2;  ///< ε of eq 4.15 (cd/m²)
     int stride = 1;  ///< dynamic: every stride-th pixel in x and y enters the log-average
 };
 
 /// Everything after the HDR frame: how it is adapted, tone-mapped and encoded.
 struct OutputSettings {
     AdaptationSettings adaptation;
-    ToneMapSettings tonemap;
-    DisplayModel display = DisplayModel::srgb(100.0, 0.1);
-    EncodeSettings encode;
+    display::ToneMapSettings tonemap;
+    display::DisplayModel display = display::DisplayModel::srgb(100.0, 0.1);
+    display::EncodeSettings encode;
     /// K2012 §6.2.2: glare billboards go to their own buffer, are tone-mapped on
     /// their own and added to a display-referred scene (simulators without HDR).
     bool ldr_glare = false;

@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "atonlab/stimuli/colour.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/fft.h"
 
@@ -29,7 +29,7 @@ struct SpectralSamples {
 };
 /// Throws InputError (key "spectral_samples") for count < 1, and (key "spd")
 /// for an SPD with no luminance.
-SpectralSamples spectral_samples(const Spectrum& spd, int count);
+SpectralSamples spectral_samples(const display::Spectrum& spd, int count);
 
 /// A monochromatic PSF (unit sum) at one wavelength.
 struct MonoPsf {

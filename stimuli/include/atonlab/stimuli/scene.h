@@ -12,6 +12,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "atonlab/stimuli/cie_glare.h"
+#include "atonlab/display/geometry.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/output_settings.h"
@@ -19,21 +20,6 @@
 #include "atonlab/stimuli/rhythm.h"
 
 namespace atonlab::stimuli {
-
-/// The observer's display. With square pixels and a veridical camera the
-/// pinhole's focal length in pixels is viewing_distance * width_px / width_m.
-struct DisplayGeometry {
-    int width_px = 1920;
-    int height_px = 1080;
-    double width_m = 0.598;             ///< visible width of the picture, metres
-    double viewing_distance_m = 0.9;    ///< eye to screen, metres
-
-    double height_m() const { return width_m * height_px / width_px; }
-    double focal_px() const { return viewing_distance_m * width_px / width_m; }
-    double fov_x_rad() const;           ///< visual angle the display subtends horizontally
-    double fov_y_rad() const;           ///< ... vertically
-    double pixels_per_degree_at_centre() const;  ///< focal_px * π/180 (small-angle, at the centre)
-};
 
 struct Camera {
     glm::dvec3 position_m{0.0, 3.0, 0.0};
@@ -157,7 +143,7 @@ struct GlareSettings {
 };
 
 struct Scene {
-    DisplayGeometry display;
+    display::DisplayGeometry display;
     Camera camera;
     Environment environment;
     ProfileTables profiles;

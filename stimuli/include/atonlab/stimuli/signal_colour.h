@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "atonlab/stimuli/display_model.h"
+#include "atonlab/display/display_model.h"
 
 namespace atonlab::stimuli {
 
@@ -39,7 +39,7 @@ glm::dvec2 uv_prime(glm::dvec3 xyz);
 /// channel's emitted luminance (displayed_luminance_rgb) over its Rec.709
 /// luminance weight is its linear drive on the absolute scale, and the Rec.709
 /// matrix gives XYZ. The display's primaries are Rec.709 (DisplayModel's).
-glm::dvec3 displayed_xyz(const DisplayModel& display, glm::ivec3 code, int bits);
+glm::dvec3 displayed_xyz(const display::DisplayModel& display, glm::ivec3 code, int bits);
 
 /// One light's check.
 struct SignalColourCheck {

@@ -1,0 +1,186 @@
+#include "atonlab/display/fit_json.h"
+
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+
+#include "atonlab/common/error.h"
+
+namespace atonlab::display {
+namespace {
+
+using Json = nlohmann::ordered_json;  // keys in the order written (docs/calibration.md)
+
+const char* const kChannelNames[3] = {"red", "green", "blue"};
+
+const char* transfer_name(TransferKind k) {
+    switch (k) {
+        case TransferKind::srgb:
+            return "srgb";
+        case TransferKind::gog:
+            return "gog";
+        case TransferKind::lut:
+            return "lut";
+        case TransferKind::pq:
+            return "pq";
+    }
+    return "?";
+}
+
+Json gog_json(const GogParams& p) {
+    return Json{{"a", p.a}, {"b", p.b}, {"k", p.k}, {"gamma", p.gamma}};
+}
+
+/// The whole screen's peak and black, as both kinds of fit_json hold them.
+void put_display(Json& out, const DisplayModel& model) {
+    out["peak_cd_m2"] = model.peak_cd_m2;
+    out["black_cd_m2"] = model.black_cd_m2;
+}
+
+Json channels_json(const DisplayModel& model) {
+    Json channels = Json::array();
+    for (int c = 0; c < 3; ++c) {
+        const ChannelTransfer& ch = model.channels[static_cast<std::size_t>(c)];
+        // srgb and pq are defined by their black and white; gog and lut carry them for the reader's eye.
+        const bool own = ch.kind == TransferKind::srgb || ch.kind == TransferKind::pq;
+        Json j{{"channel", kChannelNames[c]},
+               {"transfer", transfer_name(ch.kind)},
+               {"black_cd_m2", own ? ch.black_cd_m2 : ch.min_cd_m2()},
+               {"white_cd_m2", own ? ch.white_cd_m2 : ch.max_cd_m2()}};
+        switch (ch.kind) {
+            case TransferKind::srgb:
+                break;
+            case TransferKind::gog:
+                j.update(gog_json(ch.gog));
+                break;
+            case TransferKind::pq:
+                j["pq_weight"] = ch.pq_weight;
+                break;
+            case TransferKind::lut: {
+                Json points = Json::array();
+                for (const LutPoint& p : ch.lut) points.push_back(Json::array({p.drive, p.cd_m2}));
+                j["lut"] = std::move(points);
+                break;
+            }
+        }
+        channels.push_back(std::move(j));
+    }
+    return channels;
+}
+
+/// nlohmann writes NaN and ±inf as null, as JSON has no such numbers.
+std::string text(const Json& j) {
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+[[noreturn]] void missing(const std::string& what) {
+    throw InputError(SourceLocation{"", 0, 0, "fit_json"}, what);
+}
+
+double number(const Json& object, const std::string& at, const char* key) {
+    const auto it = object.find(key);
+    if (it == object.end() || !it->is_number()) missing(fmt::format("has no number {}{}", at, key));
+    return it->get<double>();
+}
+
+}  // namespace
+
+std::string measured_fit_json(const CalibrationReport& report, const DisplayModel& model,
+                              const DisplayGeometry& geometry, std::string_view method) {
+    Json ramps = Json::array();
+    for (const RampReport& r : report.ramps) {
+        Json j{{"channel", channel_name(r.channel)}};
+        j.update(gog_json(gog_params(r.fit)));
+        j.update(Json{{"effective_gamma", r.effective_gamma},
+                      {"black_cd_m2", r.black_cd_m2},
+                      {"peak_cd_m2", r.white_cd_m2},
+                      {"rmse_log10", r.fit.rmse_log10},
+                      {"n", r.fit.n},
+                      {"levels", r.levels}});
+        ramps.push_back(std::move(j));
+    }
+    Json display;
+    put_display(display, model);
+    display["channels"] = channels_json(model);
+    Json out{{"model", "gog"},
+             {"method", std::string(method)},
+             {"black_cd_m2", report.black_cd_m2},
+             {"white_cd_m2", report.white_cd_m2},
+             {"contrast_ratio", report.contrast_ratio},
+             {"pixels_per_degree", geometry.pixels_per_degree()},
+             {"n_measurements", report.n_measurements},
+             {"n_other", report.n_other},
+             {"ramps", std::move(ramps)},
+             {"display", std::move(display)},
+             {"notes", report.notes}};
+    return text(out);
+}
+
+std::string nominal_fit_json(const DisplayModel& model, const EncodeSettings& encode) {
+    Json out{{"model", "nominal"}};
+    put_display(out, model);
+    out["bits"] = encode.bits;
+    out["dither"] = encode.dither == Dither::spatiotemporal;
+    out["channels"] = channels_json(model);
+    return text(out);
+}
+
+std::optional<std::string> fit_json_model(std::string_view fit_json) {
+    const Json j = Json::parse(fit_json, nullptr, false);
+    if (!j.is_object()) return std::nullopt;
+    const auto it = j.find("model");
+    if (it == j.end() || !it->is_string()) return std::nullopt;
+    return it->get<std::string>();
+}
+
+DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string name) {
+    const Json j = Json::parse(fit_json, nullptr, false);
+    if (!j.is_object()) missing("is not a JSON object");
+    const auto display = j.find("display");
+    const bool nested = display != j.end() && display->is_object() && display->contains("channels");
+    const Json& root = nested ? *display : j;
+    const std::string at = nested ? "display." : "";
+    const auto channels = root.find("channels");
+    if (channels == root.end() || !channels->is_array() || channels->size() != 3)
+        missing(fmt::format("has no three channels {}channels", at));
+    DisplayModel model;
+    model.name = std::move(name);
+    model.peak_cd_m2 = number(root, at, "peak_cd_m2");
+    model.black_cd_m2 = number(root, at, "black_cd_m2");
+    for (std::size_t c = 0; c < 3; ++c) {
+        const Json& cj = (*channels)[c];
+        const std::string cat = fmt::format("{}channels[{}].", at, c);
+        if (!cj.is_object()) missing(fmt::format("has no object {}", cat));
+        const auto transfer = cj.find("transfer");
+        const std::string kind = transfer != cj.end() && transfer->is_string() ? transfer->get<std::string>() : "";
+        ChannelTransfer& ch = model.channels[c];
+        if (kind == "srgb" || kind == "pq") {
+            ch.kind = kind == "srgb" ? TransferKind::srgb : TransferKind::pq;
+            ch.black_cd_m2 = number(cj, cat, "black_cd_m2");
+            ch.white_cd_m2 = number(cj, cat, "white_cd_m2");
+            // Rows written before the weight was stored: a PQ channel's weight is its share of the peak.
+            if (ch.kind == TransferKind::pq)
+                ch.pq_weight =
+                    cj.contains("pq_weight") ? number(cj, cat, "pq_weight") : ch.white_cd_m2 / model.peak_cd_m2;
+        } else if (kind == "gog") {
+            ch.kind = TransferKind::gog;
+            ch.gog =
+                GogParams{number(cj, cat, "a"), number(cj, cat, "b"), number(cj, cat, "k"), number(cj, cat, "gamma")};
+        } else if (kind == "lut") {
+            ch.kind = TransferKind::lut;
+            const auto lut = cj.find("lut");
+            if (lut == cj.end() || !lut->is_array() || lut->empty()) missing(fmt::format("has no points {}lut", cat));
+            for (std::size_t i = 0; i < lut->size(); ++i) {
+                const Json& p = (*lut)[i];
+                if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
+                    missing(fmt::format("has no [drive, cd_m2] pair {}lut[{}]", cat, i));
+                ch.lut.push_back(LutPoint{p[0].get<double>(), p[1].get<double>()});
+            }
+        } else {
+            missing(fmt::format("has no known transfer {}transfer (srgb, gog, lut or pq)", cat));
+        }
+    }
+    return model;
+}
+
+}  // namespace atonlab::display

@@ -1,0 +1,31 @@
+#include "atonlab/display/geometry.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace atonlab::display {
+
+double DisplayGeometry::fov_x_rad() const {
+    return 2.0 * std::atan(0.5 * width_m / viewing_distance_m);
+}
+double DisplayGeometry::fov_y_rad() const {
+    return 2.0 * std::atan(0.5 * height_m() / viewing_distance_m);
+}
+double DisplayGeometry::pixels_per_degree_at_centre() const {
+    return focal_px() * std::numbers::pi / 180.0;
+}
+
+double DisplayGeometry::pixels_per_degree() const {
+    const double pitch_m = width_m / width_px;
+    const double pixel_deg = 2.0 * std::atan(pitch_m / (2.0 * viewing_distance_m)) * 180.0 / std::numbers::pi;
+    return 1.0 / pixel_deg;
+}
+
+std::string DisplayGeometry::describe() const {
+    return fmt::format("{} x {} px, {:.4g} x {:.4g} m at {:.4g} m: {:.1f} px/deg at the centre", width_px, height_px,
+                       width_m, height_m(), viewing_distance_m, pixels_per_degree());
+}
+
+}  // namespace atonlab::display

@@ -1,0 +1,387 @@
+// Tone mapping and adaptation (K2012 §4.4): the CPU reference of shaders/tonemap.glsl.
+// Every expression here has a twin there; keep them in step (tests/gl/test_tonemap.cpp
+// compares the two).
+#include "atonlab/display/tonemap.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "atonlab/common/error.h"
+#include "atonlab/display/colour.h"
+
+namespace atonlab::display {
+namespace {
+
+constexpr std::array<std::string_view, 6> kOperatorNames = {"empirical", "perceptual", "reinhard",
+                                                            "kakimoto",  "linear",     "clamp"};
+constexpr std::array<std::string_view, 3> kHueNames = {"none", "xyY", "rgb"};
+
+double max_component(glm::dvec3 v) {
+    return std::max(v.r, std::max(v.g, v.b));
+}
+
+// Rows of the Rec.709 RGB -> XYZ matrix (glm is column-major: m[col][row]).
+glm::dvec3 xyz_row(int row) {
+    const Mat3& m = rec709_rgb_to_xyz();
+    return {m[0][row], m[1][row], m[2][row]};
+}
+
+// Column sums: X+Y+Z of each primary at unit drive. All positive, so X+Y+Z of a
+// non-negative RGB has no cancellation.
+glm::dvec3 xyz_sum_row() {
+    return xyz_row(0) + xyz_row(1) + xyz_row(2);
+}
+
+// The piecewise TVI polynomials of eq 4.23/4.24 ("otherwise" branches); the base is
+// clamped at 0 so that a caller outside the branch's range cannot take pow of a negative.
+double rod_middle(double l) {
+    return std::pow(std::max(0.405 * l + 1.6, 0.0), 2.18) - 2.86;
+}
+double cone_middle(double l) {
+    return std::pow(std::max(0.249 * l + 0.65, 0.0), 2.7) - 0.72;
+}
+
+double sanitize_component(double v) {
+    return v > 0.0 ? std::min(v, kMaxInputCdM2) : 0.0;
+}  // NaN -> 0
+
+double clamp_adaptation(double l) {
+    return l > kMinAdaptationCdM2 ? std::min(l, kMaxAdaptationCdM2) : kMinAdaptationCdM2;  // NaN -> min
+}
+
+// Reinhard et al. 2002 eq 4 (K2012 eq 4.20) as L/(1+L) · (1 + L/W²): no L² (fp32 on the GPU
+// must not overflow) and no Inf/Inf. inv_white_sq = 1/W² (0 for W = ∞, their eq 3).
+double reinhard_curve(double l, double inv_white_sq) {
+    return l / (1.0 + l) * (1.0 + l * inv_white_sq);
+}
+
+double inverse_square(double w) {
+    return std::isinf(w) ? 0.0 : 1.0 / (w * w);
+}
+
+void require_positive(double v, const char* key, const char* what) {
+    if (!(v > 0.0) || !std::isfinite(v)) {
+        throw InputError(SourceLocation{"", 0, 0, key},
+                         fmt::format("{} must be a finite number greater than 0 (got {})", what, v));
+    }
+}
+
+// Neumaier's compensated sum.
+struct CompensatedSum {
+    double sum = 0.0, c = 0.0;
+    void add(double v) {
+        const double t = sum + v;
+        c += std::abs(sum) >= std::abs(v) ? (sum - t) + v : (v - t) + sum;
+        sum = t;
+    }
+    double value() const { return sum + c; }
+};
+
+}  // namespace
+
+std::string_view tone_operator_name(ToneOperator op) {
+    return kOperatorNames.at(static_cast<std::size_t>(op));
+}
+
+std::optional<ToneOperator> tone_operator_from_name(std::string_view name) {
+    for (std::size_t i = 0; i < kOperatorNames.size(); ++i) {
+        if (kOperatorNames[i] == name) return static_cast<ToneOperator>(i);
+    }
+    return std::nullopt;
+}
+
+std::vector<std::string> tone_operator_names() {
+    return {kOperatorNames.begin(), kOperatorNames.end()};
+}
+
+std::string_view hue_preservation_name(HuePreservation h) {
+    return kHueNames.at(static_cast<std::size_t>(h));
+}
+
+std::optional<HuePreservation> hue_preservation_from_name(std::string_view name) {
+    for (std::size_t i = 0; i < kHueNames.size(); ++i) {
+        if (kHueNames[i] == name) return static_cast<HuePreservation>(i);
+    }
+    return std::nullopt;
+}
+
+std::string_view blueshift_luminance_name(BlueshiftLuminance b) {
+    return b == BlueshiftLuminance::adaptation ? "adaptation" : "pixel";
+}
+
+std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name) {
+    if (name == "adaptation") return BlueshiftLuminance::adaptation;
+    if (name == "pixel") return BlueshiftLuminance::pixel;
+    return std::nullopt;
+}
+
+std::vector<std::string> hue_preservation_names() {
+    return {kHueNames.begin(), kHueNames.end()};
+}
+
+void validate_tonemap_settings(const ToneMapSettings& s) {
+    require_positive(s.white_relative, "tonemap.white_relative", "the empirical operator's white (L_white)");
+    require_positive(s.reinhard_key, "tonemap.reinhard_key", "Reinhard's key");
+    if (!(s.reinhard_white_relative > 0.0)) {
+        throw InputError(
+            SourceLocation{"", 0, 0, "tonemap.reinhard_white_relative"},
+            fmt::format("Reinhard's white must be greater than 0 or infinite (got {})", s.reinhard_white_relative));
+    }
+    require_positive(s.kakimoto_g, "tonemap.kakimoto_g", "Kakimoto's exponent g");
+    if (!(s.kakimoto_k > 1.0) || !std::isfinite(s.kakimoto_k)) {
+        throw InputError(
+            SourceLocation{"", 0, 0, "tonemap.kakimoto_k"},
+            fmt::format("Kakimoto's contrast k must be a finite number greater than 1 (got {})", s.kakimoto_k));
+    }
+    if (s.white_cd_m2) require_positive(*s.white_cd_m2, "tonemap.white_cd_m2", "the linear operators' white (cd/m2)");
+    require_positive(s.display_peak_cd_m2, "tonemap.display_peak_cd_m2", "the display's peak luminance (cd/m2)");
+    if (s.display_adaptation_cd_m2) {
+        require_positive(*s.display_adaptation_cd_m2, "tonemap.display_adaptation_cd_m2",
+                         "the viewer's adaptation to the display (cd/m2)");
+    }
+    const glm::dvec2 xy = s.blueshift_xy;
+    bool inside = std::isfinite(xy.x) && std::isfinite(xy.y) && xy.y > 0.0 && xy.x >= 0.0 && xy.x + xy.y <= 1.0;
+    if (inside) {
+        const glm::dvec3 rgb = xyz_to_linear_rgb(xyY_to_xyz(glm::dvec3(xy, 1.0)));
+        inside = rgb.r >= 0.0 && rgb.g >= 0.0 && rgb.b >= 0.0;
+    }
+    if (!inside) {
+        throw InputError(SourceLocation{"", 0, 0, "tonemap.blueshift_xy"},
+                         fmt::format("the blueshift chromaticity xy = ({}, {}) is not inside the Rec.709 gamut "
+                                     "(Durand & Dorsey use (0.3, 0.3))",
+                                     xy.x, xy.y));
+    }
+}
+
+double display_adaptation_cd_m2(const ToneMapSettings& s) {
+    // K2012 §4.4: "the viewer is assumed to be adapted to half the display's maximum luminance".
+    return s.display_adaptation_cd_m2 ? *s.display_adaptation_cd_m2 : 0.5 * s.display_peak_cd_m2;
+}
+
+double linear_white_cd_m2(double adaptation_cd_m2, const ToneMapSettings& s) {
+    return s.white_cd_m2 ? *s.white_cd_m2 : adaptation_cd_m2 * s.display_peak_cd_m2 / display_adaptation_cd_m2(s);
+}
+
+double rod_sensitivity(double luminance_cd_m2) {
+    // K2012 eq 4.27.
+    return kRodSigmaCdM2 / (kRodSigmaCdM2 + std::max(luminance_cd_m2, 0.0));
+}
+
+double log10_tvi_rod(double l) {
+    // K2012 eq 4.23, branches in the printed order.
+    if (l <= -3.94) return -2.86;
+    if (l >= -1.44) return l - 0.395;
+    return rod_middle(l);
+}
+
+double log10_tvi_cone(double l) {
+    // K2012 eq 4.24.
+    if (l <= -2.6) return -0.72;
+    if (l >= 1.9) return l - 1.255;
+    return cone_middle(l);
+}
+
+double scotopic_luminance(glm::dvec3 xyz) {
+    // K2012 eq 4.25 as in Larson, Rushmeier & Piatko 1997 (the thesis's (X+Y)/Z is a typo).
+    const double x = std::max(xyz.x, 0.0), y = std::max(xyz.y, 0.0), z = std::max(xyz.z, 0.0);
+    if (!(y > 0.0)) return 0.0;
+    const double ratio = x > 0.0 ? std::min((y + z) / x, kMaxScotopicRatio) : kMaxScotopicRatio;
+    return std::max(y * (1.33 * (1.0 + ratio) - 1.68), 0.0);
+}
+
+double krawczyk_key(double adaptation_cd_m2) {
+    // K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1). Written as
+    // 0.002 + δ/(2 + δ), δ = log10(1 + L) — algebraically 1.002 - 2/(2 + δ) — so that the
+    // GPU twin does not lose α (≈ 0.002 in the dark) to cancellation in fp32.
+    const double delta = std::log1p(std::max(adaptation_cd_m2, 0.0)) / std::numbers::ln10;
+    return 0.002 + delta / (2.0 + delta);
+}
+
+double adaptation_time_constant_s(double target_cd_m2) {
+    // K2012 eq 4.17.
+    const double sigma = rod_sensitivity(target_cd_m2);
+    return sigma * kTauRodS + (1.0 - sigma) * kTauConeS;
+}
+
+double temporal_adaptation(double current_cd_m2, double target_cd_m2, double dt_s) {
+    if (!std::isfinite(dt_s) || dt_s < 0.0) {
+        throw InputError(
+            fmt::format("the adaptation time step must be a finite number of seconds >= 0 (got {})", dt_s));
+    }
+    if (!std::isfinite(current_cd_m2) || !std::isfinite(target_cd_m2) || current_cd_m2 < 0.0 || target_cd_m2 < 0.0) {
+        throw InputError(fmt::format("adaptation luminances must be finite and >= 0 cd/m2 (got {} and {})",
+                                     current_cd_m2, target_cd_m2));
+    }
+    if (dt_s == 0.0) return current_cd_m2;
+    // K2012 eq 4.16, rearranged as target - (target - current)·e^(-Δt/τ): exactly the target
+    // once the exponential underflows.
+    return target_cd_m2 - (target_cd_m2 - current_cd_m2) * std::exp(-dt_s / adaptation_time_constant_s(target_cd_m2));
+}
+
+double log_average_luminance(std::span<const float> rgba, std::size_t n, double epsilon_cd_m2) {
+    if (!std::isfinite(epsilon_cd_m2) || !(epsilon_cd_m2 > 0.0)) {
+        throw InputError(
+            fmt::format("the log-average's epsilon must be a finite luminance > 0 cd/m2 (got {})", epsilon_cd_m2));
+    }
+    if (n == 0 || rgba.size() < n * 4) {
+        throw InputError("an empty image has no log-average luminance");
+    }
+    CompensatedSum sum;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float* p = &rgba[i * 4];
+        const glm::dvec3 rgb(sanitize_component(p[0]), sanitize_component(p[1]), sanitize_component(p[2]));
+        sum.add(std::log(luminance_of_linear_rgb(rgb) + epsilon_cd_m2));  // K2012 eq 4.15
+    }
+    return std::exp(sum.value() / static_cast<double>(n));
+}
+
+glm::dvec3 blueshift_rgb(glm::dvec2 xy) {
+    return xyz_to_linear_rgb(xyY_to_xyz(glm::dvec3(xy, 1.0)));
+}
+
+double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s) {
+    if (!(luminance_cd_m2 > 0.0)) return 0.0;  // black, negative or NaN
+    const double lw = std::min(luminance_cd_m2, kMaxInputCdM2);
+    const double lwa = clamp_adaptation(adaptation_cd_m2);
+    switch (s.tone_operator) {
+        case ToneOperator::empirical: {
+            const double lr = krawczyk_key(lwa) * lw / lwa;               // K2012 eq 4.18
+            return reinhard_curve(lr, inverse_square(s.white_relative));  // K2012 eq 4.20
+        }
+        case ToneOperator::reinhard: {
+            const double l = s.reinhard_key * lw / lwa;                           // Reinhard et al. 2002 eq 2
+            return reinhard_curve(l, inverse_square(s.reinhard_white_relative));  // their eq 4 (eq 3 for W = ∞)
+        }
+        case ToneOperator::kakimoto: {
+            // Kakimoto et al. 2005 eq 7, sig(x) = D (x^g + 1)/(x^g + k), x = L_w/L_wa, rescaled
+            // to (sig(x) - D/k)/(D - D/k) = x^g/(x^g + k) so that black is 0 and the limit is 1.
+            const double xg = std::pow(lw / lwa, s.kakimoto_g);
+            return xg / (xg + s.kakimoto_k);
+        }
+        case ToneOperator::perceptual: {
+            // K2012 eq 4.21-4.26 (Durand & Dorsey 2000): m_C = ε_C(L_da)/ε_C(L_wa),
+            // m_R = ε_C(L_da)/ε_R(L_wa); both systems see the photopic adaptation L_wa (the
+            // pipeline keeps no scotopic adaptation luminance), rods weighted by σ(L_wa).
+            const double lda = display_adaptation_cd_m2(s);
+            const double log_lwa = std::log10(lwa);
+            const double log_eps_display = log10_tvi_cone(std::log10(lda));
+            const double m_c = std::pow(10.0, log_eps_display - log10_tvi_cone(log_lwa));  // eq 4.22
+            const double m_r = std::pow(10.0, log_eps_display - log10_tvi_rod(log_lwa));
+            // V <= 1.33 (1 + kMaxScotopicRatio) Y (scotopic_luminance's cap).
+            const double v_max = 1.33 * (1.0 + kMaxScotopicRatio) * kMaxInputCdM2;
+            const double v = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, v_max) : 0.0;
+            return (m_c * lw + rod_sensitivity(lwa) * m_r * v) / s.display_peak_cd_m2;  // eq 4.26
+        }
+        case ToneOperator::linear:
+        case ToneOperator::clamp:
+            return lw / linear_white_cd_m2(lwa, s);
+    }
+    return 0.0;
+}
+
+glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s) {
+    const glm::dvec3 rgb(sanitize_component(rgb_cd_m2.r), sanitize_component(rgb_cd_m2.g),
+                         sanitize_component(rgb_cd_m2.b));
+    const double sum = glm::dot(xyz_sum_row(), rgb);  // X + Y + Z
+    if (!(sum > 0.0)) return glm::dvec3(0.0);
+    const double lwa = clamp_adaptation(adaptation_cd_m2);
+
+    // Colour as RGB per unit X+Y+Z: bounded (each component <= 1/0.644) and free of
+    // cancellation, so the xyY path needs no XYZ -> RGB matrix (whose negative entries cost
+    // the GPU's fp32 its accuracy on saturated colours). Its y is the pixel's chromaticity y.
+    const glm::dvec3 c = rgb / sum;
+    const double y_w = glm::dot(xyz_row(1), c);
+    const double lw = y_w * sum;
+    double v = 0.0;
+    if (s.tone_operator == ToneOperator::perceptual) {
+        v = scotopic_luminance(glm::dvec3(glm::dot(xyz_row(0), rgb), lw, glm::dot(xyz_row(2), rgb)));
+    }
+    const double ld = tone_curve(lw, v, lwa, s);
+
+    // Blueshift weights (K2012 eq 4.27-4.29) from the pixel's own luminance L_w (the
+    // equations' σ(L_w)) or from the adaptation luminance; the cone weight is L/(σ₀ + L)
+    // rather than 1 - σ, which fp32 would lose in the dark.
+    const bool per_pixel = s.blueshift_luminance == BlueshiftLuminance::pixel;
+    // The largest channel per unit luminance either end of the mix can have: no
+    // channel of the mix exceeds ld times it (a channel of a mix is at most the
+    // larger of its ends; eq 4.30 below).
+    const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
+    const double largest_per_unit = std::max(max_component(c) / y_w, max_component(b));
+    double l_sigma = per_pixel ? std::min(lw, kMaxInputCdM2) : lwa;
+    if (per_pixel && s.tone_operator == ToneOperator::clamp && ld * largest_per_unit > 1.0) {
+        // clamp clips each channel. Once a channel can clip (ld · largest > 1) the
+        // colour is frozen at that luminance, lw / (ld · largest) = L_white / largest:
+        // a mix still moving towards a saturated colour would clip more and more of
+        // it, and the output luminance would fall as the light brightens.
+        l_sigma = std::min(l_sigma, lw / (ld * largest_per_unit));
+    }
+    const double rod = s.blueshift ? rod_sensitivity(l_sigma) : 0.0;
+    const double cone = s.blueshift ? l_sigma / (kRodSigmaCdM2 + l_sigma) : 1.0;
+
+    glm::dvec3 out(0.0);
+    switch (s.hue_preservation) {
+        case HuePreservation::xyY: {
+            // K2012 eq 4.28: x_d = x_w(1-σ) + x_b σ (likewise y), Y_d = min(1, L_d) — the thesis
+            // prints max(1, L_d), a typo for the "rudimentary hue preservation" it describes.
+            // A mix in xy with weights (1-σ, σ) is the additive mix of the two colours scaled
+            // to equal X+Y+Z, so RGB_d = Y_d/y_d · ((1-σ) c_w + σ c_b), c = RGB/(X+Y+Z).
+            const glm::dvec2 bxy = s.blueshift_xy;
+            const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));
+            const double y_d = cone * y_w + rod * bxy.y;
+            out = std::min(1.0, ld) / y_d * (cone * c + rod * c_b);
+            break;
+        }
+        case HuePreservation::none:
+        case HuePreservation::rgb: {
+            // K2012 eq 4.29: RGB_w · L_d/L_w · (1-σ) + b · L_d · σ, with RGB_w/L_w = c / y_w.
+            out = ld * (cone / y_w * c + rod * b);
+            if (s.hue_preservation == HuePreservation::rgb) {
+                // K2012 eq 4.30: divided by max(1, largest channel). With σ of the pixel's
+                // own luminance the mix, and so its largest channel per unit luminance,
+                // changes with L_w: dividing by it would make a saturated light's output
+                // luminance fall as it brightens. So that case divides by ld times the
+                // largest channel either end of the mix can have (a channel of the mix
+                // is at most the larger of its ends), which keeps every channel <= 1,
+                // the ratios, and the output monotonic in L_w.
+                const double largest = per_pixel && s.blueshift ? ld * largest_per_unit : max_component(out);
+                out /= std::max(1.0, largest);
+            }
+            break;
+        }
+    }
+    if (s.tone_operator == ToneOperator::clamp) out = glm::clamp(out, 0.0, 1.0);
+    return glm::max(out, glm::dvec3(0.0));
+}
+
+ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
+    validate_tonemap_settings(s);
+    const auto f = [](double v) { return static_cast<float>(v); };
+    const auto row = [&](int r) {
+        const glm::dvec3 v = xyz_row(r);
+        return std::array<float, 4>{f(v.x), f(v.y), f(v.z), 0.0f};
+    };
+    ToneMapGpuParams p;
+    p.mode = {static_cast<std::uint32_t>(s.tone_operator), static_cast<std::uint32_t>(s.hue_preservation),
+              s.blueshift ? static_cast<std::uint32_t>(s.blueshift_luminance) : 0u, s.white_cd_m2 ? 1u : 0u};
+    p.curve = {f(inverse_square(s.white_relative)), f(s.reinhard_key), f(inverse_square(s.reinhard_white_relative)),
+               f(s.kakimoto_g)};
+    const double lda = display_adaptation_cd_m2(s);
+    p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
+    const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(max_component(b)), 0.0f};
+    p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
+    const glm::dvec2 bxy = s.blueshift_xy;
+    const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));
+    p.blue_per_sum = {f(c_b.r), f(c_b.g), f(c_b.b), 0.0f};
+    p.rgb_to_x = row(0);
+    p.rgb_to_y = row(1);
+    p.rgb_to_z = row(2);
+    return p;
+}
+
+}  // namespace atonlab::display
