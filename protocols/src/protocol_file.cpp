@@ -166,7 +166,7 @@ public:
         if (!f) return std::nullopt;
         const std::string text = doc_.string(f->node, f->key, context_);
         if (auto e = parse(text)) return e;
-        fail(*f, fmt::format("{} must be one of {}, got \"{}\".", key, detail::join_quoted(allowed), text));
+        fail(*f, fmt::format("{} must be one of {}, got \"{}\".", key, toml_reader::join_quoted(allowed), text));
     }
 
 private:
@@ -219,7 +219,7 @@ public:
                 doc_.fail(f.node, f.key,
                           cond_.context() + fmt::format("expected a procedure table (procedure = {{ kind = "
                                                         "\"staircase\", ... }}), got {}.",
-                                                        detail::type_phrase(f.node->type())));
+                                                        text::type_phrase(f.node->type())));
             const toml::table& t = *f.node->as_table();
             table_ = f;
             if (const toml::node* k = t.get("kind")) {
@@ -228,7 +228,7 @@ public:
                 if (!parsed)
                     doc_.fail(k, f.key + ".kind",
                               cond_.context() + fmt::format("kind must be one of {}, got \"{}\".",
-                                                            detail::join_quoted(kKindNames), text));
+                                                            toml_reader::join_quoted(kKindNames), text));
                 if (kind_ && *kind_ != *parsed) entries_.clear();
                 kind_ = parsed;
                 kind_at_ = Found{k, f.key + ".kind"};
@@ -248,8 +248,8 @@ public:
                     doc_.fail_at_key(
                         key, f.key + "." + std::string(key.str()),
                         cond_.context() + fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", key.str(), what,
-                                                      detail::suggestion(key.str(), allowed),
-                                                      detail::join_quoted(allowed)));
+                                                      text::did_you_mean(key.str(), allowed),
+                                                      toml_reader::join_quoted(allowed)));
                 }
                 if (key.str() != "kind")
                     entries_[std::string(key.str())] = Found{&value, f.key + "." + std::string(key.str())};
@@ -440,9 +440,9 @@ public:
         try {
             root_ = toml::parse(text, doc_.file());
         } catch (const toml::parse_error& e) {
-            throw ProtocolError(doc_.file(), static_cast<int>(e.source().begin.line),
-                                static_cast<int>(e.source().begin.column), "",
-                                fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
+            throw InputError(SourceLocation{doc_.file(), static_cast<int>(e.source().begin.line),
+                                            static_cast<int>(e.source().begin.column), ""},
+                             fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
         }
         text_ = std::string(text);
         step([&] { expand_conditions_files(); });
@@ -462,11 +462,7 @@ public:
         step([&] { read_blocks(root, p); });
         step([&] { read_responses(root, p); });
         doc_.collect_into(nullptr);
-        if (!errors_.empty()) {
-            const text::Problem first = errors_.in_file_order().front();
-            throw ProtocolError(first.file, first.line, first.column, first.key, first.message,
-                                errors_.further_lines());
-        }
+        errors_.throw_if_any();
         return p;
     }
 
@@ -596,7 +592,8 @@ private:
         std::string error;
         const auto header = csv_fields(lines.empty() ? std::string_view() : std::string_view(lines.front()), error);
         if (!header || header->empty() || (header->size() == 1 && header->front().empty()))
-            throw ProtocolError(file, 1, 0, "", error.empty() ? "the conditions file has no header row." : error);
+            throw InputError(SourceLocation{file, 1, 0, ""},
+                             error.empty() ? "the conditions file has no header row." : error);
         // What each column is.
         enum class Kind { name, block, string_key, other_key, procedure, set, test_set, reference_set };
         constexpr std::string_view kStringKeys[] = {"task",      "presentation", "prompt",
@@ -608,7 +605,7 @@ private:
             const std::string& h = (*header)[c];
             const int col = static_cast<int>(c) + 1;
             auto fail = [&](const std::string& m) {
-                throw ProtocolError(file, 1, col, "", fmt::format("column {} '{}': {}", col, h, m));
+                throw InputError(SourceLocation{file, 1, col, ""}, fmt::format("column {} '{}': {}", col, h, m));
             };
             if (h.empty()) fail("the column has no name.");
             if (!seen.insert(h).second) fail("the column appears twice in the header.");
@@ -634,7 +631,7 @@ private:
                                 "left_position_m, right_position_m), procedure.PARAMETER, a scene key "
                                 "(section.key, a `set` override), test:KEY or reference:KEY (test_set, "
                                 "reference_set), or block.{}",
-                                detail::join_quoted(kStringKeys), text::did_you_mean(h, kStringKeys)));
+                                toml_reader::join_quoted(kStringKeys), text::did_you_mean(h, kStringKeys)));
         }
         // One TOML line per CSV line: row N of the file is line N of the text.
         std::string toml_text = "\n";
@@ -649,10 +646,9 @@ private:
                 continue;
             }
             const auto cells = csv_fields(lines[li], error);
-            if (!cells) throw ProtocolError(file, line, 0, "", error);
+            if (!cells) throw InputError(SourceLocation{file, line, 0, ""}, error);
             if (cells->size() != header->size())
-                throw ProtocolError(
-                    file, line, 0, "",
+                throw InputError(SourceLocation{file, line, 0, ""},
                     fmt::format("the row has {} fields where the header has {}.", cells->size(), header->size()));
             Document::CsvRow row;
             row.file = file;
@@ -717,8 +713,7 @@ private:
         try {
             parsed = toml::parse(toml_text, file);
         } catch (const toml::parse_error& e) {
-            throw ProtocolError(
-                file, static_cast<int>(e.source().begin.line), 0, "",
+            throw InputError(SourceLocation{file, static_cast<int>(e.source().begin.line), 0, ""},
                 fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
         }
         if (rows.empty())
@@ -744,7 +739,7 @@ private:
     /// Runs one part of the reading; its error is kept and the reading goes on.
     template <class F>
     bool step(F&& f) {
-        return errors_.attempt<ProtocolError>(f, Document::problem);
+        return errors_.attempt(f);
     }
 
     /// Where a key written in the wrong table belongs (Section::allow's
@@ -928,7 +923,7 @@ private:
                             doc_.fail(n, ss.key_path(action),
                                       fmt::format("\"{}\" is not a {} name.{} See docs/protocol-file.md for the "
                                                   "names.",
-                                                  name, what, detail::suggestion(name, names)));
+                                                  name, what, text::did_you_mean(name, names)));
                     table[a] = std::move(v);
                     nodes[a] = n;
                     paths[a] = ss.key_path(action);
@@ -1004,7 +999,7 @@ private:
         if (!blocks->is_array_of_tables())
             doc_.fail(
                 blocks, "block",
-                fmt::format("expected an array of tables [[block]], got {}.", detail::type_phrase(blocks->type())));
+                fmt::format("expected an array of tables [[block]], got {}.", text::type_phrase(blocks->type())));
         std::vector<std::string_view> block_keys(std::begin(kBlockOwnKeys), std::end(kBlockOwnKeys));
         block_keys.insert(block_keys.end(), std::begin(kConditionKeys), std::end(kConditionKeys));
 
@@ -1088,7 +1083,7 @@ private:
             if (!conds->is_array_of_tables())
                 doc_.fail(conds, bs.key_path("condition"),
                           fmt::format("expected an array of tables [[block.condition]], got {}.",
-                                      detail::type_phrase(conds->type())));
+                                      text::type_phrase(conds->type())));
             return conds->as_array();
         }
     }
@@ -1205,7 +1200,7 @@ private:
         if (!pr.kind())
             doc_.fail(pr.table()->node, pr.table()->key + ".kind",
                       r.context() + fmt::format("the procedure has no kind: give kind = one of {}.",
-                                                detail::join_quoted(kKindNames)));
+                                                toml_reader::join_quoted(kKindNames)));
         const bool adjustment = *pr.kind() == ProcedureKind::Adjustment;
         if (adjustment != (c.task == Task::Adjust))
             r.fail(
@@ -1430,7 +1425,8 @@ std::string read_text(const std::filesystem::path& file) {
     // the memory runs out.
     text::FileText read = text::read_text_file(file);
     if (!read.ok())
-        throw ProtocolError(file.string(), 0, 0, "", fmt::format("cannot read the protocol file: {}.", read.error));
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the protocol file: {}.", read.error));
     return std::move(read.text);
 }
 

@@ -102,10 +102,6 @@ std::string read_text(const std::filesystem::path& file, std::string_view what,
     return std::move(read.text);
 }
 
-InputError input_error(const p::ProtocolError& e) {
-    return InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message(), e.further());
-}
-
 /// The response codes of trials the procedure never saw (docs/running.md,
 /// "Missed frames and timeouts"): shown again, skipped on replay.
 bool is_uncounted(std::string_view response) {
@@ -540,7 +536,7 @@ s::Scene condition_scene(const std::string& scene_text, const std::filesystem::p
         return scene;
     } catch (const InputError& e) {
         const std::optional<SourceLocation>& w = e.where();
-        const bool from_override = w && w->file.rfind("--set", 0) == 0;
+        const bool from_override = w && w->option == "--set";
         if (!from_override) {
             // The scene file's own error (it names its file and line), or a
             // setting that only the combination of overrides breaks.
@@ -551,7 +547,7 @@ s::Scene condition_scene(const std::string& scene_text, const std::filesystem::p
                                          condition.name, scene_file.filename().string(), e.message()));
         }
         // "--set KEY" (a value) or "--set" with the key: the override's key.
-        std::string key = w->file.size() > 6 ? w->file.substr(6) : w->key;
+        std::string key = w->key;
         std::string text;
         for (const std::string& o : frame.overrides)
             if (o.compare(0, key.size() + 1, key + "=") == 0) text = o;
@@ -1122,14 +1118,9 @@ int run_session(const RunOptions& o) {
                                      code));
 
     // --- Load and validate everything before the first trial.
-    p::Protocol protocol;
+    p::Protocol protocol = p::load_protocol(o.protocol);
     std::optional<p::ScriptedObserver> script;
-    try {
-        protocol = p::load_protocol(o.protocol);
-        if (!o.script.empty()) script = p::ScriptedObserver::load(o.script);
-    } catch (const p::ProtocolError& e) {
-        throw input_error(e);
-    }
+    if (!o.script.empty()) script = p::ScriptedObserver::load(o.script);
     // The protocol file's text, with its conditions files (if any) appended as
     // comments: the study stores the whole design (protocol_file.h).
     const std::string protocol_text = p::with_conditions_files(read_text(o.protocol, "protocol file"), o.protocol);
@@ -1445,9 +1436,9 @@ int run_session(const RunOptions& o) {
             if (!person) {
                 try {
                     answer = observer.answer(t, &renderer);
-                } catch (const p::ProtocolError& e) {
+                } catch (const InputError& e) {
                     // The script ran out or does not fit: what is stored stays, and the session can go on.
-                    throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()},
+                    throw InputError(e.where().value_or(SourceLocation{}),
                                      fmt::format("{} Session {} stays open: continue it with --resume {}.", e.message(),
                                                  session.value, session.value));
                 }

@@ -30,6 +30,7 @@
 #include "atonlab/common/error_list.h"
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
+#include "atonlab/common/toml_reader.h"
 #include "atonlab/common/toml_text.h"
 #include "atonlab/stimuli/calibration.h"
 #include "atonlab/stimuli/colour.h"
@@ -44,14 +45,14 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr std::string_view kSetFile = "--set";
+constexpr std::string_view kSetOption = "--set";
 constexpr std::string_view kSetPrefix = "--set ";  // source path of an override's value: "--set KEY"
 
 // ---------------------------------------------------------------------------
 // The schema: the keys each table takes. Unknown keys are errors, so a typo
 // ("intensity_cdd") is reported instead of silently taking a default.
 
-using KeyList = std::span<const std::string_view>;
+using toml_reader::KeyList;
 
 constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light",
                                            "disc"};
@@ -114,51 +115,48 @@ std::string join(const Range& items, std::string_view quote = "'") {
     return s;
 }
 
-/// " Did you mean 'x'?" for the nearest allowed key, or "" (common/toml_text.h).
-std::string suggestion(std::string_view key, KeyList allowed) { return text::did_you_mean(key, allowed); }
-
+using text::did_you_mean;
 using text::type_phrase;
-
-std::string number_text(double v) {
-    return fmt::format("{}", v);
-}
+using toml_reader::number_text;
 
 // ---------------------------------------------------------------------------
-// Where a node came from.
+// Where a node came from: the scene file, or an override (common/toml_reader.h
+// reads the values; this document says where an overridden one was written).
 
-class Document {
+using toml_reader::Section;
+
+class Document : public toml_reader::Document {
 public:
-    explicit Document(std::string file) : file_(std::move(file)) {}
-
-    const std::string& file() const { return file_; }
+    using toml_reader::Document::Document;
 
     /// Location of a node with its dotted schema key ("light[2].intensity_cd").
-    SourceLocation where(const toml::node* node, const std::string& key) const {
+    SourceLocation where(const toml::node* node, const std::string& key) const override {
         if (node != nullptr) {
             const auto& path = node->source().path;
             if (path && path->starts_with(kSetPrefix)) return override_location(path->substr(kSetPrefix.size()), key);
             if (auto it = made_for_override_.find(node); it != made_for_override_.end())
                 return override_location(it->second, key);
             if (node->source().begin.line > 0)
-                return {file_, static_cast<int>(node->source().begin.line),
+                return {file(), static_cast<int>(node->source().begin.line),
                         static_cast<int>(node->source().begin.column), key};
         }
-        return {file_, 0, 0, key};
+        return {file(), 0, 0, key};
     }
-    SourceLocation where(const toml::key& k, const std::string& key) const {
+    SourceLocation where(const toml::key& k, const std::string& key) const override {
         const auto& path = k.source().path;
         if (path && path->starts_with(kSetPrefix)) return override_location(path->substr(kSetPrefix.size()), key);
-        return {file_, static_cast<int>(k.source().begin.line), static_cast<int>(k.source().begin.column), key};
+        return toml_reader::Document::where(k, key);
     }
 
-    [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& message) const {
-        SourceLocation w = where(node, key);
+protected:
+    void relocate(SourceLocation& w, std::string& message) const override {
         // A type error in an override that was not valid TOML says so.
-        if (w.file == kSetFile && message.ends_with("got a string."))
+        if (w.option == kSetOption && message.ends_with("got a string."))
             if (auto it = string_fallbacks_.find(w.key); it != string_fallbacks_.end())
-                throw InputError(std::move(w), message.substr(0, message.size() - 1) + it->second + ".");
-        throw InputError(std::move(w), message);
+                message = message.substr(0, message.size() - 1) + it->second + ".";
     }
+
+public:
 
     /// Records an applied override: its key as typed and its schema key
     /// ("light.buoy.intensity_cd" -> "light[0].intensity_cd"), and where it
@@ -191,173 +189,25 @@ private:
             key += schema_key.substr(it->second.size());
         if (auto it = origins_.find(typed); it != origins_.end())
             return {it->second.file, it->second.line, it->second.column, key};
-        return {std::string(kSetFile), 0, 0, key};
+        return SourceLocation::command_line(std::string(kSetOption), key);
     }
 
-    std::string file_;
     std::map<std::string, std::string> override_keys_;
     std::map<std::string, SourceLocation> origins_;  // typed key -> where a file wrote it
     std::map<const toml::node*, std::string> made_for_override_;
     std::map<std::string, std::string> string_fallbacks_;
 };
 
-// ---------------------------------------------------------------------------
-// Reading one table of the schema.
-
-class Section {
-public:
-    /// path: dotted key of the table ("display", "light[2]"); title: how a
-    /// sentence names it ("the [display] table", "[[light]] \"buoy\"").
-    Section(const Document& doc, const toml::table& table, std::string path, std::string title)
-        : doc_(doc), table_(table), path_(std::move(path)), title_(std::move(title)) {}
-
-    const toml::table& table() const { return table_; }
-    const std::string& path() const { return path_; }
-    const std::string& title() const { return title_; }
-    /// Prefix for value errors, e.g. "in light \"buoy\", ".
-    void set_context(std::string context) { context_ = std::move(context); }
-    void set_title(std::string title) { title_ = std::move(title); }
-
-    std::string key_path(std::string_view key) const {
-        return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-    }
-
-    [[noreturn]] void fail(const toml::node* node, std::string_view key, const std::string& message) const {
-        doc_.fail(node, key_path(key), context_ + message);
-    }
-    [[noreturn]] void fail_table(const std::string& message) const { doc_.fail(&table_, path_, context_ + message); }
-
-    /// Every key must be in the allowed list.
-    void allow(KeyList allowed) const {
-        for (auto&& [k, v] : table_) {
-            if (contains(allowed, k.str())) continue;
-            throw InputError(doc_.where(k, key_path(k.str())),
-                             fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", text::echo(k.str()), title_,
-                                         suggestion(k.str(), allowed), join(allowed)));
-        }
-    }
-
-    const toml::node* get(std::string_view key) const { return table_.get(key); }
-    bool has(std::string_view key) const { return table_.contains(key); }
-
-    [[noreturn]] void missing(std::string_view key, std::string_view what) const {
-        const SourceLocation w = doc_.where(&table_, path_);
-        const std::string at_line =
-            w.file != kSetFile && w.line > 0 ? fmt::format(" (line {})", w.line) : std::string();
-        doc_.fail(&table_, key_path(key),
-                  fmt::format("{}{} has no '{}', which is required ({}).", title_, at_line, key, what));
-    }
-
-    // Values, type-checked and finite. Integers are accepted as numbers.
-    std::optional<double> number(std::string_view key) const {
-        const toml::node* n = get(key);
-        if (n == nullptr) return std::nullopt;
-        return number_of(n, key_path(key), std::string(key));
-    }
-    double number_or(std::string_view key, double fallback) const { return number(key).value_or(fallback); }
-    double required_number(std::string_view key, std::string_view what) const {
-        if (auto v = number(key)) return *v;
-        missing(key, what);
-    }
-
-    std::optional<int> integer(std::string_view key, int min, int max) const {
-        const toml::node* n = get(key);
-        if (n == nullptr) return std::nullopt;
-        if (!n->is_integer()) fail(n, key, fmt::format("expected an integer, got {}.", type_phrase(n->type())));
-        const std::int64_t v = n->as_integer()->get();
-        if (v < min || v > max) fail(n, key, fmt::format("{} must be between {} and {}, got {}.", key, min, max, v));
-        return static_cast<int>(v);
-    }
-
-    std::optional<bool> boolean(std::string_view key) const {
-        const toml::node* n = get(key);
-        if (n == nullptr) return std::nullopt;
-        if (!n->is_boolean()) fail(n, key, fmt::format("expected true or false, got {}.", type_phrase(n->type())));
-        return n->as_boolean()->get();
-    }
-
-    std::optional<std::string> string(std::string_view key) const {
-        const toml::node* n = get(key);
-        if (n == nullptr) return std::nullopt;
-        if (!n->is_string()) fail(n, key, fmt::format("expected a string, got {}.", type_phrase(n->type())));
-        return n->as_string()->get();
-    }
-
-    /// A numeric array; size_required 0 = any length of at least min_size.
-    std::optional<std::vector<double>> numbers(std::string_view key, std::size_t size_required,
-                                               std::size_t min_size = 0) const {
-        const toml::node* n = get(key);
-        if (n == nullptr) return std::nullopt;
-        const std::string shape = size_required == 3   ? "an array of 3 numbers [x, y, z]"
-                                  : size_required == 2 ? "an array of 2 numbers"
-                                                       : "an array of numbers";
-        if (!n->is_array()) fail(n, key, fmt::format("expected {}, got {}.", shape, type_phrase(n->type())));
-        const toml::array& a = *n->as_array();
-        if (size_required != 0 && a.size() != size_required)
-            fail(n, key, fmt::format("expected {}, got {} element{}.", shape, a.size(), a.size() == 1 ? "" : "s"));
-        if (a.size() < min_size) fail(n, key, fmt::format("expected at least {} numbers, got {}.", min_size, a.size()));
-        std::vector<double> out;
-        out.reserve(a.size());
-        for (std::size_t i = 0; i < a.size(); ++i) {
-            const std::string element = fmt::format("{}[{}]", key, i);
-            out.push_back(number_of(a.get(i), key_path(element), element));
-        }
-        return out;
-    }
-
-    std::optional<glm::dvec3> vec3(std::string_view key) const {
-        auto v = numbers(key, 3);
-        if (!v) return std::nullopt;
-        return glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
-    }
-
-    // Range checks with one sentence each.
-    void at_least(std::string_view key, double v, double min) const {
-        if (!(v >= min))
-            fail(get(key), key, fmt::format("{} must be at least {}, got {}.", key, number_text(min), number_text(v)));
-    }
-    void greater_than(std::string_view key, double v, double min) const {
-        if (!(v > min))
-            fail(get(key), key,
-                 fmt::format("{} must be greater than {}, got {}.", key, number_text(min), number_text(v)));
-    }
-    void within(std::string_view key, double v, double lo, double hi) const {
-        if (!(v >= lo && v <= hi))
-            fail(get(key), key,
-                 fmt::format("{} must be between {} and {}, got {}.", key, number_text(lo), number_text(hi),
-                             number_text(v)));
-    }
-
-private:
-    double number_of(const toml::node* n, const std::string& full_key, const std::string& short_key) const {
-        double v = 0.0;
-        if (n->is_integer()) {
-            v = static_cast<double>(n->as_integer()->get());
-        } else if (n->is_floating_point()) {
-            v = n->as_floating_point()->get();
-        } else {
-            doc_.fail(n, full_key, context_ + fmt::format("expected a number, got {}.", type_phrase(n->type())));
-        }
-        if (!std::isfinite(v))
-            doc_.fail(n, full_key,
-                      context_ + fmt::format("{} must be a finite number, got {}.", short_key, number_text(v)));
-        return v;
-    }
-
-    const Document& doc_;
-    const toml::table& table_;
-    std::string path_;
-    std::string title_;
-    std::string context_;
-};
-
 /// The sub-table `key` of `parent`, or nullptr when absent; an error when it is not a table.
 const toml::table* sub_table(const Section& parent, std::string_view key, std::string_view as_written) {
-    const toml::node* n = parent.get(key);
-    if (n == nullptr) return nullptr;
-    if (!n->is_table())
-        parent.fail(n, key, fmt::format("expected a table {}, got {}.", as_written, type_phrase(n->type())));
-    return n->as_table();
+    return parent.table(key, as_written);
+}
+
+/// A [x, y, z] array as a vector.
+std::optional<glm::dvec3> vec3(const Section& s, std::string_view key) {
+    auto v = s.numbers(key, 3);
+    if (!v) return std::nullopt;
+    return glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
 }
 
 double wrap_degrees(double deg) {
@@ -592,7 +442,7 @@ Camera read_camera(const Document& doc, const Section& root) {
     if (t == nullptr) return c;
     Section s(doc, *t, "camera", "the [camera] table");
     s.allow(kCameraKeys);
-    if (auto p = s.vec3("position_m")) c.position_m = *p;
+    if (auto p = vec3(s, "position_m")) c.position_m = *p;
     c.yaw_deg = s.number_or("yaw_deg", 0.0);
     c.pitch_deg = s.number_or("pitch_deg", 0.0);
     c.roll_deg = s.number_or("roll_deg", 0.0);
@@ -766,7 +616,7 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
     if (auto img = s.string("aperture_image")) {
         // Relative to the scene file, like every path in it.
         std::filesystem::path p(*img);
-        if (p.is_relative() && doc.file() != kSetFile) p = std::filesystem::path(doc.file()).parent_path() / p;
+        if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;
         if (!std::filesystem::is_regular_file(p))
             s.fail(s.get("aperture_image"), "aperture_image",
                    fmt::format("the aperture image {} does not exist or is not a file.", p.string()));
@@ -841,7 +691,7 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
                                transfer));
         if (auto cal = s.string("calibration")) {
             std::filesystem::path p(*cal);
-            if (p.is_relative() && doc.file() != kSetFile) p = std::filesystem::path(doc.file()).parent_path() / p;
+            if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;
             try {
                 out.display = display_from_calibration(fit_calibration(read_calibration_file(p)), p.stem().string());
             } catch (const InputError& e) {
@@ -984,7 +834,7 @@ struct SceneBuilder {
         s.set_context(fmt::format("in light \"{}\", ", text::echo(light.name)));
         s.set_title(fmt::format("[[light]] \"{}\" ({})", text::echo(light.name), path));
 
-        auto position = s.vec3("position_m");
+        auto position = vec3(s, "position_m");
         if (!position) s.missing("position_m", "the light's position [x, y, z] in metres");
         light.position_m = *position;
         light.intensity_cd = s.required_number("intensity_cd", "the light's peak luminous intensity in cd");
@@ -1085,7 +935,7 @@ struct SceneBuilder {
         if (disc.name.empty()) s.fail(s.get("name"), "name", "a disc's name must not be empty.");
         s.set_context(fmt::format("in disc \"{}\", ", text::echo(disc.name)));
         s.set_title(fmt::format("[[disc]] \"{}\" ({})", text::echo(disc.name), path));
-        auto position = s.vec3("position_m");
+        auto position = vec3(s, "position_m");
         if (!position) s.missing("position_m", "a point [x, y, z] in metres on the line of sight to the disc's centre");
         disc.position_m = *position;
         disc.diameter_deg = s.required_number("diameter_deg", "the disc's angular diameter in degrees");
@@ -1144,7 +994,7 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
         const toml::node* n = node_in(table, key);
         if (n == nullptr) return std::string(" (not given)");
         const SourceLocation w = doc.where(n, fmt::format("{}.{}", table, key));
-        if (w.file == kSetFile) return std::string(" (--set)");
+        if (w.from_command_line()) return std::string(" (--set)");
         if (w.file != doc.file()) return fmt::format(" ({}:{})", w.file, w.line);  // e.g. a protocol's [display]
         return w.line > 0 ? fmt::format(" (line {})", w.line) : std::string();
     };
@@ -1182,15 +1032,13 @@ void read_discs(const Section& root, SceneBuilder& builder) {
     for (std::size_t i = 0; i < a.size(); ++i) builder.read_disc(*a.get(i), i);
 }
 
-Scene build_scene(const Document& doc, const toml::table& root_table) {
+Scene build_scene(Document& doc, const toml::table& root_table) {
     // Every table (and every light) is read even after an error in another:
     // all the errors, in file order, in one run (text::ErrorList; docs/scene-file.md).
     text::ErrorList errors;
-    const auto problem = [](const InputError& e) {
-        const SourceLocation w = e.where().value_or(SourceLocation{});
-        return text::Problem{w.file, w.line, w.column, w.key, e.message(), e.what()};
-    };
-    const auto step = [&](auto&& f) { return errors.attempt<InputError>(f, problem); };
+    const auto step = [&](auto&& f) { return errors.attempt(f); };
+    // Every unknown key of a table is reported, not only the first (Section::allow).
+    doc.collect_into(&errors);
     Section root(doc, root_table, "", "the scene");
     // Unknown top-level tables are reported with the list of sections.
     for (auto&& entry : root_table) {
@@ -1203,7 +1051,7 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
             throw InputError(
                 doc.where(k, std::string(k.str())),
                 fmt::format("unknown {} '{}'.{} A scene has the tables {}.", v.is_table() ? "table" : "key",
-                            text::echo(k.str()), suggestion(k.str(), kSections), join(kSections)));
+                            text::echo(k.str()), did_you_mean(k.str(), kSections), join(kSections)));
         });
     }
     Scene scene;
@@ -1242,11 +1090,8 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
     // The billboard check needs the display, the output and each light's own
     // glare model as read.
     if (output_read && errors.empty()) step([&] { check_billboard(doc, root, scene); });
-    if (!errors.empty()) {
-        const text::Problem first = errors.in_file_order().front();
-        throw InputError(SourceLocation{first.file, first.line, first.column, first.key}, first.message,
-                         errors.further_lines());
-    }
+    doc.collect_into(nullptr);
+    errors.throw_if_any();
     return scene;
 }
 
@@ -1254,7 +1099,7 @@ Scene build_scene(const Document& doc, const toml::table& root_table) {
 // Overrides.
 
 [[noreturn]] void override_error(const std::string& key, const std::string& message) {
-    throw InputError(SourceLocation{std::string(kSetFile), 0, 0, key}, message);
+    throw InputError(SourceLocation::command_line(std::string(kSetOption), key), message);
 }
 
 /// A TOML basic string holding `text`, for values that are not valid TOML.
@@ -1382,7 +1227,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
     const auto unknown = [&](std::string_view section, KeyList allowed, std::string_view leaf) {
         override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", text::echo(leaf),
                                       text::echo(section),
-                                      suggestion(leaf, allowed), join(allowed)));
+                                      did_you_mean(leaf, allowed), join(allowed)));
     };
 
     if (k == "light" || k.starts_with("light.") || k.starts_with("light[")) {
@@ -1446,7 +1291,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
         if (!same) {
             const SourceLocation w = doc.where(old, schema_key);
             const std::string from =
-                w.file == kSetFile ? std::string("an earlier --set") : fmt::format("{}:{}", w.file, w.line);
+                w.from_command_line() ? std::string("an earlier --set") : fmt::format("{}:{}", w.file, w.line);
             override_error(k, fmt::format("expected {} like the value it replaces ({}), got {}{}.",
                                           is_number(*old) ? std::string_view("a number") : type_phrase(old->type()),
                                           from, type_phrase(value->type()), note));
@@ -1472,13 +1317,13 @@ SceneOverride SceneOverride::parse(std::string_view text) {
     };
     const auto eq = text.find('=');
     if (eq == std::string_view::npos)
-        throw InputError(SourceLocation{std::string(kSetFile), 0, 0, std::string(trim(text))},
+        throw InputError(SourceLocation::command_line(std::string(kSetOption), std::string(trim(text))),
                          fmt::format("expected KEY=VALUE, e.g. camera.yaw_deg=45, got \"{}\".", text::echo(text)));
     SceneOverride o;
     o.key = std::string(trim(text.substr(0, eq)));
     o.value = std::string(trim(text.substr(eq + 1)));
     if (o.key.empty())
-        throw InputError(SourceLocation{std::string(kSetFile), 0, 0, ""},
+        throw InputError(SourceLocation::command_line(std::string(kSetOption)),
                          fmt::format("the key before '=' is empty in \"{}\".", text::echo(text)));
     return o;
 }

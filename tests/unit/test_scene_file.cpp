@@ -504,7 +504,7 @@ TEST(SceneFileGlare, BadCieObserverNamesFileLineAndKey) {
     expect_error_at(eye + "cie_age_years = 100\ncie_pigmentation = 1.2\n", 8, "eye.cie_age_years",
                     "more than all of it");
     const InputError e = error_of(std::string(kMinimal), sets({"eye.cie_age_years=-1"}));
-    EXPECT_EQ(e.where()->file, "--set");
+    EXPECT_EQ(e.where()->option, "--set");
     EXPECT_EQ(e.where()->key, "eye.cie_age_years");
 }
 
@@ -630,7 +630,7 @@ TEST(SceneOverrides, AddKeysAndTablesTheFileLeavesOut) {
 TEST(SceneOverrides, WrongTypeIsRejected) {
     const InputError e = error_of(kFullScene, sets({"camera.yaw_deg=\"north\""}));
     ASSERT_TRUE(e.where().has_value());
-    EXPECT_EQ(e.where()->file, "--set");
+    EXPECT_EQ(e.where()->option, "--set");
     EXPECT_EQ(e.where()->key, "camera.yaw_deg");
     const std::string what = e.what();
     EXPECT_NE(what.find("expected a number like the value it replaces (harbour.toml:10), got a string"),
@@ -661,7 +661,7 @@ TEST(SceneOverrides, UnknownKeysAreRejectedNamingSet) {
                             "light[9].intensity_cd=1", "profiles.vertical.lantern.relativ=[1, 1]", "camera=4"}) {
         const InputError e = error_of(kFullScene, sets({bad}));
         ASSERT_TRUE(e.where().has_value()) << bad;
-        EXPECT_EQ(e.where()->file, "--set") << bad;
+        EXPECT_EQ(e.where()->option, "--set") << bad;
         EXPECT_TRUE(std::string(e.what()).starts_with("--set: key '")) << e.what();
     }
     const InputError e = error_of(kFullScene, sets({"camera.yaw=4"}));
@@ -675,7 +675,7 @@ TEST(SceneOverrides, ValidationErrorsPointAtTheOverride) {
     const InputError s =
         error_of(kFullScene, sets({"light.buoy.horizontal_profile=\"uniform\"",
                                    "light.buoy.sectors=[{from_deg = 10, to_deg = 20}, {from_deg = 1}]"}));
-    EXPECT_EQ(s.where()->file, "--set");
+    EXPECT_EQ(s.where()->option, "--set");
     EXPECT_EQ(s.where()->key, "light.buoy.sectors[1].to_deg") << s.what();
     const InputError r = error_of(kFullScene, sets({"light[2].rhythm=Blink"}));
     EXPECT_EQ(r.where()->key, "light[2].rhythm");
