@@ -86,29 +86,55 @@ SceneOverride SceneOverride::parse(std::string_view text) {
     return o;
 }
 
-Scene parse_scene(std::string_view toml_text, std::string_view file_label,
-                  const std::vector<SceneOverride>& overrides) {
-    Document doc{std::string(file_label)};
-    toml::table root;
+// The text is kept and parsed again by each instantiate(): toml++ drops a
+// node's source region when it is copied ("does not copy source information"),
+// and every error must keep the file's line, so a copy of one parsed tree
+// cannot serve. The template checks the syntax once, and reads the file once.
+struct SceneTemplate::Parsed {
+    std::string file_label;
+    std::string text;
+};
+
+SceneTemplate SceneTemplate::parse(std::string_view toml_text, std::string_view file_label) {
+    auto parsed = std::make_shared<Parsed>();
+    parsed->file_label = std::string(file_label);
+    parsed->text = std::string(toml_text);
     try {
-        root = toml::parse(toml_text, file_label);
+        (void)toml::parse(toml_text, file_label);
     } catch (const toml::parse_error& e) {
         throw InputError(SourceLocation{std::string(file_label), static_cast<int>(e.source().begin.line),
                                         static_cast<int>(e.source().begin.column), ""},
                          fmt::format("TOML syntax error: {}.", std::string(e.description())));
     }
-    for (const SceneOverride& o : overrides) apply_override(doc, root, o);
-    return build_scene(doc, root);
+    return SceneTemplate(std::move(parsed));
 }
 
-Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+SceneTemplate SceneTemplate::load(const std::filesystem::path& file) {
     // Read only up to a limit: /dev/zero or a video file given by mistake is
     // refused, not read until the memory runs out.
     const text::FileText read = text::read_text_file(file);
     if (!read.ok())
         throw InputError(SourceLocation{file.string(), 0, 0, ""},
                          fmt::format("cannot read the scene file: {}.", read.error));
-    return parse_scene(read.text, file.string(), overrides);
+    return parse(read.text, file.string());
+}
+
+const std::string& SceneTemplate::file_label() const noexcept { return parsed_->file_label; }
+
+Scene SceneTemplate::instantiate(const std::vector<SceneOverride>& overrides) const {
+    Document doc{parsed_->file_label};
+    toml::table root = toml::parse(parsed_->text, parsed_->file_label);
+    for (const SceneOverride& o : overrides) apply_override(doc, root, o);
+    return build_scene(doc, root);
+}
+
+Scene parse_scene(std::string_view toml_text, std::string_view file_label,
+                  const std::vector<SceneOverride>& overrides) {
+    return SceneTemplate::parse(toml_text, file_label).instantiate(overrides);
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+    return SceneTemplate::load(file).instantiate(overrides);
 }
 
 }  // namespace atonlab::stimuli

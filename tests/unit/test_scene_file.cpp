@@ -813,3 +813,44 @@ intensity_cd = 10
     const std::string all = e.what();
     EXPECT_EQ(std::count(all.begin(), all.end(), '\n'), 3) << all;
 }
+
+// A template makes each scene afresh: overrides never leak into the next
+// instantiation, and errors keep the template's own lines.
+TEST(SceneTemplate, EachInstantiationStartsFromTheFileAndKeepsItsLines) {
+    const SceneTemplate t = SceneTemplate::parse(kFullScene, kFile);
+    const Scene brighter = t.instantiate({SceneOverride::parse("light.buoy.intensity_cd=400")});
+    EXPECT_EQ(brighter.lights[0].intensity_cd, 400.0);
+    const Scene plain = t.instantiate();
+    EXPECT_EQ(plain.lights[0].intensity_cd, 250.0);  // the file's value, as written
+    EXPECT_EQ(plain.lights[1].intensity_cd, 1000.0);
+
+    // An override that makes a value of the file wrong elsewhere: the error
+    // names the file's line, which the copy kept.
+    const std::string bad = std::string(kMinimal) + "\n[eye]\npupil_mm = -1\n";
+    const SceneTemplate tb = SceneTemplate::parse(bad, kFile);
+    try {
+        (void)tb.instantiate({SceneOverride::parse("camera.yaw_deg=10")});
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        ASSERT_TRUE(e.where());
+        EXPECT_EQ(e.where()->file, kFile);
+        EXPECT_EQ(e.where()->line, line_of(bad, "pupil_mm = -1")) << e.what();
+        EXPECT_EQ(e.where()->key, "eye.pupil_mm") << e.what();
+    }
+}
+
+// Every unknown key of one table is reported in one run, not only the first.
+TEST(SceneFileErrors, EveryUnknownKeyOfATableIsReported) {
+    const std::string text = std::string(kMinimal) + "brightness = 1\ncontrast = 2\n";
+    try {
+        (void)parse_scene(text, kFile);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        ASSERT_TRUE(e.where());
+        EXPECT_EQ(e.where()->key, "display.brightness") << e.what();
+        ASSERT_EQ(e.further().size(), 1u) << e.what();
+        EXPECT_NE(e.further()[0].find("key 'display.contrast'"), std::string::npos) << e.what();
+        EXPECT_NE(e.further()[0].find(":" + std::to_string(line_of(text, "contrast")) + ":"), std::string::npos)
+            << e.what();
+    }
+}
