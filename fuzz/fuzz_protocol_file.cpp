@@ -1,7 +1,7 @@
 // libFuzzer target: the protocol-file loader (protocols/src/protocol_file.cpp)
 // on arbitrary text, and for a protocol it accepts, the first trials of its
 // schedule (every procedure is built and answered), as `atonlab run` would.
-// A ProtocolError is the expected refusal; anything else is a finding
+// An InputError is the expected refusal; anything else is a finding
 // (docs/fuzzing.md).
 #include <cstddef>
 #include <cstdint>
@@ -17,7 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     p::Protocol protocol;
     try {
         protocol = p::parse_protocol(text, "fuzz/protocol.toml");
-    } catch (const p::ProtocolError&) {
+    } catch (const atonlab::InputError&) {
         return 0;  // a refusal with a sentence
     }
     // An accepted protocol must schedule and take its task's answers.

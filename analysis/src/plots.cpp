@@ -11,7 +11,7 @@
 #include <map>
 #include <set>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/display/fit_json.h"
 #include "atonlab/store/error.h"

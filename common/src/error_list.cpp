@@ -6,9 +6,20 @@
 
 namespace atonlab::text {
 
+Problem Problem::of(const InputError& e) {
+    const SourceLocation w = e.where().value_or(SourceLocation{});
+    return Problem{w.file, w.line, w.column, w.key, e.message(), e.what(), w.option};
+}
+
+void ErrorList::throw_if_any() const {
+    if (kept_.empty()) return;
+    const Problem first = in_file_order().front();
+    throw InputError(first.where(), first.message, further_lines());
+}
+
 void ErrorList::add(Problem p) {
     for (const Problem& k : kept_)
-        if (k.file == p.file && k.line == p.line && k.column == p.column && k.key == p.key) return;
+        if (k.file == p.file && k.option == p.option && k.line == p.line && k.column == p.column && k.key == p.key) return;
     if (kept_.size() >= kLimit) {
         ++dropped_;
         return;

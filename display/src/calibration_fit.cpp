@@ -11,7 +11,7 @@
 #include <nlopt.hpp>
 #include <optional>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/calibration.h"
 #include "atonlab/display/colour.h"
 

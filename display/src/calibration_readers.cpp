@@ -10,7 +10,7 @@
 #include <map>
 #include <optional>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
 
 namespace atonlab::display {

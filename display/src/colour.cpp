@@ -10,7 +10,7 @@
 #include <numbers>
 #include <string>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "cie_tables.h"
 
 namespace atonlab::display {

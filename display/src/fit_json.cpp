@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::display {
 namespace {

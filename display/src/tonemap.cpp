@@ -11,7 +11,7 @@
 #include <numbers>
 #include <string>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/colour.h"
 
 namespace atonlab::display {

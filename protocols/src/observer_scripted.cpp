@@ -75,7 +75,7 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
             continue;
         }
         if (tokens.size() > 2)
-            throw ProtocolError(file, number, 0, "",
+            throw InputError(SourceLocation{file, number, 0, ""},
                                 fmt::format("expected an answer and at most a response time in seconds "
                                             "(\"left 0.62\"), got \"{}\".",
                                             line));
@@ -85,7 +85,7 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
         });
         const std::optional<Response> response = scripted_response(word);
         if (!response)
-            throw ProtocolError(file, number, 0, "",
+            throw InputError(SourceLocation{file, number, 0, ""},
                                 fmt::format("unknown answer \"{}\"; expected one of {}.", tokens[0], kWordList));
         Line l;
         l.line = number;
@@ -95,8 +95,7 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
             double rt = 0.0;
             const auto [ptr, ec] = std::from_chars(tokens[1].data(), tokens[1].data() + tokens[1].size(), rt);
             if (ec != std::errc() || ptr != tokens[1].data() + tokens[1].size() || !std::isfinite(rt) || rt < 0.0)
-                throw ProtocolError(
-                    file, number, 0, "",
+                throw InputError(SourceLocation{file, number, 0, ""},
                     fmt::format("the response time \"{}\" is not a number of seconds >= 0.", tokens[1]));
             l.answer.response_time_s = rt;
         }
@@ -109,18 +108,19 @@ ScriptedObserver ScriptedObserver::parse(std::string_view text, std::string_view
 ScriptedObserver ScriptedObserver::load(const std::filesystem::path& file) {
     text::FileText read = text::read_text_file(file);  // only up to a limit (/dev/zero is refused)
     if (!read.ok())
-        throw ProtocolError(file.string(), 0, 0, "", fmt::format("cannot read the answer file: {}.", read.error));
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the answer file: {}.", read.error));
     return parse(read.text, file.string());
 }
 
 Answer ScriptedObserver::answer(const Shown& shown) {
     if (next_ >= lines_.size())
-        throw ProtocolError(file_, 0, 0, "",
+        throw InputError(SourceLocation{file_, 0, 0, ""},
                             fmt::format("the script's {} {} used up: answer {} needs one more line.", lines_.size(),
                                         lines_.size() == 1 ? "answer is" : "answers are", next_ + 1));
     const Line& l = lines_[next_];
     if (!fits(shown.task, l.answer.response))
-        throw ProtocolError(file_, l.line, 0, "",
+        throw InputError(SourceLocation{file_, l.line, 0, ""},
                             fmt::format("the answer \"{}\" does not fit a {} trial, which takes {}.", l.word,
                                         to_string(shown.task), takes(shown.task)));
     ++next_;

@@ -4,7 +4,6 @@
 
 #include <fmt/format.h>
 
-#include "atonlab/common/input_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,19 +13,6 @@
 namespace atonlab::protocols {
 
 namespace {
-
-std::string format_error(const std::string& file, int line, const std::string& key, const std::string& message) {
-    std::string s;
-    if (!file.empty()) {
-        s += file;
-        if (line > 0) s += fmt::format(":{}", line);
-        s += ": ";
-    }
-    if (!key.empty()) s += fmt::format("key '{}': ", text::echo(key));
-    s += message;
-    // One line of bounded length, whatever the message echoes.
-    return text::one_line(s);
-}
 
 /// Looks `text` up in a table of (name, value) pairs.
 template <class E, std::size_t N>
@@ -99,31 +85,6 @@ void append(std::vector<std::string>& out, const std::vector<Override>& override
 }
 
 }  // namespace
-
-ProtocolError::ProtocolError(std::string file, int line, int column, std::string key, const std::string& message)
-    : std::runtime_error(format_error(file, line, key, message)),
-      file_(std::move(file)),
-      line_(line),
-      column_(column),
-      key_(std::move(key)),
-      message_(text::one_line(message)) {}
-
-namespace {
-std::string with_further(std::string first, const std::vector<std::string>& further) {
-    for (const std::string& f : further) first += "\n" + f;
-    return first;
-}
-}  // namespace
-
-ProtocolError::ProtocolError(std::string file, int line, int column, std::string key, const std::string& message,
-                             std::vector<std::string> further)
-    : std::runtime_error(with_further(format_error(file, line, key, message), further)),
-      further_(std::move(further)),
-      file_(std::move(file)),
-      line_(line),
-      column_(column),
-      key_(std::move(key)),
-      message_(text::one_line(message)) {}
 
 std::string_view to_string(Task t) noexcept {
     return name_of(kTasks, t);

@@ -24,6 +24,7 @@
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
 #include "protocol_reader.h"
+#include "protocol_schema.h"
 
 namespace atonlab::protocols {
 
@@ -32,402 +33,7 @@ namespace {
 using detail::Document;
 using detail::KeyList;
 using detail::Section;
-
-constexpr std::string_view kRootKeys[] = {"protocol", "display", "timing", "responses", "screens", "defaults", "block"};
-constexpr std::string_view kProtocolKeys[] = {"name", "description", "scene", "seed", "adaptation_s"};
-constexpr std::string_view kDisplayKeys[] = {"width_px",           "height_px", "width_m",
-                                             "viewing_distance_m", "name",      "max_calibration_age_days"};
-constexpr std::string_view kTimingKeys[] = {"stimulus_s",          "inter_stimulus_s", "inter_trial_s",
-                                            "response_timeout_s",  "repeat_missed",    "refresh_hz",
-                                            "adaptation_skippable"};
-constexpr std::string_view kScreenKeys[] = {"instructions", "break",         "end",     "text_cd_m2",
-                                            "cue_cd_m2",    "text_size_deg", "fixation"};
-constexpr std::string_view kResponseKeys[] = {"keys", "gamepad"};
-constexpr std::string_view kActionNames[] = {"left",    "right",     "yes",     "no",       "coarse_up", "coarse_down",
-                                             "fine_up", "fine_down", "confirm", "continue", "quit"};
-
-// Condition keys may be written in [defaults], in a [[block]] (for all its
-// conditions) or in the [[block.condition]] itself; the nearest wins, and the
-// override lists add up.
-constexpr std::string_view kConditionKeys[] = {
-    "task",        "presentation", "prompt", "set",        "test_set",        "reference_set",   "level_key",
-    "level_scale", "level_on",     "choice", "test_light", "reference_light", "left_position_m", "right_position_m",
-    "procedure",   "reference_disc"};
-constexpr std::string_view kBlockOwnKeys[] = {"name",         "adaptation_s", "repetitions",    "interleave",
-                                              "instructions", "condition",    "conditions_file"};
-
-constexpr std::string_view kStaircaseKeys[] = {
-    "kind",        "start",    "step_sizes", "step_type", "n_up",      "n_down",        "apply_initial_rule",
-    "n_reversals", "n_trials", "max_trials", "min_level", "max_level", "up_step_ratio", "estimate_reversals"};
-constexpr std::string_view kWeightedKeys[] = {
-    "kind",     "start",      "target",    "step_sizes", "step_type",         "n_reversals",
-    "n_trials", "max_trials", "min_level", "max_level",  "estimate_reversals"};
-constexpr std::string_view kQuestKeys[] = {
-    "kind",  "t_guess", "t_guess_sd",     "p_threshold", "beta",          "delta",     "gamma",     "grain",
-    "range", "method",  "quantile_order", "n_trials",    "stop_interval", "min_level", "max_level", "first_at_guess"};
-constexpr std::string_view kAdjustmentKeys[] = {"kind",      "start_min", "start_max", "coarse_step",
-                                                "fine_step", "min_level", "max_level", "n_trials"};
-constexpr std::string_view kConstantKeys[] = {"kind", "levels", "repetitions", "order", "criterion"};
-constexpr std::string_view kKindNames[] = {"staircase", "weighted-staircase", "quest", "adjustment",
-                                           "constant-stimuli"};
-
-// Key names (GLFW's key names, lower case with underscores) and gamepad buttons
-// (GLFW_GAMEPAD_BUTTON_*).
-const std::vector<std::string>& key_names() {
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> v;
-        for (char c = 'a'; c <= 'z'; ++c) v.emplace_back(1, c);
-        for (char c = '0'; c <= '9'; ++c) v.emplace_back(1, c);
-        for (int i = 1; i <= 12; ++i) v.push_back(fmt::format("f{}", i));
-        for (int i = 0; i <= 9; ++i) v.push_back(fmt::format("kp_{}", i));
-        for (const char* s :
-             {"left",         "right",         "up",        "down",        "space",       "enter",     "escape",
-              "backspace",    "tab",           "insert",    "delete",      "home",        "end",       "page_up",
-              "page_down",    "kp_enter",      "kp_add",    "kp_subtract", "kp_multiply", "kp_divide", "kp_decimal",
-              "comma",        "period",        "slash",     "semicolon",   "apostrophe",  "minus",     "equal",
-              "left_bracket", "right_bracket", "backslash", "grave_accent"})
-            v.emplace_back(s);
-        return v;
-    }();
-    return names;
-}
-constexpr std::string_view kButtonNames[] = {
-    "a",     "b",          "x",           "y",       "left_bumper", "right_bumper", "back",     "start",
-    "guide", "left_thumb", "right_thumb", "dpad_up", "dpad_right",  "dpad_down",    "dpad_left"};
-
-std::string strip_period(std::string s) {
-    while (!s.empty() && s.back() == '.') s.pop_back();
-    return s;
-}
-
-// ---------------------------------------------------------------------------
-// A condition's keys, looked up from the most specific table outwards.
-
-struct Found {
-    const toml::node* node = nullptr;
-    std::string key;  ///< dotted path where it was written
-};
-
-struct Layer {
-    const toml::table* table = nullptr;  ///< may be null ([defaults] absent)
-    std::string path;                    ///< "defaults", "block[0]", "block[0].condition[1]"
-};
-
-class ConditionReader {
-public:
-    ConditionReader(const Document& doc, std::vector<Layer> outer_to_inner, std::string name, int line)
-        : doc_(doc), layers_(std::move(outer_to_inner)), name_(std::move(name)), line_(line) {
-        context_ = fmt::format("in condition \"{}\", ", name_);
-    }
-
-    const std::string& context() const noexcept { return context_; }
-    const Layer& own() const { return layers_.back(); }
-
-    std::optional<Found> find(std::string_view key) const {
-        for (auto it = layers_.rbegin(); it != layers_.rend(); ++it)
-            if (it->table != nullptr)
-                if (const toml::node* n = it->table->get(key)) return Found{n, it->path + "." + std::string(key)};
-        return std::nullopt;
-    }
-
-    /// Every layer's value of a list key, outer first.
-    std::vector<Found> find_all(std::string_view key) const {
-        std::vector<Found> out;
-        for (const Layer& l : layers_)
-            if (l.table != nullptr)
-                if (const toml::node* n = l.table->get(key)) out.push_back(Found{n, l.path + "." + std::string(key)});
-        return out;
-    }
-
-    [[noreturn]] void missing(std::string_view key, std::string_view what) const {
-        doc_.fail_at_line(line_, own().path + "." + std::string(key),
-                          fmt::format("condition \"{}\" (line {}) has no '{}', which is required ({}); give it in "
-                                      "the condition, its [[block]] or [defaults].",
-                                      name_, line_, key, what));
-    }
-    [[noreturn]] void fail(const Found& f, const std::string& message) const {
-        doc_.fail(f.node, f.key, context_ + message);
-    }
-    [[noreturn]] void fail_condition(std::string_view key, const std::string& message) const {
-        doc_.fail_at_line(line_, own().path + "." + std::string(key), context_ + message);
-    }
-
-    std::optional<std::string> string(std::string_view key) const {
-        auto f = find(key);
-        if (!f) return std::nullopt;
-        return doc_.string(f->node, f->key, context_);
-    }
-
-    /// An enumerated string value.
-    template <class E>
-    std::optional<E> choice(std::string_view key, std::optional<E> (*parse)(std::string_view) noexcept,
-                            KeyList allowed) const {
-        auto f = find(key);
-        if (!f) return std::nullopt;
-        const std::string text = doc_.string(f->node, f->key, context_);
-        if (auto e = parse(text)) return e;
-        fail(*f, fmt::format("{} must be one of {}, got \"{}\".", key, detail::join_quoted(allowed), text));
-    }
-
-private:
-    const Document& doc_;
-    std::vector<Layer> layers_;
-    std::string name_;
-    int line_;
-    std::string context_;
-};
-
-// ---------------------------------------------------------------------------
-// The procedure table, merged over the layers.
-
-KeyList keys_of(ProcedureKind k) {
-    switch (k) {
-        case ProcedureKind::Staircase:
-            return kStaircaseKeys;
-        case ProcedureKind::WeightedStaircase:
-            return kWeightedKeys;
-        case ProcedureKind::Quest:
-            return kQuestKeys;
-        case ProcedureKind::Adjustment:
-            return kAdjustmentKeys;
-        case ProcedureKind::ConstantStimuli:
-            return kConstantKeys;
-    }
-    return {};
-}
-
-const std::vector<std::string_view>& all_procedure_keys() {
-    static const std::vector<std::string_view> all = [] {
-        std::set<std::string_view> s;
-        for (auto list : {KeyList(kStaircaseKeys), KeyList(kWeightedKeys), KeyList(kQuestKeys),
-                          KeyList(kAdjustmentKeys), KeyList(kConstantKeys)})
-            s.insert(list.begin(), list.end());
-        return std::vector<std::string_view>(s.begin(), s.end());
-    }();
-    return all;
-}
-
-class ProcedureReader {
-public:
-    ProcedureReader(const Document& doc, const ConditionReader& cond) : doc_(doc), cond_(cond) {}
-
-    /// Merges the layers' procedure tables. A layer that names a different
-    /// kind from the one inherited starts afresh.
-    void merge(const std::vector<Found>& tables) {
-        for (const Found& f : tables) {
-            if (!f.node->is_table())
-                doc_.fail(f.node, f.key,
-                          cond_.context() + fmt::format("expected a procedure table (procedure = {{ kind = "
-                                                        "\"staircase\", ... }}), got {}.",
-                                                        detail::type_phrase(f.node->type())));
-            const toml::table& t = *f.node->as_table();
-            table_ = f;
-            if (const toml::node* k = t.get("kind")) {
-                const std::string text = doc_.string(k, f.key + ".kind", cond_.context());
-                const auto parsed = parse_procedure_kind(text);
-                if (!parsed)
-                    doc_.fail(k, f.key + ".kind",
-                              cond_.context() + fmt::format("kind must be one of {}, got \"{}\".",
-                                                            detail::join_quoted(kKindNames), text));
-                if (kind_ && *kind_ != *parsed) entries_.clear();
-                kind_ = parsed;
-                kind_at_ = Found{k, f.key + ".kind"};
-            }
-            const KeyList allowed = kind_ ? keys_of(*kind_) : KeyList(all_procedure_keys());
-            for (auto&& [key, value] : t) {
-                if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
-                    const std::string what =
-                        kind_ ? fmt::format("a {} procedure", to_string(*kind_)) : std::string("a procedure");
-                    if (std::find(std::begin(kConditionKeys), std::end(kConditionKeys), key.str()) !=
-                        std::end(kConditionKeys))
-                        doc_.fail_at_key(
-                            key, f.key + "." + std::string(key.str()),
-                            cond_.context() + fmt::format("'{}' is not a key of {}: it belongs beside the procedure, "
-                                                          "in [defaults], a [[block]] or a [[block.condition]].",
-                                                          key.str(), what));
-                    doc_.fail_at_key(
-                        key, f.key + "." + std::string(key.str()),
-                        cond_.context() + fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", key.str(), what,
-                                                      detail::suggestion(key.str(), allowed),
-                                                      detail::join_quoted(allowed)));
-                }
-                if (key.str() != "kind")
-                    entries_[std::string(key.str())] = Found{&value, f.key + "." + std::string(key.str())};
-            }
-        }
-    }
-
-    std::optional<ProcedureKind> kind() const { return kind_; }
-    const std::optional<Found>& kind_at() const { return kind_at_; }
-    const std::optional<Found>& table() const { return table_; }
-
-    const Found* entry(std::string_view key) const {
-        auto it = entries_.find(std::string(key));
-        return it == entries_.end() ? nullptr : &it->second;
-    }
-    bool has(std::string_view key) const { return entry(key) != nullptr; }
-
-    /// Where a parameter error is reported: at the key when it was written,
-    /// else at the nearest procedure table.
-    [[noreturn]] void fail(std::string_view key, const std::string& message) const {
-        if (const Found* f = entry(key)) doc_.fail(f->node, f->key, cond_.context() + message);
-        doc_.fail(table_->node, table_->key + "." + std::string(key), cond_.context() + message);
-    }
-
-    std::optional<double> number(std::string_view key) const {
-        const Found* f = entry(key);
-        return f ? std::optional<double>(doc_.number(f->node, f->key, key, cond_.context())) : std::nullopt;
-    }
-    void number(std::string_view key, double& out) const {
-        if (auto v = number(key)) out = *v;
-    }
-    void number(std::string_view key, std::optional<double>& out) const {
-        if (auto v = number(key)) out = *v;
-    }
-    std::optional<int> integer(std::string_view key) const {
-        const Found* f = entry(key);
-        if (f == nullptr) return std::nullopt;
-        return doc_.integer(f->node, f->key, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
-                            cond_.context());
-    }
-    void integer(std::string_view key, int& out) const {
-        if (auto v = integer(key)) out = *v;
-    }
-    void integer(std::string_view key, std::optional<int>& out) const {
-        if (auto v = integer(key)) out = *v;
-    }
-    void boolean(std::string_view key, bool& out) const {
-        if (const Found* f = entry(key)) out = doc_.boolean(f->node, f->key, cond_.context());
-    }
-    std::optional<std::string> string(std::string_view key) const {
-        const Found* f = entry(key);
-        return f ? std::optional<std::string>(doc_.string(f->node, f->key, cond_.context())) : std::nullopt;
-    }
-    std::optional<std::vector<double>> numbers(std::string_view key, bool scalar_ok) const {
-        const Found* f = entry(key);
-        if (f == nullptr) return std::nullopt;
-        return doc_.numbers(f->node, f->key, key, scalar_ok, cond_.context());
-    }
-
-    /// A start that may be a list (one interleaved track per entry).
-    void starts(std::string_view key, double& first, std::vector<double>& tracks) const {
-        const Found* f = entry(key);
-        if (f == nullptr)
-            fail(key, fmt::format("the {} procedure has no '{}', which is required.", to_string(*kind_), key));
-        std::vector<double> v = doc_.numbers(f->node, f->key, key, true, cond_.context());
-        first = v.front();
-        if (f->node->is_array()) tracks = std::move(v);
-    }
-
-    void require_stop_rule(std::initializer_list<std::string_view> keys, std::string_view what) const {
-        for (std::string_view k : keys)
-            if (has(k)) return;
-        // Reported at the condition's own procedure table (or the one it inherits).
-        doc_.fail(
-            table_->node, table_->key,
-            cond_.context() + fmt::format("the {} procedure has no stop rule: give {}.", to_string(*kind_), what));
-    }
-
-private:
-    const Document& doc_;
-    const ConditionReader& cond_;
-    std::optional<ProcedureKind> kind_;
-    std::optional<Found> kind_at_;
-    std::optional<Found> table_;
-    std::map<std::string, Found> entries_;
-};
-
-ProcedureSpec read_procedure(const ProcedureReader& r) {
-    ProcedureSpec spec;
-    spec.kind = *r.kind();
-    switch (spec.kind) {
-        case ProcedureKind::Staircase: {
-            StaircaseParams p;
-            r.starts("start", p.start, spec.track_starts);
-            if (auto v = r.numbers("step_sizes", true)) p.step_sizes = *v;
-            if (auto s = r.string("step_type")) p.step_type = parse_step_type(*s);
-            r.integer("n_up", p.n_up);
-            r.integer("n_down", p.n_down);
-            r.boolean("apply_initial_rule", p.apply_initial_rule);
-            r.integer("n_reversals", p.n_reversals);
-            r.integer("n_trials", p.n_trials);
-            r.integer("max_trials", p.max_trials);
-            r.number("min_level", p.min_level);
-            r.number("max_level", p.max_level);
-            r.number("up_step_ratio", p.up_step_ratio);
-            r.integer("estimate_reversals", p.estimate_reversals);
-            r.require_stop_rule({"n_reversals", "n_trials", "max_trials"}, "n_reversals, n_trials or max_trials");
-            spec.params = std::move(p);
-            break;
-        }
-        case ProcedureKind::WeightedStaircase: {
-            WeightedStaircaseParams p;
-            r.starts("start", p.start, spec.track_starts);
-            r.number("target", p.target);
-            if (auto v = r.numbers("step_sizes", true)) p.step_sizes = *v;
-            if (auto s = r.string("step_type")) p.step_type = parse_step_type(*s);
-            r.integer("n_reversals", p.n_reversals);
-            r.integer("n_trials", p.n_trials);
-            r.integer("max_trials", p.max_trials);
-            r.number("min_level", p.min_level);
-            r.number("max_level", p.max_level);
-            r.integer("estimate_reversals", p.estimate_reversals);
-            r.require_stop_rule({"n_reversals", "n_trials", "max_trials"}, "n_reversals, n_trials or max_trials");
-            spec.params = std::move(p);
-            break;
-        }
-        case ProcedureKind::Quest: {
-            QuestParams p;
-            r.starts("t_guess", p.t_guess, spec.track_starts);
-            r.number("t_guess_sd", p.t_guess_sd);
-            r.number("p_threshold", p.p_threshold);
-            r.number("beta", p.beta);
-            r.number("delta", p.delta);
-            r.number("gamma", p.gamma);
-            r.number("grain", p.grain);
-            r.number("range", p.range);
-            if (auto s = r.string("method")) p.method = parse_quest_method(*s);
-            r.number("quantile_order", p.quantile_order);
-            r.integer("n_trials", p.n_trials);
-            r.number("stop_interval", p.stop_interval);
-            r.number("min_level", p.min_level);
-            r.number("max_level", p.max_level);
-            r.boolean("first_at_guess", p.first_at_guess);
-            r.require_stop_rule({"n_trials"}, "n_trials (and, if you like, stop_interval)");
-            spec.params = std::move(p);
-            break;
-        }
-        case ProcedureKind::Adjustment: {
-            AdjustmentParams p;
-            if (!r.has("start_min"))
-                r.fail("start_min", "the adjustment procedure has no 'start_min', which is required.");
-            if (!r.has("start_max"))
-                r.fail("start_max", "the adjustment procedure has no 'start_max', which is required.");
-            r.number("start_min", p.start_min);
-            r.number("start_max", p.start_max);
-            r.number("coarse_step", p.coarse_step);
-            r.number("fine_step", p.fine_step);
-            r.number("min_level", p.min_level);
-            r.number("max_level", p.max_level);
-            r.integer("n_trials", p.n_trials);
-            r.require_stop_rule({"n_trials"}, "n_trials (the matches to make)");
-            spec.params = std::move(p);
-            break;
-        }
-        case ProcedureKind::ConstantStimuli: {
-            ConstantStimuliParams p;
-            auto levels = r.numbers("levels", false);
-            if (!levels) r.fail("levels", "the constant-stimuli procedure has no 'levels', which is required.");
-            p.levels = std::move(*levels);
-            r.integer("repetitions", p.repetitions);
-            if (auto s = r.string("order")) p.order = parse_constant_order(*s);
-            r.number("criterion", p.criterion);
-            spec.params = std::move(p);
-            break;
-        }
-    }
-    return spec;
-}
+using namespace detail;  // NOLINT: the schema and the readers of protocol_schema.h
 
 // ---------------------------------------------------------------------------
 // The whole file.
@@ -440,9 +46,9 @@ public:
         try {
             root_ = toml::parse(text, doc_.file());
         } catch (const toml::parse_error& e) {
-            throw ProtocolError(doc_.file(), static_cast<int>(e.source().begin.line),
-                                static_cast<int>(e.source().begin.column), "",
-                                fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
+            throw InputError(SourceLocation{doc_.file(), static_cast<int>(e.source().begin.line),
+                                            static_cast<int>(e.source().begin.column), ""},
+                             fmt::format("TOML syntax error: {}.", strip_period(std::string(e.description()))));
         }
         text_ = std::string(text);
         step([&] { expand_conditions_files(); });
@@ -456,97 +62,17 @@ public:
         Protocol p;
         p.file = doc_.file();
         step([&] { read_header(root, p, check_scene_exists); });
-        step([&] { read_display(root, p); });
-        step([&] { read_timing(root, p); });
-        step([&] { read_screens(root, p); });
+        step([&] { read_display(doc_, root, p); });
+        step([&] { read_timing(doc_, root, p); });
+        step([&] { read_screens(doc_, root, p); });
         step([&] { read_blocks(root, p); });
-        step([&] { read_responses(root, p); });
+        step([&] { read_responses(doc_, root, p); });
         doc_.collect_into(nullptr);
-        if (!errors_.empty()) {
-            const text::Problem first = errors_.in_file_order().front();
-            throw ProtocolError(first.file, first.line, first.column, first.key, first.message,
-                                errors_.further_lines());
-        }
+        errors_.throw_if_any();
         return p;
     }
 
 private:
-    // --- Conditions files -------------------------------------------------------------
-
-    /// A CSV cell as TOML: the text itself when it is one TOML value (a number,
-    /// true / false, an array), else a TOML string of it.
-    static std::string toml_value(const std::string& cell, bool always_string) {
-        if (!always_string) {
-            try {
-                (void)toml::parse("v = " + cell);
-                return cell;
-            } catch (const toml::parse_error&) {
-            }
-        }
-        return toml_string(cell);
-    }
-    static std::string toml_string(std::string_view text) {
-        std::string q = "\"";
-        for (const char ch : text) {
-            if (ch == '"' || ch == '\\') q += '\\';
-            q += ch;
-        }
-        return q + "\"";
-    }
-
-    /// One CSV line split into fields (RFC 4180 quoting; a field may not span lines).
-    static std::optional<std::vector<std::string>> csv_fields(std::string_view line, std::string& error) {
-        std::vector<std::string> out;
-        std::string field;
-        bool quoted = false, was_quoted = false;
-        for (std::size_t i = 0; i < line.size(); ++i) {
-            const char ch = line[i];
-            if (quoted) {
-                if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                    field += '"';
-                    ++i;
-                } else if (ch == '"') {
-                    quoted = false;
-                } else {
-                    field += ch;
-                }
-            } else if (ch == '"' && field.empty() && !was_quoted) {
-                quoted = was_quoted = true;
-            } else if (ch == ',') {
-                out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
-                field.clear();
-                was_quoted = false;
-            } else {
-                field += ch;
-            }
-        }
-        if (quoted) {
-            error = "a quoted field is not closed on its line (a field may not span lines).";
-            return std::nullopt;
-        }
-        out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
-        return out;
-    }
-    static std::string_view trim_blanks(std::string_view s) {
-        while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-        while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-        return s;
-    }
-
-    /// The CSV text stored after "#@conditions_file NAME" in the protocol text, if any.
-    std::optional<std::string> embedded_csv(const std::string& name) const {
-        const std::string tag = "\n#@conditions_file " + name + "\n";
-        std::size_t at = text_.find(tag);
-        if (at == std::string::npos) return std::nullopt;
-        at += tag.size();
-        std::string out;
-        while (at < text_.size() && text_.compare(at, 3, "#@|") == 0) {
-            const std::size_t end = std::min(text_.find('\n', at), text_.size());
-            out += text_.substr(at + 3, end - at - 3) + "\n";
-            at = end + 1;
-        }
-        return out;
-    }
 
     /// Each [[block]] with conditions_file = "FILE.csv" gets one
     /// [[block.condition]] per row of the file (after those written in the
@@ -562,212 +88,14 @@ private:
             toml::table& bt = *arr.get(bi)->as_table();
             const toml::node* f = bt.get("conditions_file");
             if (f == nullptr) continue;
-            step([&] { expand_conditions_file(bt, bi, *f); });
-        }
-    }
-
-    void expand_conditions_file(toml::table& bt, std::size_t bi, const toml::node& f) {
-        const std::string key = fmt::format("block[{}].conditions_file", bi);
-        const std::string rel = doc_.string(&f, key);
-        if (rel.empty()) doc_.fail(&f, key, "conditions_file must name a CSV file, got an empty string.");
-        const std::filesystem::path csv = std::filesystem::path(rel).is_absolute()
-                                              ? std::filesystem::path(rel)
-                                              : std::filesystem::path(doc_.file()).parent_path() / rel;
-        text::FileText read = text::read_text_file(csv);
-        std::string file = csv.string();
-        if (!read.ok()) {
-            // A stored protocol text carries its conditions files (with_conditions_files).
-            if (auto embedded = embedded_csv(rel)) {
-                read.text = std::move(*embedded);
-                read.error.clear();
-                file = rel;
-            } else {
-                doc_.fail(&f, key,
-                          fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
-            }
-        }
-        std::vector<std::string> lines;
-        for (std::size_t at = 0; at <= read.text.size();) {
-            const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
-            lines.push_back(read.text.substr(at, end - at));
-            at = end + 1;
-        }
-        if (!lines.empty() && lines.front().rfind("\xEF\xBB\xBF", 0) == 0) lines.front().erase(0, 3);
-        std::string error;
-        const auto header = csv_fields(lines.empty() ? std::string_view() : std::string_view(lines.front()), error);
-        if (!header || header->empty() || (header->size() == 1 && header->front().empty()))
-            throw ProtocolError(file, 1, 0, "", error.empty() ? "the conditions file has no header row." : error);
-        // What each column is.
-        enum class Kind { name, block, string_key, other_key, procedure, set, test_set, reference_set };
-        constexpr std::string_view kStringKeys[] = {"task",      "presentation", "prompt",
-                                                    "level_key", "level_scale",  "level_on",
-                                                    "choice",    "test_light",   "reference_light"};
-        std::vector<Kind> kinds;
-        std::set<std::string> seen;
-        for (std::size_t c = 0; c < header->size(); ++c) {
-            const std::string& h = (*header)[c];
-            const int col = static_cast<int>(c) + 1;
-            auto fail = [&](const std::string& m) {
-                throw ProtocolError(file, 1, col, "", fmt::format("column {} '{}': {}", col, h, m));
-            };
-            if (h.empty()) fail("the column has no name.");
-            if (!seen.insert(h).second) fail("the column appears twice in the header.");
-            if (h == "name")
-                kinds.push_back(Kind::name);
-            else if (h == "block")
-                kinds.push_back(Kind::block);
-            else if (std::find(std::begin(kStringKeys), std::end(kStringKeys), h) != std::end(kStringKeys))
-                kinds.push_back(Kind::string_key);
-            else if (h == "left_position_m" || h == "right_position_m")
-                kinds.push_back(Kind::other_key);
-            else if (h.rfind("procedure.", 0) == 0 && h.size() > 10)
-                kinds.push_back(Kind::procedure);
-            else if (h.rfind("test:", 0) == 0 && h.find('.') != std::string::npos)
-                kinds.push_back(Kind::test_set);
-            else if (h.rfind("reference:", 0) == 0 && h.find('.') != std::string::npos)
-                kinds.push_back(Kind::reference_set);
-            else if (h.find('.') != std::string::npos && h.find_first_of(" =\"'") == std::string::npos)
-                kinds.push_back(Kind::set);
-            else
-                fail(
-                    fmt::format("not a column of a conditions file: give name, a condition key ({}, "
-                                "left_position_m, right_position_m), procedure.PARAMETER, a scene key "
-                                "(section.key, a `set` override), test:KEY or reference:KEY (test_set, "
-                                "reference_set), or block.{}",
-                                detail::join_quoted(kStringKeys), text::did_you_mean(h, kStringKeys)));
-        }
-        // One TOML line per CSV line: row N of the file is line N of the text.
-        std::string toml_text = "\n";
-        std::vector<std::pair<std::string, Document::CsvRow>> rows;
-        const std::string block_name = bt.get("name") && bt.get("name")->is_string()
-                                           ? *bt.get("name")->value<std::string>()
-                                           : fmt::format("block{}", bi);
-        for (std::size_t li = 1; li < lines.size(); ++li) {
-            const int line = static_cast<int>(li) + 1;
-            if (trim_blanks(lines[li]).empty()) {
-                toml_text += "\n";
-                continue;
-            }
-            const auto cells = csv_fields(lines[li], error);
-            if (!cells) throw ProtocolError(file, line, 0, "", error);
-            if (cells->size() != header->size())
-                throw ProtocolError(
-                    file, line, 0, "",
-                    fmt::format("the row has {} fields where the header has {}.", cells->size(), header->size()));
-            Document::CsvRow row;
-            row.file = file;
-            row.line = line;
-            std::string fields, procedure;
-            std::vector<std::string> set, test_set, reference_set;
-            bool take = true;
-            for (std::size_t c = 0; c < cells->size(); ++c) {
-                const std::string& cell = (*cells)[c];
-                const std::string& h = (*header)[c];
-                const int col = static_cast<int>(c) + 1;
-                if (cell.empty()) continue;  // not given for this row
-                row.columns.emplace_back(h, col);
-                switch (kinds[c]) {
-                    case Kind::block:
-                        take = cell == block_name;
-                        break;
-                    case Kind::name:
-                    case Kind::string_key:
-                        fields += fmt::format("{} = {}, ", h, toml_string(cell));
-                        break;
-                    case Kind::other_key:
-                        fields += fmt::format("{} = {}, ", h, toml_value(cell, false));
-                        break;
-                    case Kind::procedure:
-                        procedure += fmt::format("{}{} = {}", procedure.empty() ? "" : ", ", h.substr(10),
-                                                 toml_value(cell, false));
-                        break;
-                    case Kind::set:
-                        set.push_back(toml_string(h + "=" + toml_value(cell, false)));
-                        row.set.push_back(col);
-                        break;
-                    case Kind::test_set:
-                        test_set.push_back(toml_string(h.substr(5) + "=" + toml_value(cell, false)));
-                        row.test_set.push_back(col);
-                        break;
-                    case Kind::reference_set:
-                        reference_set.push_back(toml_string(h.substr(10) + "=" + toml_value(cell, false)));
-                        row.reference_set.push_back(col);
-                        break;
-                }
-            }
-            if (!take) {
-                toml_text += "\n";
-                continue;
-            }
-            auto list = [](const std::vector<std::string>& v) {
-                std::string out = "[";
-                for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + v[i];
-                return out + "]";
-            };
-            if (!set.empty()) fields += "set = " + list(set) + ", ";
-            if (!test_set.empty()) fields += "test_set = " + list(test_set) + ", ";
-            if (!reference_set.empty()) fields += "reference_set = " + list(reference_set) + ", ";
-            if (!procedure.empty()) fields += "procedure = { " + procedure + " }, ";
-            if (fields.size() >= 2) fields.resize(fields.size() - 2);
-            const std::string row_key = fmt::format("row{}", line);
-            toml_text += fmt::format("{} = {{ {} }}\n", row_key, fields);
-            rows.emplace_back(row_key, std::move(row));
-        }
-        toml::table parsed;
-        try {
-            parsed = toml::parse(toml_text, file);
-        } catch (const toml::parse_error& e) {
-            throw ProtocolError(
-                file, static_cast<int>(e.source().begin.line), 0, "",
-                fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
-        }
-        if (rows.empty())
-            doc_.fail(&f, key,
-                      fmt::format("the conditions file \"{}\" has no rows for block \"{}\" (one row per condition{}).",
-                                  file, block_name,
-                                  std::find(kinds.begin(), kinds.end(), Kind::block) != kinds.end()
-                                      ? "; its block column names the block each row belongs to"
-                                      : ""));
-        if (!bt.contains("condition")) bt.insert("condition", toml::array{});
-        toml::node* conds = bt.get("condition");
-        if (!conds->is_array_of_tables() && !(conds->is_array() && conds->as_array()->empty()))
-            return;  // reported where the block's conditions are read
-        toml::array& carr = *conds->as_array();
-        for (auto& [row_key, row] : rows) {
-            toml::node* t = parsed.get(row_key);
-            if (t == nullptr || !t->is_table()) continue;
-            doc_.add_csv_row(fmt::format("block[{}].condition[{}]", bi, carr.size()), std::move(row));
-            carr.push_back(std::move(*t->as_table()));
+            step([&] { expand_conditions_file(doc_, text_, bt, bi, *f); });
         }
     }
 
     /// Runs one part of the reading; its error is kept and the reading goes on.
     template <class F>
     bool step(F&& f) {
-        return errors_.attempt<ProtocolError>(f, Document::problem);
-    }
-
-    /// Where a key written in the wrong table belongs (Section::allow's
-    /// `belongs`), "" when it is known nowhere else. `here`: "" for the
-    /// top level, "defaults", "block" or "condition".
-    static std::string belongs_elsewhere(std::string_view key, std::string_view here) {
-        auto in = [&](KeyList list) { return std::find(list.begin(), list.end(), key) != list.end(); };
-        if (here.empty() && in(kConditionKeys))
-            return fmt::format("'{}' belongs in [defaults] (or in a [[block]] or [[block.condition]]).", key);
-        if (!in(kConditionKeys) && in(all_procedure_keys())) {
-            if (here.empty() || here == "defaults")
-                return fmt::format(
-                    "'{}' belongs in [defaults.procedure] (or a block's or condition's procedure "
-                    "table).",
-                    key);
-            return fmt::format("'{}' belongs in the {}'s procedure table: procedure = {{ {} = ... }}.", key, here, key);
-        }
-        if (in(kProtocolKeys) && key != "adaptation_s" && key != "name")
-            return fmt::format("'{}' belongs in [protocol].", key);
-        if (in(kDisplayKeys) && key != "name") return fmt::format("'{}' belongs in [display].", key);
-        if (in(kTimingKeys)) return fmt::format("'{}' belongs in [timing].", key);
-        if (in(kScreenKeys)) return fmt::format("'{}' belongs in [screens].", key);
-        return {};
+        return errors_.attempt(f);
     }
 
     void read_header(const Section& root, Protocol& p, bool check_scene_exists) {
@@ -802,194 +130,6 @@ private:
         s.duration_at_most("adaptation_s", adaptation_s_);
     }
 
-    void read_display(const Section& root, Protocol& p) {
-        const toml::table* t = root.table("display");
-        if (t == nullptr)
-            doc_.fail_at_line(0, "display",
-                              "the protocol file has no [display] table, which is required (the observer's display, "
-                              "with the scene file's [display] keys).");
-        Section s(doc_, *t, "display", "the [display] table");
-        s.allow(kDisplayKeys);
-        auto px = [&](std::string_view key, std::string_view what) {
-            // What every GL 4.5 context can allocate (common/input_limits.h).
-            auto v = s.integer(key, 1, limits::kMaxDisplaySidePx);
-            if (!v) s.missing(key, what);
-            return *v;
-        };
-        p.display.width_px = px("width_px", "the display's width in pixels");
-        p.display.height_px = px("height_px", "the display's height in pixels");
-        const long long pixels = static_cast<long long>(p.display.width_px) * p.display.height_px;
-        if (pixels > limits::kMaxDisplayPixels)
-            s.fail("height_px", fmt::format("a display of {}×{} px has {} pixels, more than the {} (8192×8192) the "
-                                            "renderer's full-frame targets are sized for.",
-                                            p.display.width_px, p.display.height_px, pixels,
-                                            limits::kMaxDisplayPixels));
-        p.display.width_m = s.required_number("width_m", "the picture's visible width in metres");
-        s.greater_than("width_m", p.display.width_m, 0.0);
-        p.display.viewing_distance_m = s.required_number("viewing_distance_m", "eye to screen in metres");
-        s.greater_than("viewing_distance_m", p.display.viewing_distance_m, 0.0);
-        // Optional: which calibrated display this is, and how old its calibration may be.
-        if (auto name = s.string("name")) {
-            if (name->empty()) s.fail("name", "the display's name must not be empty (leave the key out instead).");
-            p.display.name = *name;
-        }
-        if (auto days = s.number("max_calibration_age_days")) {
-            s.greater_than("max_calibration_age_days", *days, 0.0);
-            p.display.max_calibration_age_days = *days;
-        }
-        for (auto&& [k, v] : *t) p.display.lines[std::string(k.str())] = Document::line_of(&v);
-    }
-
-    void read_timing(const Section& root, Protocol& p) {
-        const toml::table* t = root.table("timing");
-        if (t == nullptr) return;
-        Section s(doc_, *t, "timing", "the [timing] table");
-        s.allow(kTimingKeys);
-        if (auto v = s.number("stimulus_s")) {
-            s.greater_than("stimulus_s", *v, 0.0);
-            s.duration_at_most("stimulus_s", *v);
-            p.timing.stimulus_s = *v;
-        }
-        if (auto v = s.number("inter_stimulus_s")) {
-            s.at_least("inter_stimulus_s", *v, 0.0);
-            s.duration_at_most("inter_stimulus_s", *v);
-            p.timing.inter_stimulus_s = *v;
-        }
-        if (auto v = s.number("inter_trial_s")) {
-            s.at_least("inter_trial_s", *v, 0.0);
-            s.duration_at_most("inter_trial_s", *v);
-            p.timing.inter_trial_s = *v;
-        }
-        if (auto v = s.number("response_timeout_s")) {
-            s.greater_than("response_timeout_s", *v, 0.0);
-            s.duration_at_most("response_timeout_s", *v);
-            p.timing.response_timeout_s = *v;
-        }
-        if (const toml::node* n = s.get("repeat_missed"))
-            p.timing.repeat_missed = doc_.boolean(n, s.key_path("repeat_missed"));
-        if (auto v = s.number("refresh_hz")) {
-            if (!(*v >= 1.0 && *v <= 1000.0))
-                s.fail("refresh_hz", fmt::format("the refresh rate must be 1 to 1000 Hz, not {}.", *v));
-            p.timing.refresh_hz = *v;
-        }
-        if (const toml::node* n = s.get("adaptation_skippable"))
-            p.timing.adaptation_skippable = doc_.boolean(n, s.key_path("adaptation_skippable"));
-    }
-
-    void read_screens(const Section& root, Protocol& p) {
-        const toml::table* t = root.table("screens");
-        if (t == nullptr) return;
-        Section s(doc_, *t, "screens", "the [screens] table");
-        s.allow(kScreenKeys);
-        p.screens.instructions = s.string("instructions").value_or("");
-        p.screens.between = s.string("break").value_or("");
-        p.screens.end = s.string("end").value_or("");
-        if (auto v = s.number("text_cd_m2")) {
-            s.greater_than("text_cd_m2", *v, 0.0);
-            p.screens.text_cd_m2 = *v;
-        }
-        if (auto v = s.number("cue_cd_m2")) {
-            s.greater_than("cue_cd_m2", *v, 0.0);
-            p.screens.cue_cd_m2 = *v;
-        }
-        if (auto v = s.number("text_size_deg")) {
-            if (!(*v >= 0.05 && *v <= 10.0))
-                s.fail("text_size_deg",
-                       fmt::format("a line of text must be 0.05 to 10 degrees of visual angle high, not {}.", *v));
-            p.screens.text_size_deg = *v;
-        }
-        if (const toml::node* n = s.get("fixation")) p.screens.fixation = doc_.boolean(n, s.key_path("fixation"));
-    }
-
-    void read_responses(const Section& root, Protocol& p) {
-        p.responses = ResponseMap::defaults();
-        // Where the file bound each action (for conflict messages).
-        std::array<const toml::node*, kActionCount> key_nodes{};
-        std::array<std::string, kActionCount> key_paths{};
-        std::array<const toml::node*, kActionCount> button_nodes{};
-        std::array<std::string, kActionCount> button_paths{};
-        const toml::table* t = root.table("responses");
-        if (t != nullptr) {
-            Section s(doc_, *t, "responses", "the [responses] table");
-            s.allow(kResponseKeys);
-            auto read = [&](std::string_view sub, auto& table, auto& nodes, auto& paths, KeyList names,
-                            std::string_view what) {
-                const toml::table* st = s.table(sub);
-                if (st == nullptr) return;
-                Section ss(doc_, *st, s.key_path(sub), fmt::format("the [responses.{}] table", sub));
-                ss.allow(kActionNames);
-                for (std::size_t a = 0; a < kActionCount; ++a) {
-                    const std::string_view action = kActionNames[a];
-                    const toml::node* n = ss.get(action);
-                    if (n == nullptr) continue;
-                    std::vector<std::string> v = doc_.strings(n, ss.key_path(action));
-                    for (const std::string& name : v)
-                        if (std::find(names.begin(), names.end(), name) == names.end())
-                            doc_.fail(n, ss.key_path(action),
-                                      fmt::format("\"{}\" is not a {} name.{} See docs/protocol-file.md for the "
-                                                  "names.",
-                                                  name, what, detail::suggestion(name, names)));
-                    table[a] = std::move(v);
-                    nodes[a] = n;
-                    paths[a] = ss.key_path(action);
-                }
-            };
-            const auto& kn = key_names();
-            const std::vector<std::string_view> key_views(kn.begin(), kn.end());
-            read("keys", p.responses.keys, key_nodes, key_paths, KeyList(key_views), "key");
-            read("gamepad", p.responses.buttons, button_nodes, button_paths, KeyList(kButtonNames), "gamepad button");
-        }
-
-        // Every action the protocol needs has a key, and no key means two things at once.
-        std::set<Task> tasks;
-        for (const Block& b : p.blocks)
-            for (const Condition& c : b.conditions) tasks.insert(c.task);
-        std::vector<std::vector<Action>> contexts;
-        for (Task task : tasks) {
-            std::vector<Action> v(task_actions(task).begin(), task_actions(task).end());
-            v.push_back(Action::Quit);
-            contexts.push_back(std::move(v));
-        }
-        contexts.push_back({Action::Continue, Action::Quit});
-        for (const auto& actions : contexts)
-            for (Action a : actions) {
-                const auto i = static_cast<std::size_t>(a);
-                if (p.responses.keys[i].empty()) {
-                    const std::string key = fmt::format("responses.keys.{}", to_string(a));
-                    if (key_nodes[i] != nullptr)
-                        doc_.fail(key_nodes[i], key,
-                                  fmt::format("'{}' needs at least one key: the protocol uses it.", to_string(a)));
-                    doc_.fail_at_line(0, key, fmt::format("'{}' needs at least one key.", to_string(a)));
-                }
-            }
-        check_conflicts(p.responses.keys, key_nodes, key_paths, contexts, "key", "responses.keys");
-        check_conflicts(p.responses.buttons, button_nodes, button_paths, contexts, "gamepad button",
-                        "responses.gamepad");
-    }
-
-    void check_conflicts(const std::array<std::vector<std::string>, kActionCount>& table,
-                         const std::array<const toml::node*, kActionCount>& nodes,
-                         const std::array<std::string, kActionCount>& paths,
-                         const std::vector<std::vector<Action>>& contexts, std::string_view what,
-                         std::string_view table_path) const {
-        for (const auto& actions : contexts)
-            for (std::size_t x = 0; x < actions.size(); ++x)
-                for (std::size_t y = x + 1; y < actions.size(); ++y) {
-                    const auto a = static_cast<std::size_t>(actions[x]);
-                    const auto b = static_cast<std::size_t>(actions[y]);
-                    for (const std::string& name : table[a]) {
-                        if (std::find(table[b].begin(), table[b].end(), name) == table[b].end()) continue;
-                        // Report at the binding the file wrote (the later one if both).
-                        const std::size_t at = nodes[b] != nullptr ? b : a;
-                        const std::string message =
-                            fmt::format("the {} \"{}\" is bound to both '{}' and '{}', which are used together.", what,
-                                        name, to_string(actions[x]), to_string(actions[y]));
-                        if (nodes[at] != nullptr) doc_.fail(nodes[at], paths[at], message);
-                        doc_.fail_at_line(0, fmt::format("{}.{}", table_path, to_string(actions[y])), message);
-                    }
-                }
-    }
-
     void read_blocks(const Section& root, Protocol& p) {
         const toml::table* defaults = root.table("defaults");
         if (defaults != nullptr) {
@@ -1004,7 +144,7 @@ private:
         if (!blocks->is_array_of_tables())
             doc_.fail(
                 blocks, "block",
-                fmt::format("expected an array of tables [[block]], got {}.", detail::type_phrase(blocks->type())));
+                fmt::format("expected an array of tables [[block]], got {}.", text::type_phrase(blocks->type())));
         std::vector<std::string_view> block_keys(std::begin(kBlockOwnKeys), std::end(kBlockOwnKeys));
         block_keys.insert(block_keys.end(), std::begin(kConditionKeys), std::end(kConditionKeys));
 
@@ -1088,7 +228,7 @@ private:
             if (!conds->is_array_of_tables())
                 doc_.fail(conds, bs.key_path("condition"),
                           fmt::format("expected an array of tables [[block.condition]], got {}.",
-                                      detail::type_phrase(conds->type())));
+                                      text::type_phrase(conds->type())));
             return conds->as_array();
         }
     }
@@ -1205,7 +345,7 @@ private:
         if (!pr.kind())
             doc_.fail(pr.table()->node, pr.table()->key + ".kind",
                       r.context() + fmt::format("the procedure has no kind: give kind = one of {}.",
-                                                detail::join_quoted(kKindNames)));
+                                                toml_reader::join_quoted(kKindNames)));
         const bool adjustment = *pr.kind() == ProcedureKind::Adjustment;
         if (adjustment != (c.task == Task::Adjust))
             r.fail(
@@ -1430,7 +570,8 @@ std::string read_text(const std::filesystem::path& file) {
     // the memory runs out.
     text::FileText read = text::read_text_file(file);
     if (!read.ok())
-        throw ProtocolError(file.string(), 0, 0, "", fmt::format("cannot read the protocol file: {}.", read.error));
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the protocol file: {}.", read.error));
     return std::move(read.text);
 }
 

@@ -1,23 +1,16 @@
-// Strict TOML reading for the protocol file (protocol_reader.h).
+// What the protocol file adds to the strict TOML reader (protocol_reader.h).
 #include "protocol_reader.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdlib>
-#include <limits>
 
-#include "atonlab/common/input_limits.h"
 #include "atonlab/common/toml_text.h"
 
 namespace atonlab::protocols::detail {
 
 namespace {
-
-std::string number_text(double v) {
-    return fmt::format("{}", v);
-}
 
 std::string_view trim(std::string_view s) {
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -34,39 +27,11 @@ bool is_scene_key(std::string_view k) {
 
 }  // namespace
 
-std::string suggestion(std::string_view key, KeyList allowed) { return text::did_you_mean(key, allowed); }
-
-std::string join_quoted(KeyList items) {
-    std::string s;
-    for (std::string_view item : items) {
-        if (!s.empty()) s += ", ";
-        s += fmt::format("'{}'", item);
-    }
-    return s;
-}
-
-std::string_view type_phrase(toml::node_type type) { return text::type_phrase(type); }
-
 // ---------------------------------------------------------------------------
 // Document
 
-int Document::line_of(const toml::node* node) noexcept {
-    return node != nullptr ? static_cast<int>(node->source().begin.line) : 0;
-}
-
-int Document::column_of(const toml::node* node) noexcept {
-    return node != nullptr ? static_cast<int>(node->source().begin.column) : 0;
-}
-
-void Document::note(const ProtocolError& e) const {
-    if (errors_ != nullptr) errors_->add(problem(e));
-}
-
-text::Problem Document::problem(const ProtocolError& e) {
-    return text::Problem{e.file(), e.line(), e.column(), e.key(), e.message(), e.what()};
-}
-
-void Document::throw_at(int line, int column, const std::string& key, const std::string& message) const {
+void Document::relocate(SourceLocation& w, std::string& message) const {
+    const std::string key = w.key;
     for (const auto& entry : csv_rows_) {
         // Named references, not structured bindings: clang 14 (the fuzz
         // build) cannot capture a binding in a lambda.
@@ -101,102 +66,10 @@ void Document::throw_at(int line, int column, const std::string& key, const std:
             by_name(rest.substr(0, dot));
         }
         const std::string where = col > 0 ? fmt::format("column {} '{}': ", col, name) : std::string();
-        throw ProtocolError(row.file, row.line, col, "", where + message);
+        w = SourceLocation{row.file, row.line, col, ""};
+        message = where + message;
+        return;
     }
-    throw ProtocolError(file_, line, column, key, message);
-}
-
-void Document::fail(const toml::node* node, const std::string& key, const std::string& message) const {
-    throw_at(line_of(node), column_of(node), key, message);
-}
-
-void Document::fail_at_key(const toml::key& k, const std::string& key, const std::string& message) const {
-    throw_at(static_cast<int>(k.source().begin.line), static_cast<int>(k.source().begin.column), key, message);
-}
-
-void Document::fail_at_line(int line, const std::string& key, const std::string& message) const {
-    throw_at(line, 0, key, message);
-}
-
-double Document::number(const toml::node* n, const std::string& key, std::string_view name,
-                        const std::string& context) const {
-    double v = 0.0;
-    if (n->is_integer())
-        v = static_cast<double>(n->as_integer()->get());
-    else if (n->is_floating_point())
-        v = n->as_floating_point()->get();
-    else
-        fail(n, key, context + fmt::format("expected a number, got {}.", type_phrase(n->type())));
-    if (!std::isfinite(v))
-        fail(n, key, context + fmt::format("{} must be a finite number, got {}.", name, number_text(v)));
-    return v;
-}
-
-int Document::integer(const toml::node* n, const std::string& key, std::string_view name, long long min, long long max,
-                      const std::string& context) const {
-    if (!n->is_integer()) fail(n, key, context + fmt::format("expected an integer, got {}.", type_phrase(n->type())));
-    const std::int64_t v = n->as_integer()->get();
-    if (v < min || v > max)
-        fail(n, key, context + fmt::format("{} must be between {} and {}, got {}.", name, min, max, v));
-    return static_cast<int>(v);
-}
-
-std::int64_t Document::integer64(const toml::node* n, const std::string& key, const std::string& context) const {
-    if (!n->is_integer()) fail(n, key, context + fmt::format("expected an integer, got {}.", type_phrase(n->type())));
-    return n->as_integer()->get();
-}
-
-bool Document::boolean(const toml::node* n, const std::string& key, const std::string& context) const {
-    if (!n->is_boolean())
-        fail(n, key, context + fmt::format("expected true or false, got {}.", type_phrase(n->type())));
-    return n->as_boolean()->get();
-}
-
-std::string Document::string(const toml::node* n, const std::string& key, const std::string& context) const {
-    if (!n->is_string()) fail(n, key, context + fmt::format("expected a string, got {}.", type_phrase(n->type())));
-    return n->as_string()->get();
-}
-
-std::vector<double> Document::numbers(const toml::node* n, const std::string& key, std::string_view name,
-                                      bool scalar_ok, const std::string& context) const {
-    if (scalar_ok && (n->is_integer() || n->is_floating_point())) return {number(n, key, name, context)};
-    if (!n->is_array())
-        fail(n, key,
-             context + fmt::format("expected {}an array of numbers, got {}.", scalar_ok ? "a number or " : "",
-                                   type_phrase(n->type())));
-    const toml::array& a = *n->as_array();
-    if (a.empty()) fail(n, key, context + fmt::format("{} needs at least one number, got an empty array.", name));
-    std::vector<double> out;
-    out.reserve(a.size());
-    for (std::size_t i = 0; i < a.size(); ++i)
-        out.push_back(number(a.get(i), fmt::format("{}[{}]", key, i), fmt::format("{}[{}]", name, i), context));
-    return out;
-}
-
-std::vector<std::string> Document::strings(const toml::node* n, const std::string& key,
-                                           const std::string& context) const {
-    if (n->is_string()) return {n->as_string()->get()};
-    if (!n->is_array())
-        fail(n, key,
-             context + fmt::format("expected a string or an array of strings, got {}.", type_phrase(n->type())));
-    std::vector<std::string> out;
-    const toml::array& a = *n->as_array();
-    for (std::size_t i = 0; i < a.size(); ++i) out.push_back(string(a.get(i), fmt::format("{}[{}]", key, i), context));
-    return out;
-}
-
-std::array<double, 3> Document::vec3(const toml::node* n, const std::string& key, std::string_view name,
-                                     const std::string& context) const {
-    if (!n->is_array() || n->as_array()->size() != 3)
-        fail(n, key,
-             context + fmt::format("expected an array of 3 numbers [x, y, z], got {}.",
-                                   n->is_array() ? fmt::format("{} elements", n->as_array()->size())
-                                                 : std::string(type_phrase(n->type()))));
-    const toml::array& a = *n->as_array();
-    std::array<double, 3> v{};
-    for (std::size_t i = 0; i < 3; ++i)
-        v[i] = number(a.get(i), fmt::format("{}[{}]", key, i), fmt::format("{}[{}]", name, i), context);
-    return v;
 }
 
 std::string Document::scene_key(const toml::node* n, const std::string& key, const std::string& context) const {
@@ -250,95 +123,12 @@ std::vector<Override> Document::scene_overrides(const toml::node* n, const std::
     if (!n->is_array())
         fail(n, key,
              context +
-                 fmt::format("expected an array of \"section.key=value\" strings, got {}.", type_phrase(n->type())));
+                 fmt::format("expected an array of \"section.key=value\" strings, got {}.", text::type_phrase(n->type())));
     std::vector<Override> out;
     const toml::array& a = *n->as_array();
     for (std::size_t i = 0; i < a.size(); ++i)
         out.push_back(scene_override(a.get(i), fmt::format("{}[{}]", key, i), context));
     return out;
-}
-
-// ---------------------------------------------------------------------------
-// Section
-
-std::string Section::key_path(std::string_view key) const {
-    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-}
-
-void Section::allow(KeyList allowed, const std::function<std::string(std::string_view)>& belongs) const {
-    std::vector<ProtocolError> unknown;
-    for (auto&& [k, v] : table_) {
-        if (std::find(allowed.begin(), allowed.end(), k.str()) != allowed.end()) continue;
-        const std::string elsewhere = belongs ? belongs(k.str()) : std::string();
-        const std::string message = elsewhere.empty()
-                                        ? fmt::format("unknown key '{}' in {}.{} Allowed keys: {}.", k.str(), title_,
-                                                      suggestion(k.str(), allowed), join_quoted(allowed))
-                                        : fmt::format("'{}' is not a key of {}: {}", k.str(), title_, elsewhere);
-        unknown.emplace_back(doc_.file(), static_cast<int>(k.source().begin.line),
-                             static_cast<int>(k.source().begin.column), key_path(k.str()), message);
-    }
-    if (unknown.empty()) return;
-    for (std::size_t i = 1; i < unknown.size(); ++i) doc_.note(unknown[i]);
-    throw unknown.front();
-}
-
-void Section::missing(std::string_view key, std::string_view what) const {
-    const int at = line();
-    const std::string at_line = at > 0 ? fmt::format(" (line {})", at) : std::string();
-    doc_.fail_at_line(at, key_path(key),
-                      fmt::format("{}{} has no '{}', which is required ({}).", title_, at_line, key, what));
-}
-
-void Section::fail(std::string_view key, const std::string& message) const {
-    const toml::node* n = get(key);
-    doc_.fail(n != nullptr ? n : &table_, key_path(key), message);
-}
-
-std::optional<double> Section::number(std::string_view key) const {
-    const toml::node* n = get(key);
-    if (n == nullptr) return std::nullopt;
-    return doc_.number(n, key_path(key), key);
-}
-
-double Section::required_number(std::string_view key, std::string_view what) const {
-    if (auto v = number(key)) return *v;
-    missing(key, what);
-}
-
-std::optional<int> Section::integer(std::string_view key, long long min, long long max) const {
-    const toml::node* n = get(key);
-    if (n == nullptr) return std::nullopt;
-    return doc_.integer(n, key_path(key), key, min, max);
-}
-
-std::optional<std::string> Section::string(std::string_view key) const {
-    const toml::node* n = get(key);
-    if (n == nullptr) return std::nullopt;
-    return doc_.string(n, key_path(key));
-}
-
-const toml::table* Section::table(std::string_view key) const {
-    const toml::node* n = get(key);
-    if (n == nullptr) return nullptr;
-    if (!n->is_table())
-        doc_.fail(n, key_path(key),
-                  fmt::format("expected a table [{}], got {}.", key_path(key), type_phrase(n->type())));
-    return n->as_table();
-}
-
-void Section::at_least(std::string_view key, double v, double min) const {
-    if (!(v >= min)) fail(key, fmt::format("{} must be at least {}, got {}.", key, number_text(min), number_text(v)));
-}
-
-void Section::greater_than(std::string_view key, double v, double min) const {
-    if (!(v > min))
-        fail(key, fmt::format("{} must be greater than {}, got {}.", key, number_text(min), number_text(v)));
-}
-
-void Section::duration_at_most(std::string_view key, double v) const {
-    if (!(v <= limits::kMaxDurationS))
-        fail(key, fmt::format("{} must be at most {} s (a day; durations are counted in whole refreshes), got {}.",
-                              key, number_text(limits::kMaxDurationS), number_text(v)));
 }
 
 }  // namespace atonlab::protocols::detail

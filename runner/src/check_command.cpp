@@ -32,7 +32,7 @@ namespace {
 
 /// `--set display.KEY=VALUE`: the protocol's [display] for this check.
 void apply_display_set(p::Display& display, const std::string& set) {
-    const SourceLocation where{"--set", 0, 0, set};
+    const SourceLocation where = SourceLocation::command_line("--set", set);
     const auto eq = set.find('=');
     if (eq == std::string::npos)
         throw InputError(where, "a --set is KEY=VALUE, e.g. display.width_px=3840.");
@@ -40,18 +40,18 @@ void apply_display_set(p::Display& display, const std::string& set) {
     const std::string value = set.substr(eq + 1);
     if (key != "display.width_px" && key != "display.height_px" && key != "display.width_m" &&
         key != "display.viewing_distance_m")
-        throw InputError(SourceLocation{"--set", 0, 0, key},
+        throw InputError(SourceLocation::command_line("--set", key),
                          "check sets only the display: display.width_px, display.height_px, display.width_m or "
                          "display.viewing_distance_m.");
     double v = 0.0;
     const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
     if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(v) || !(v > 0))
-        throw InputError(SourceLocation{"--set", 0, 0, key},
+        throw InputError(SourceLocation::command_line("--set", key),
                          fmt::format("\"{}\" is not a positive number.", text::echo(value)));
     const bool whole = v == std::floor(v) && v <= 65536;
     if (key == "display.width_px" || key == "display.height_px") {
         if (!whole)
-            throw InputError(SourceLocation{"--set", 0, 0, key},
+            throw InputError(SourceLocation::command_line("--set", key),
                              fmt::format("{} is a whole number of pixels from 1 to 65536.", text::echo(value)));
         (key == "display.width_px" ? display.width_px : display.height_px) = static_cast<int>(v);
     } else if (key == "display.width_m") {
@@ -78,12 +78,7 @@ void add_check_command(CLI::App& app, CheckOptions& o) {
 }
 
 int run_check(const CheckOptions& o) {
-    p::Protocol protocol;
-    try {
-        protocol = p::load_protocol(o.protocol);
-    } catch (const p::ProtocolError& e) {
-        throw InputError(SourceLocation{e.file(), e.line(), e.column(), e.key()}, e.message());
-    }
+    p::Protocol protocol = p::load_protocol(o.protocol);
     for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
     const std::string scene_text = files::read_text(protocol.scene, "scene template");
 

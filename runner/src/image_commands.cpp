@@ -30,7 +30,7 @@ namespace atonlab::runner {
 namespace {
 
 SourceLocation option(const char* name) {
-    return SourceLocation{name, 0, 0, ""};
+    return SourceLocation::command_line(name);
 }
 
 bool on_off(const std::optional<std::string>& v, const char* name, bool fallback) {

@@ -45,28 +45,28 @@ bool positive_finite(double v) {
 int run_light(const LightOptions& o) {
     // Every check before any output.
     if (o.intensity_cd.has_value() == o.range_nmi.has_value())
-        throw InputError(SourceLocation{"--intensity-cd", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--intensity-cd"),
                          "give exactly one of --intensity-cd and --range-nmi");
     if (o.intensity_cd && !positive_finite(*o.intensity_cd))
-        throw InputError(SourceLocation{"--intensity-cd", 0, 0, ""}, "the intensity must be a positive number of cd");
+        throw InputError(SourceLocation::command_line("--intensity-cd"), "the intensity must be a positive number of cd");
     if (o.range_nmi && !positive_finite(*o.range_nmi))
-        throw InputError(SourceLocation{"--range-nmi", 0, 0, ""}, "the range must be a positive number of nmi");
+        throw InputError(SourceLocation::command_line("--range-nmi"), "the range must be a positive number of nmi");
     constexpr std::array<std::string_view, 5> colours{"white", "red", "green", "yellow", "blue"};
     bool known_colour = false;
     for (const auto c : colours) known_colour = known_colour || o.colour == c;
     if (!known_colour)
-        throw InputError(SourceLocation{"--colour", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--colour"),
                          "the colour must be white, red, green, yellow or blue, not '" + o.colour + "'");
     double visibility_nmi = 10.0;
     if (o.visibility_nmi) {
         if (!positive_finite(*o.visibility_nmi))
-            throw InputError(SourceLocation{"--visibility-nmi", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--visibility-nmi"),
                              "the visibility must be a positive number of nmi");
         visibility_nmi = *o.visibility_nmi;
     }
     if (o.transmissivity_per_nmi) {
         if (!(*o.transmissivity_per_nmi > 0 && *o.transmissivity_per_nmi < 1))
-            throw InputError(SourceLocation{"--transmissivity", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--transmissivity"),
                              "the transmissivity per nmi must lie between 0 and 1 (exclusive)");
         visibility_nmi = stimuli::visibility_nmi_from_transmissivity(*o.transmissivity_per_nmi);
     }
@@ -76,7 +76,7 @@ int run_light(const LightOptions& o) {
     else if (o.period == "day")
         threshold_lux = stimuli::allard_threshold_day_lux;
     else
-        throw InputError(SourceLocation{"--period", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--period"),
                          "the period must be night or day, not '" + o.period + "'");
     double background_factor = 0;
     if (o.background == "none")
@@ -86,11 +86,11 @@ int run_light(const LightOptions& o) {
     else if (o.background == "substantial")
         background_factor = 100;
     else
-        throw InputError(SourceLocation{"--background", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--background"),
                          "the background must be none, minor or substantial, not '" + o.background + "'");
     for (const double d : o.distances_nmi)
         if (!positive_finite(d))
-            throw InputError(SourceLocation{"--at-nmi", 0, 0, ""}, "each distance must be a positive number of nmi");
+            throw InputError(SourceLocation::command_line("--at-nmi"), "each distance must be a positive number of nmi");
 
     // K2012 eq 2.1 one way or the other.
     const double intensity_cd =

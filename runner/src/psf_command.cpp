@@ -83,7 +83,7 @@ int run_psf(const PsfOptions& o) {
         if (!named) {
             std::string names;
             for (const auto& n : stimuli::eye_preset_names()) names += (names.empty() ? "" : ", ") + n;
-            throw InputError(SourceLocation{"--eye-preset", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--eye-preset"),
                              fmt::format("unknown eye preset \"{}\"; presets are {}.", *o.eye_preset, names));
         }
         eye = *named;
@@ -92,13 +92,13 @@ int run_psf(const PsfOptions& o) {
     double pupil = 0;
     if (o.pupil_mm) {
         if (!(*o.pupil_mm > 0) || !std::isfinite(*o.pupil_mm))
-            throw InputError(SourceLocation{"--pupil-mm", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--pupil-mm"),
                              fmt::format("the pupil diameter must be a positive number of mm, not {}.", *o.pupil_mm));
         pupil = *o.pupil_mm;
     } else {
         const double L = o.adaptation_cd_m2.value_or(0.001);
         if (!(L >= 0) || !std::isfinite(L))
-            throw InputError(SourceLocation{"--adaptation-cd-m2", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--adaptation-cd-m2"),
                              fmt::format("the adaptation luminance must be a finite number ≥ 0 cd/m², not {}.", L));
         pupil = stimuli::pupil_diameter_mm_from_adaptation(L);
     }
@@ -111,28 +111,29 @@ int run_psf(const PsfOptions& o) {
     }
     eye.pupil_diameter_mm = pupil;
     if (!stimuli::is_power_of_two(o.size) || o.size < stimuli::kGpuFftMinSize || o.size > stimuli::kGpuFftMaxSize)
-        throw InputError(SourceLocation{"--size", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--size"),
                          fmt::format("the PSF size must be a power of two from {} to {}, not {}.",
                                      stimuli::kGpuFftMinSize, stimuli::kGpuFftMaxSize, o.size));
     try {
         eye.validate(o.size);
     } catch (const InputError& e) {
         throw InputError(
-            SourceLocation{o.scene.empty() ? "--pupil-mm" : o.scene, 0, 0, e.where() ? e.where()->key : std::string()},
+            o.scene.empty() ? SourceLocation::command_line("--pupil-mm", e.where() ? e.where()->key : std::string())
+                            : SourceLocation{o.scene, 0, 0, e.where() ? e.where()->key : std::string()},
             e.message());
     }
     auto spd = display::named_spectrum(o.spd);
     if (!spd) {
         std::string names;
         for (const auto& n : display::spectrum_names()) names += (names.empty() ? "" : ", ") + n;
-        throw InputError(SourceLocation{"--spd", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--spd"),
                          fmt::format("unknown spectrum \"{}\"; named spectra are {}.", o.spd, names));
     }
     if (o.samples < 1 || o.samples > 128)
-        throw InputError(SourceLocation{"--samples", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--samples"),
                          fmt::format("the number of spectral samples must be 1 to 128, not {}.", o.samples));
     if (!(o.pixels_per_degree > 0) || !std::isfinite(o.pixels_per_degree))
-        throw InputError(SourceLocation{"--pixels-per-degree", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--pixels-per-degree"),
                          "the display's pixels per degree must be a positive number.");
     const stimuli::SpectralSamples samples = stimuli::spectral_samples(*spd, o.samples);
 

@@ -53,9 +53,9 @@ int run_render(const RenderOptions& o) {
     std::vector<stimuli::SceneOverride> overrides;
     for (const auto& s : o.overrides) overrides.push_back(stimuli::SceneOverride::parse(s));
     if (!std::isfinite(o.time_s))
-        throw InputError(SourceLocation{"--time", 0, 0, ""}, "the time must be a finite number of seconds");
+        throw InputError(SourceLocation::command_line("--time"), "the time must be a finite number of seconds");
     if (o.white_cd_m2 && !(*o.white_cd_m2 > 0.0 && std::isfinite(*o.white_cd_m2)))
-        throw InputError(SourceLocation{"--white-cd-m2", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--white-cd-m2"),
                          "the white luminance must be a positive number of cd/m²");
     // Validate everything before touching the GPU or the output paths.
     stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);

@@ -137,10 +137,6 @@ int run_run(const RunOptions& o) {
         // The refresh measurement failed before any session began: nothing stored.
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 5;
-    } catch (const protocols::ProtocolError& e) {
-        // A protocol or script error the engine did not already turn into an InputError.
-        std::fprintf(stderr, "atonlab: %s\n", e.what());
-        return 2;
     }
 }
 

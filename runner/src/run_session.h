@@ -4,155 +4,19 @@
 // study file before the next is shown. run_command.cpp is the command line
 // around it.
 //
-// Two parts:
-//  - StimulusRenderer: a frame (a list of scene overrides) → the displayed
-//    luminance (cd/m²) that the screen would emit around each judged light,
-//    with an LRU cache keyed by the exact override list, so that a frame shown
-//    twice is rendered once;
-//  - run_session(): load and validate everything, open the store, begin or
-//    resume a session, run the trials, summarise.
-#include <cstddef>
-#include <cstdint>
-#include <filesystem>
-#include <glm/vec2.hpp>
-#include <list>
-#include <memory>
-#include <optional>
-#include <string>
-#include <unordered_map>
-#include <vector>
-
-#include "atonlab/protocols/observer.h"
-#include "atonlab/protocols/protocol.h"
-#include "atonlab/protocols/protocol_schedule.h"
-#include "atonlab/stimuli/display_pipeline.h"
-#include "atonlab/stimuli/frame_renderer.h"
-#include "atonlab/stimuli/image_io.h"
-#include "atonlab/stimuli/scene.h"
+// The parts live in session/: stimulus_renderer.h (a frame's overrides → the
+// displayed luminance around each judged light, cached), session_inputs.h
+// (options, protocol and scene checked), condition_scene.h, resume.h,
+// session_observer.h, trial_loop.h, trial_record.h, snapshot.h,
+// true_value.h, progress.h, summary.h. run_session() drives them: load and
+// validate everything, open the store, begin or resume a session, run the
+// trials, summarise.
 #include "commands.h"
+#include "session/session_observer.h"
+#include "session/stimulus_renderer.h"
+#include "session/true_value.h"
 
 namespace atonlab::runner {
-
-/// The displayed luminance around one judged light: a square window of the
-/// screen centred on the light (pixels beyond the screen's edge are black,
-/// 0 cd/m²), and the light's position in it (pixels, row 0 at the top, the
-/// DisplayedImage convention).
-struct LightWindow {
-    protocols::DisplayedImage image;
-    glm::dvec2 light_px{0.0};
-    /// The code values sent to the screen in the same window (displayability.h):
-    int peak_code = 0;        ///< the highest code of any channel of any pixel
-    int background_code = 0;  ///< the same with the judged lights off
-    int rise_codes = 0;       ///< the most any channel of a pixel lies above that pixel with the lights off
-    bool clipped = false;     ///< a channel of a pixel is at the display's white where the lights-off frame is not
-    int white_code = 255;     ///< the display's white, 2^bits − 1
-};
-
-/// One rendered frame, as the observer sees it: a window per judged light.
-struct FrameViews {
-    double time_s = 0.0;               ///< the scene time it was rendered at (rhythms), s
-    std::vector<LightWindow> windows;  ///< one per light asked for, in that order
-};
-
-class StimulusRenderer {
-public:
-    /// scene_text: the scene template's text (read once: a session renders the
-    /// file as it was when it began); scene_file resolves its relative paths and
-    /// names it in errors. window_radius_deg: the radius (degrees of visual
-    /// angle) around a light that the observer looks at; the windows kept are
-    /// 2 × that (the yes-no annulus) plus a margin. interval_s: how long a frame
-    /// is shown (a frame is rendered at the moment in it when its judged light
-    /// is brightest). Needs a current GL 4.5 context.
-    StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
-                     double interval_s, std::size_t cache_frames = 4096);
-
-    /// The scene a frame's overrides give. Throws InputError (the scene's own
-    /// errors, or "--set KEY" for an override).
-    stimuli::Scene scene(const std::vector<std::string>& overrides) const;
-
-    /// The frame seen around `lights` (scene light names; "" = the screen's
-    /// centre), from the cache or rendered.
-    std::shared_ptr<const FrameViews> views(const protocols::Frame& frame, const std::vector<std::string>& lights);
-
-    /// Renders the frame afresh (also filling the cache) and returns its
-    /// scene-referred HDR image (cd/m²) and the degrees per pixel at its centre.
-    stimuli::ImageRGBA32F hdr(const protocols::Frame& frame, const std::vector<std::string>& lights,
-                              double& degrees_per_pixel);
-
-    // --- On screen (SessionDisplay draws through these) ------------------
-    /// The frame's code values for the screen: rendered at the moment of its
-    /// interval when `lights` are brightest (as the observer's views), kept in a
-    /// small LRU (a block's background is shown every trial).
-    std::shared_ptr<const stimuli::EncodedImage> codes(const protocols::Frame& frame,
-                                                       const std::vector<std::string>& lights);
-    /// A light of the frame's scene has a rhythm: the frame changes within its interval.
-    bool animated(const protocols::Frame& frame);
-    /// Renders the frame at time_s (s after its onset) through the display
-    /// pipeline, leaving its codes on the GPU for present(): an animated frame
-    /// is sampled at each flip's predicted time.
-    void encode(const protocols::Frame& frame, double time_s);
-    /// Draws the codes encode() made into the bound framebuffer, lower-left corner at (x, y).
-    void present(int x, int y) const;
-    /// The names of the scene's lights (the template with the display).
-    std::vector<std::string> light_names(const std::vector<std::string>& overrides) const;
-    /// The overrides that take every light and disc of the scene out (lights
-    /// dark, discs of zero diameter): what surrounds the stimuli.
-    std::vector<std::string> all_off(const std::vector<std::string>& overrides) const;
-
-    /// Encode every frame for this display model instead of the scene's (the
-    /// display's measured calibration: calibration_policy.h). Set before the first frame.
-    void use_display_model(display::DisplayModel model) { display_model_ = std::move(model); }
-
-    std::size_t frames_rendered() const noexcept { return rendered_; }
-    std::size_t frames_requested() const noexcept { return requested_; }
-    /// Wall-clock seconds spent rendering and reading frames back.
-    double render_seconds() const noexcept { return render_s_; }
-
-private:
-    std::shared_ptr<const FrameViews> render(const protocols::Frame& frame, const std::vector<std::string>& lights,
-                                             stimuli::ImageRGBA32F* hdr, double* degrees_per_pixel);
-    void remember(const std::string& key, std::shared_ptr<const FrameViews> views);
-    /// Renders a scene through the display pipeline: the code values the screen gets.
-    stimuli::EncodedImage render_codes(const stimuli::Scene& scene, double time_s);
-    /// render_codes without reading the codes back (they stay on the GPU).
-    void encode_scene(const stimuli::Scene& scene, double time_s);
-    /// The codes of `frame` with the named `lights` off, at time_s (a small LRU).
-    const stimuli::EncodedImage& background_codes(const protocols::Frame& frame, const std::vector<std::string>& lights,
-                                                  double time_s);
-
-    std::string scene_text_;
-    std::filesystem::path scene_file_;
-    std::optional<display::DisplayModel> display_model_;  ///< use_display_model()
-    double window_radius_deg_;
-    double interval_s_;
-    std::size_t capacity_;
-    stimuli::FrameRenderer frame_;
-    stimuli::DisplayPipeline display_;
-    // LRU: most recent at the front.
-    std::list<std::pair<std::string, std::shared_ptr<const FrameViews>>> lru_;
-    std::unordered_map<std::string, decltype(lru_)::iterator> index_;
-    std::list<std::pair<std::string, stimuli::EncodedImage>> background_lru_;
-    std::list<std::pair<std::string, std::shared_ptr<const stimuli::EncodedImage>>> codes_lru_;
-    std::pair<std::string, std::shared_ptr<const stimuli::Scene>> last_scene_;  ///< encode()'s parsed scene
-    std::size_t rendered_ = 0;
-    std::size_t requested_ = 0;
-    double render_s_ = 0.0;
-};
-
-/// What the observer is shown in trial t: each view's window of its rendered
-/// frame (rendered or from the cache). `frames` keeps the frames alive while
-/// the returned Shown points into them.
-protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer& renderer,
-                           std::vector<std::shared_ptr<const FrameViews>>& frames);
-
-/// The model observer's true value for condition c: the level its procedure
-/// should converge on (2AFC and adjust: where the level stimulus is chosen with
-/// the procedure's target probability, 0.5 = the PSE; yes-no: the detection
-/// threshold at the target P(yes)), found on the frames the renderer makes.
-/// Returns "" and sets value, or says why there is none (e.g. the display
-/// clips the level stimulus so its brightness never crosses the other's).
-std::string true_value(StimulusRenderer& renderer, const protocols::Protocol& protocol,
-                       const protocols::Condition& c, const protocols::ModelObserverParams& params, double& value);
 
 /// Runs `atonlab run` (RunOptions in commands.h). Returns the exit status: 0
 /// when the session completed, 128 + N when signal N stopped it between trials.

@@ -51,12 +51,12 @@ std::deque<ViewKey> parse_keys(const std::string& text) {
             }
             item = item.substr(0, star);
             if (count < 1)
-                throw InputError(SourceLocation{"--keys", 0, 0, ""},
+                throw InputError(SourceLocation::command_line("--keys"),
                                  fmt::format("\"{}\": the repeat count after * must be a whole number >= 1.", item));
         }
         const auto key = view_key_from_name(item);
         if (!key)
-            throw InputError(SourceLocation{"--keys", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--keys"),
                              fmt::format("unknown key \"{}\" (docs/view.md lists the names).", item));
         for (int i = 0; i < count; ++i) out.push_back(*key);
         if (comma == std::string::npos) break;
@@ -173,19 +173,19 @@ int run_view(const ViewOptions& o) {
     std::vector<stimuli::SceneOverride> overrides;
     for (const auto& s : o.overrides) overrides.push_back(stimuli::SceneOverride::parse(s));
     if (!std::isfinite(o.time_s) || o.time_s < 0.0)
-        throw InputError(SourceLocation{"--time", 0, 0, ""}, "the time must be a finite number of seconds >= 0");
+        throw InputError(SourceLocation::command_line("--time"), "the time must be a finite number of seconds >= 0");
     std::deque<ViewKey> script = parse_keys(o.keys);
     stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);
     stimuli::validate_output_settings(scene.output);
     if (o.display.empty() != o.db.empty())
-        throw InputError(SourceLocation{o.display.empty() ? "--db" : "--display", 0, 0, ""},
+        throw InputError(SourceLocation::command_line(o.display.empty() ? "--db" : "--display"),
                          "--display and --db go together: the display's calibration is read from the study file.");
     if (!o.display.empty()) {
         try {
             const store::Store db = store::Store::open_read_only(o.db);
             const auto cal = latest_measured_calibration(db, o.display);
             if (!cal)
-                throw InputError(SourceLocation{"--display", 0, 0, ""},
+                throw InputError(SourceLocation::command_line("--display"),
                                  fmt::format("display \"{}\" has no measured calibration in {}.", o.display, o.db));
             apply_display_model(scene, display_model_of(*cal));
             std::printf("encoding for calibration %lld of display \"%s\" (measured %s)\n",

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "atonlab/display/colour.h"
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::display {
 namespace {

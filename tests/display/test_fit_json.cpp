@@ -6,7 +6,7 @@
 #include <limits>
 #include <string>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/fit_json.h"
 #include "input_error.h"
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "atonlab/display/colour.h"
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::display {
 namespace {

@@ -2,7 +2,7 @@
 // What a call throws as InputError, for tests that check the message.
 #include <string>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::test {
 

@@ -68,13 +68,13 @@ TEST(CalibratePatches, TooFewLevelsNameTheOption) {
         measurement_patches(8, 9);
         FAIL();
     } catch (const InputError& e) {
-        EXPECT_EQ(e.where()->file, "--grey-levels");
+        EXPECT_EQ(e.where()->option, "--grey-levels");
     }
     try {
         measurement_patches(9, 3);
         FAIL();
     } catch (const InputError& e) {
-        EXPECT_EQ(e.where()->file, "--colour-levels");
+        EXPECT_EQ(e.where()->option, "--colour-levels");
     }
 }
 
@@ -398,9 +398,9 @@ TEST(CalibratePolicy, ProtocolDisplayNameAndMaximumAge) {
     auto error_key = [&](const std::string& keys) {
         try {
             protocols::parse_protocol(with_keys(keys), "p.toml");
-        } catch (const protocols::ProtocolError& e) {
-            EXPECT_EQ(e.line(), 18) << e.what();  // [display] is line 15; 16 and 17 are blank
-            return e.key();
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.where()->line, 18) << e.what();  // [display] is line 15; 16 and 17 are blank
+            return e.where()->key;
         }
         ADD_FAILURE() << keys;
         return std::string();

@@ -398,10 +398,10 @@ Shown task_only(Task t) {
 std::string error_of(const std::function<void()>& f) {
     try {
         f();
-    } catch (const ProtocolError& e) {
+    } catch (const atonlab::InputError& e) {
         return e.what();
     }
-    return "(no ProtocolError)";
+    return "(no InputError)";
 }
 
 TEST(ScriptedObserver, ReadsAnswersInOrder) {

@@ -70,8 +70,8 @@ TEST(ProtocolDisc, ReferenceLightAndDiscTogetherAreRefused) {
     text.replace(text.find("reference_disc"), 0, "reference_light = \"white\"\n");
     try {
         (void)parse_protocol(text, "inline.toml");
-        FAIL() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
+        FAIL() << "no InputError";
+    } catch (const atonlab::InputError& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find("inline.toml:18:"), std::string::npos) << what;
         EXPECT_NE(what.find("reference_disc"), std::string::npos) << what;

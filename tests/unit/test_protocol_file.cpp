@@ -526,10 +526,10 @@ Protocol parse(const std::string& body) {
 std::string error_of(const std::string& body) {
     try {
         (void)parse(body);
-    } catch (const ProtocolError& e) {
+    } catch (const atonlab::InputError& e) {
         return e.what();
     }
-    return "(no ProtocolError)";
+    return "(no InputError)";
 }
 
 TEST(ProtocolSchema, SideBySideSwapsThePositionsWithTheForcedChoice) {
@@ -675,7 +675,7 @@ std::string conflict_case(const std::string& presentation, const std::string& de
 std::string conflict_error(const std::string& text) {
     try {
         (void)parse(text);
-    } catch (const ProtocolError& e) {
+    } catch (const atonlab::InputError& e) {
         return e.what();
     }
     return "";
@@ -834,12 +834,12 @@ TEST(ProtocolErrors, EveryMalformedFileNamesFileLineAndKey) {
         const fs::path path = dir / b.file;
         try {
             (void)load_protocol(path);
-            ADD_FAILURE() << "no ProtocolError";
-        } catch (const ProtocolError& e) {
+            ADD_FAILURE() << "no InputError";
+        } catch (const atonlab::InputError& e) {
             const std::string what = e.what();
-            EXPECT_EQ(e.file(), path.string());
-            EXPECT_EQ(e.line(), b.line) << what;
-            EXPECT_EQ(e.key(), b.key) << what;
+            EXPECT_EQ(e.where()->file, path.string());
+            EXPECT_EQ(e.where()->line, b.line) << what;
+            EXPECT_EQ(e.where()->key, b.key) << what;
             EXPECT_NE(what.find(b.says), std::string::npos) << what;
             // One sentence: "FILE:LINE: key 'KEY': MESSAGE." on one line, one final period.
             std::string prefix = path.string();
@@ -860,7 +860,7 @@ TEST(ProtocolErrors, AnUnreadableFileIsOneSentence) {
     try {
         (void)load_protocol("/nonexistent/protocol.toml");
         ADD_FAILURE();
-    } catch (const ProtocolError& e) {
+    } catch (const atonlab::InputError& e) {
         EXPECT_EQ(std::string(e.what()),
                   "/nonexistent/protocol.toml: cannot read the protocol file: No such file or directory.");
     }
@@ -1105,10 +1105,10 @@ level_key = "light.r.intensity_cd"
 level_scale = "linear"
 procedure = { kind = "staircase", start = -2.0, step_type = "lin", n_reversals = 4 }
 )");
-        ADD_FAILURE() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
-        EXPECT_EQ(e.line(), 12);
-        EXPECT_EQ(e.key(), "timing.stimulus");
+        ADD_FAILURE() << "no InputError";
+    } catch (const atonlab::InputError& e) {
+        EXPECT_EQ(e.where()->line, 12);
+        EXPECT_EQ(e.where()->key, "timing.stimulus");
         ASSERT_EQ(e.further().size(), 2u) << e.what();
         EXPECT_EQ(e.further()[0].rfind("inline.toml:13: key 'timing.inter_trial'", 0), 0u) << e.further()[0];
         EXPECT_NE(e.further()[1].find("These look like log10 values"), std::string::npos) << e.further()[1];
@@ -1175,11 +1175,11 @@ conditions_file = "c.csv"
     }
     try {
         (void)load_protocol(dir / "p.toml");
-        ADD_FAILURE() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
+        ADD_FAILURE() << "no InputError";
+    } catch (const atonlab::InputError& e) {
         const std::string csv = (dir / "c.csv").string();
-        EXPECT_EQ(e.file(), csv) << e.what();
-        EXPECT_EQ(e.line(), 3) << e.what();
+        EXPECT_EQ(e.where()->file, csv) << e.what();
+        EXPECT_EQ(e.where()->line, 3) << e.what();
         ASSERT_EQ(e.further().size(), 1u) << e.what();
         EXPECT_EQ(e.further()[0].rfind(csv + ":4: column 4 'level_scale': ", 0), 0u) << e.further()[0];
     }
@@ -1189,8 +1189,8 @@ conditions_file = "c.csv"
     }
     try {
         (void)load_protocol(dir / "p.toml");
-        ADD_FAILURE() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
+        ADD_FAILURE() << "no InputError";
+    } catch (const atonlab::InputError& e) {
         EXPECT_EQ(std::string(e.what()).rfind((dir / "c.csv").string() + ":2: column 2 'procedure.strat': ", 0), 0u)
             << e.what();
     }
@@ -1200,8 +1200,8 @@ conditions_file = "c.csv"
     }
     try {
         (void)load_protocol(dir / "p.toml");
-        ADD_FAILURE() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
+        ADD_FAILURE() << "no InputError";
+    } catch (const atonlab::InputError& e) {
         EXPECT_EQ(std::string(e.what()).rfind((dir / "c.csv").string() + ":1: column 2 'colour': not a column", 0), 0u)
             << e.what();
     }
@@ -1234,9 +1234,9 @@ TEST(ConditionsFile, TheStoredTextCarriesTheCsvSoThatItParsesWithoutIt) {
     // Without the CSV and without the stored copy, the error names the key.
     try {
         (void)parse_protocol(text, "/nonexistent/glare_brightness_2afc_csv.toml");
-        ADD_FAILURE() << "no ProtocolError";
-    } catch (const ProtocolError& e) {
-        EXPECT_EQ(e.key(), "block[0].conditions_file") << e.what();
+        ADD_FAILURE() << "no InputError";
+    } catch (const atonlab::InputError& e) {
+        EXPECT_EQ(e.where()->key, "block[0].conditions_file") << e.what();
         EXPECT_NE(std::string(e.what()).find("cannot read the conditions file"), std::string::npos) << e.what();
     }
 }

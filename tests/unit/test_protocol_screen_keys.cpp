@@ -71,9 +71,9 @@ void expect_error(const std::string& timing, const std::string& screens, const s
     try {
         (void)parse_protocol(protocol_with(timing, screens), "p.toml");
         FAIL() << "accepted";
-    } catch (const ProtocolError& e) {
-        EXPECT_EQ(e.key(), key) << e.what();
-        EXPECT_EQ(e.line(), line) << e.what();
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.where()->key, key) << e.what();
+        EXPECT_EQ(e.where()->line, line) << e.what();
         EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
         EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
     }

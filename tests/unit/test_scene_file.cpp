@@ -505,7 +505,7 @@ TEST(SceneFileGlare, BadCieObserverNamesFileLineAndKey) {
     expect_error_at(eye + "cie_age_years = 100\ncie_pigmentation = 1.2\n", 8, "eye.cie_age_years",
                     "more than all of it");
     const InputError e = error_of(std::string(kMinimal), sets({"eye.cie_age_years=-1"}));
-    EXPECT_EQ(e.where()->file, "--set");
+    EXPECT_EQ(e.where()->option, "--set");
     EXPECT_EQ(e.where()->key, "eye.cie_age_years");
 }
 
@@ -631,7 +631,7 @@ TEST(SceneOverrides, AddKeysAndTablesTheFileLeavesOut) {
 TEST(SceneOverrides, WrongTypeIsRejected) {
     const InputError e = error_of(kFullScene, sets({"camera.yaw_deg=\"north\""}));
     ASSERT_TRUE(e.where().has_value());
-    EXPECT_EQ(e.where()->file, "--set");
+    EXPECT_EQ(e.where()->option, "--set");
     EXPECT_EQ(e.where()->key, "camera.yaw_deg");
     const std::string what = e.what();
     EXPECT_NE(what.find("expected a number like the value it replaces (harbour.toml:10), got a string"),
@@ -662,7 +662,7 @@ TEST(SceneOverrides, UnknownKeysAreRejectedNamingSet) {
                             "light[9].intensity_cd=1", "profiles.vertical.lantern.relativ=[1, 1]", "camera=4"}) {
         const InputError e = error_of(kFullScene, sets({bad}));
         ASSERT_TRUE(e.where().has_value()) << bad;
-        EXPECT_EQ(e.where()->file, "--set") << bad;
+        EXPECT_EQ(e.where()->option, "--set") << bad;
         EXPECT_TRUE(std::string(e.what()).starts_with("--set: key '")) << e.what();
     }
     const InputError e = error_of(kFullScene, sets({"camera.yaw=4"}));
@@ -676,7 +676,7 @@ TEST(SceneOverrides, ValidationErrorsPointAtTheOverride) {
     const InputError s =
         error_of(kFullScene, sets({"light.buoy.horizontal_profile=\"uniform\"",
                                    "light.buoy.sectors=[{from_deg = 10, to_deg = 20}, {from_deg = 1}]"}));
-    EXPECT_EQ(s.where()->file, "--set");
+    EXPECT_EQ(s.where()->option, "--set");
     EXPECT_EQ(s.where()->key, "light.buoy.sectors[1].to_deg") << s.what();
     const InputError r = error_of(kFullScene, sets({"light[2].rhythm=Blink"}));
     EXPECT_EQ(r.where()->key, "light[2].rhythm");
@@ -813,4 +813,45 @@ intensity_cd = 10
     // what() is every line: the first, then the others.
     const std::string all = e.what();
     EXPECT_EQ(std::count(all.begin(), all.end(), '\n'), 3) << all;
+}
+
+// A template makes each scene afresh: overrides never leak into the next
+// instantiation, and errors keep the template's own lines.
+TEST(SceneTemplate, EachInstantiationStartsFromTheFileAndKeepsItsLines) {
+    const SceneTemplate t = SceneTemplate::parse(kFullScene, kFile);
+    const Scene brighter = t.instantiate({SceneOverride::parse("light.buoy.intensity_cd=400")});
+    EXPECT_EQ(brighter.lights[0].intensity_cd, 400.0);
+    const Scene plain = t.instantiate();
+    EXPECT_EQ(plain.lights[0].intensity_cd, 250.0);  // the file's value, as written
+    EXPECT_EQ(plain.lights[1].intensity_cd, 1000.0);
+
+    // An override that makes a value of the file wrong elsewhere: the error
+    // names the file's line, which the copy kept.
+    const std::string bad = std::string(kMinimal) + "\n[eye]\npupil_mm = -1\n";
+    const SceneTemplate tb = SceneTemplate::parse(bad, kFile);
+    try {
+        (void)tb.instantiate({SceneOverride::parse("camera.yaw_deg=10")});
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        ASSERT_TRUE(e.where());
+        EXPECT_EQ(e.where()->file, kFile);
+        EXPECT_EQ(e.where()->line, line_of(bad, "pupil_mm = -1")) << e.what();
+        EXPECT_EQ(e.where()->key, "eye.pupil_mm") << e.what();
+    }
+}
+
+// Every unknown key of one table is reported in one run, not only the first.
+TEST(SceneFileErrors, EveryUnknownKeyOfATableIsReported) {
+    const std::string text = std::string(kMinimal) + "brightness = 1\ncontrast = 2\n";
+    try {
+        (void)parse_scene(text, kFile);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        ASSERT_TRUE(e.where());
+        EXPECT_EQ(e.where()->key, "display.brightness") << e.what();
+        ASSERT_EQ(e.further().size(), 1u) << e.what();
+        EXPECT_NE(e.further()[0].find("key 'display.contrast'"), std::string::npos) << e.what();
+        EXPECT_NE(e.further()[0].find(":" + std::to_string(line_of(text, "contrast")) + ":"), std::string::npos)
+            << e.what();
+    }
 }

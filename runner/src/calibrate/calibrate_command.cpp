@@ -66,7 +66,7 @@ std::string measurement_date(const std::string& date) {
     const std::chrono::year_month_day ymd{std::chrono::year{y}, std::chrono::month{m}, std::chrono::day{d}};
     if (!shaped || !ymd.ok())
         throw InputError(
-            SourceLocation{"--date", 0, 0, ""},
+            SourceLocation::command_line("--date"),
             fmt::format("\"{}\" is not a date YYYY-MM-DD (optionally with a time, 2024-05-01T10:30Z).", date));
     return date;
 }
@@ -121,7 +121,7 @@ display::DisplayGeometry resolve_geometry(const CalibrateOptions& o, const std::
                                         {g.height_m(), "--height-m"},
                                         {g.viewing_distance_m, "--viewing-distance-m"}})
         if (!(std::isfinite(value) && value > 0.0))
-            throw InputError(SourceLocation{option, 0, 0, ""},
+            throw InputError(SourceLocation::command_line(option),
                              fmt::format("must be a positive length in metres, not {}.", value));
     return g;
 }
@@ -187,19 +187,19 @@ std::optional<Measured> measure(const CalibrateOptions& o, const std::vector<Pat
                                 const std::optional<store::Calibration>& prior, bool need_geometry) {
     const bool instrument = !o.instrument.kind.empty();
     if (instrument && !o.readings.empty())
-        throw InputError(SourceLocation{"--instrument", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--instrument"),
                          "the readings come from --instrument or from --readings FILE, not both.");
     if (instrument) validate_instrument_options(o.instrument);
     if (o.headless && o.readings.empty() && !instrument)
-        throw InputError(SourceLocation{"--headless", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--headless"),
                          "--headless shows the patches to no one: give the readings with --readings FILE (or "
                          "--instrument virtual).");
     if (!(o.window_percent > 0.0 && o.window_percent <= 100.0))
         throw InputError(
-            SourceLocation{"--window-percent", 0, 0, ""},
+            SourceLocation::command_line("--window-percent"),
             fmt::format("the patch covers more than 0 and at most 100 % of the screen, not {}.", o.window_percent));
     if (!(o.patch_seconds >= 0.0 && std::isfinite(o.patch_seconds)))
-        throw InputError(SourceLocation{"--patch-seconds", 0, 0, ""}, "must be a number of seconds >= 0.");
+        throw InputError(SourceLocation::command_line("--patch-seconds"), "must be a number of seconds >= 0.");
     PatchSessionOptions session;
     session.patch_seconds = o.patch_seconds;
     session.quiet = o.quiet;
@@ -395,7 +395,7 @@ int run_import(const CalibrateOptions& o) {
     if (!o.drive_scale.empty()) {
         file_options.drive_scale = display::drive_scale_from_name(o.drive_scale);
         if (!file_options.drive_scale)
-            throw InputError(SourceLocation{"--drive-scale", 0, 0, ""},
+            throw InputError(SourceLocation::command_line("--drive-scale"),
                              fmt::format("\"{}\" is not a drive scale: fraction (0 to 1), 8bit (codes 0 to 255) or "
                                          "10bit (codes 0 to 1023).",
                                          o.drive_scale));
@@ -422,10 +422,10 @@ int run_check(const CalibrateOptions& o) {
                                         {o.tolerances.peak_percent, "--tol-peak-percent"},
                                         {o.tolerances.gamma, "--tol-gamma"}})
         if (!(std::isfinite(value) && value > 0.0))
-            throw InputError(SourceLocation{option, 0, 0, ""}, fmt::format("a tolerance must be > 0, not {}.", value));
+            throw InputError(SourceLocation::command_line(option), fmt::format("a tolerance must be > 0, not {}.", value));
     std::error_code ec;
     if (o.profiles_file && !fs::exists(o.db, ec))
-        throw InputError(SourceLocation{"--display", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--display"),
                          fmt::format("display \"{}\" has no measured calibration to check: the display-profile file "
                                      "{} ({}) does not exist yet; run `atonlab calibrate measure` (or import) first.",
                                      o.display, o.db, o.profiles_default ? "the per-user default" : file_option(o)));
@@ -433,7 +433,7 @@ int run_check(const CalibrateOptions& o) {
     store::Store& db = file.displays();
     const std::optional<store::Calibration> cal = latest_measured_calibration(db, o.display);
     if (!cal)
-        throw InputError(SourceLocation{"--display", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--display"),
                          fmt::format("display \"{}\" has no measured calibration in {} to check: run `atonlab "
                                      "calibrate measure` (or import) first.",
                                      o.display, o.db));
@@ -587,11 +587,11 @@ int run_calibrate(const CalibrateOptions& given) {
     try {
         CalibrateOptions o = given;
         if (o.display.empty() && o.mode != "list" && o.mode != "import")
-            throw InputError(SourceLocation{"--display", 0, 0, ""}, "the display's name must not be empty.");
+            throw InputError(SourceLocation::command_line("--display"), "the display's name must not be empty.");
         if (o.db.empty()) {
             const std::optional<ProfilesLocation> where = profiles_location(o.profiles);
             if (!where)
-                throw InputError(SourceLocation{"--profiles", 0, 0, ""},
+                throw InputError(SourceLocation::command_line("--profiles"),
                                  fmt::format("no display-profile file: give --profiles FILE (or --db STUDY.db), or "
                                              "set {} (HOME and XDG_DATA_HOME are both unset).",
                                              kProfilesEnv));

@@ -90,7 +90,7 @@ int run_show(const CalibrateOptions& o) {
     const store::Store& f = file.displays();
     const std::vector<store::Calibration> cals = f.calibrations(o.display);
     if (cals.empty())
-        throw InputError(SourceLocation{"--display", 0, 0, ""},
+        throw InputError(SourceLocation::command_line("--display"),
                          fmt::format("display \"{}\" has no calibration in {} (`atonlab calibrate list` shows which "
                                      "displays it has).",
                                      o.display, o.db));

@@ -53,11 +53,11 @@ std::string Patch::description() const {
 std::vector<Patch> measurement_patches(int grey_levels, int colour_levels) {
     if (grey_levels < 9 || grey_levels > 256)
         throw InputError(
-            SourceLocation{"--grey-levels", 0, 0, ""},
+            SourceLocation::command_line("--grey-levels"),
             fmt::format("the grey ramp needs 9 to 256 levels (black and white included), not {}.", grey_levels));
     if (colour_levels < 4 || colour_levels > 256)
         throw InputError(
-            SourceLocation{"--colour-levels", 0, 0, ""},
+            SourceLocation::command_line("--colour-levels"),
             fmt::format("each colour ramp needs 4 to 256 levels (black included) for a fit, not {}.", colour_levels));
     std::vector<Patch> out{make_patch(display::Channel::grey, 0), make_patch(display::Channel::grey, Patch::max_code)};
     for (int code : ramp_codes(grey_levels))

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/fit_json.h"
 
 namespace atonlab::runner {

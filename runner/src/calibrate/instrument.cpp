@@ -36,7 +36,7 @@ void add_instrument_options(CLI::App* cmd, InstrumentOptions& o) {
 
 void validate_instrument_options(const InstrumentOptions& o) {
     auto bad = [](const char* option, const std::string& why) {
-        return InputError(SourceLocation{option, 0, 0, ""}, why);
+        return InputError(SourceLocation::command_line(option), why);
     };
     auto positive = [&](double v, const char* option, const char* what) {
         if (!(std::isfinite(v) && v > 0.0)) throw bad(option, fmt::format("{} must be > 0, not {}.", what, v));

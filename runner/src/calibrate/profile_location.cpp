@@ -30,7 +30,7 @@ std::optional<store::Profiles> open_profiles_for_run(const std::string& option, 
     std::error_code ec;
     if (!std::filesystem::exists(where->path, ec)) {
         if (!where->explicit_path) return std::nullopt;
-        throw InputError(SourceLocation{where->origin, 0, 0, ""},
+        throw InputError(SourceLocation::command_line(where->origin),
                          fmt::format("the display-profile file {} does not exist (measure a display into it with "
                                      "`atonlab calibrate measure --profiles {}`, or run with --no-profiles).",
                                      where->path.string(), where->path.string()));

@@ -3,11 +3,13 @@
 // on past an error in one table or entry, collect what each part throws, and
 // report all of it (up to a limit) in file order in one run — a protocol
 // written by trial and error then takes one run per batch of mistakes, not
-// one run per mistake. Each loader turns its own error type into a Problem
-// and back; this is the one mechanism both use.
+// one run per mistake. This is the one mechanism both use.
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::text {
 
@@ -20,6 +22,12 @@ struct Problem {
     std::string key;
     std::string message;  ///< the sentence without its location
     std::string text;     ///< "FILE:LINE: key 'KEY': MESSAGE"
+    std::string option;   ///< the command-line option, when the value came from one
+
+    /// The error `e` as a Problem.
+    static Problem of(const InputError& e);
+    /// The location as an InputError takes it.
+    SourceLocation where() const { return SourceLocation{file, line, column, key, option}; }
 };
 
 class ErrorList {
@@ -43,6 +51,16 @@ public:
             return false;
         }
     }
+
+    /// Runs `f`; an InputError that it throws is added and false returned.
+    template <class F>
+    bool attempt(F&& f) {
+        return attempt<InputError>(std::forward<F>(f), Problem::of);
+    }
+
+    /// When errors were kept: throws the first (in file order) as an
+    /// InputError whose further() holds the others' lines.
+    void throw_if_any() const;
 
     bool empty() const noexcept { return kept_.empty(); }
     std::size_t size() const noexcept { return kept_.size() + dropped_; }

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::display {
 

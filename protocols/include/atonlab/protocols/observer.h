@@ -196,13 +196,13 @@ double true_threshold(const std::function<DisplayedImage(double level)>& image_a
 /// response time in seconds ("left 0.62"). Words: left, right (also first,
 /// second), yes, no, coarse_up, coarse_down, fine_up, fine_down, confirm
 /// (hyphens may replace underscores). '#' starts a comment; blank lines are
-/// skipped. Every error is a ProtocolError naming the file and the line.
+/// skipped. Every error is an InputError naming the file and the line.
 class ScriptedObserver : public Observer {
 public:
     static ScriptedObserver load(const std::filesystem::path& file);
     static ScriptedObserver parse(std::string_view text, std::string_view file_name);
 
-    /// The next line's answer. Throws ProtocolError when the answers are used
+    /// The next line's answer. Throws InputError when the answers are used
     /// up, or when the line's answer does not fit the task (naming the line).
     Answer answer(const Shown& shown) override;
     std::size_t size() const noexcept { return lines_.size(); }

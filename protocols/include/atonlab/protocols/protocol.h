@@ -24,38 +24,10 @@
 #include <variant>
 #include <vector>
 
+#include "atonlab/common/input_error.h"  // bad input: InputError, as every library's
 #include "atonlab/protocols/procedures.h"
 
 namespace atonlab::protocols {
-
-/// Bad input in a protocol file (or a scripted observer's answer file): one
-/// sentence and where it happened. what() is "FILE:LINE: key 'KEY': MESSAGE",
-/// the parts omitted when unknown (line 0, empty key) — the same shape as the
-/// stimuli library's InputError, which this library must not include.
-class ProtocolError : public std::runtime_error {
-public:
-    ProtocolError(std::string file, int line, int column, std::string key, const std::string& message);
-    /// The first of several errors (in file order), with the others' whole
-    /// lines: what() is the first line, then each further one on its own line.
-    ProtocolError(std::string file, int line, int column, std::string key, const std::string& message,
-                  std::vector<std::string> further);
-
-    const std::string& file() const noexcept { return file_; }
-    int line() const noexcept { return line_; }               ///< 1-based; 0 when unknown
-    int column() const noexcept { return column_; }           ///< 1-based; 0 when unknown
-    const std::string& key() const noexcept { return key_; }  ///< dotted key as written; may be empty
-    const std::string& message() const noexcept { return message_; }
-    /// The other errors found in the same run, each a whole line ("FILE:LINE: ..."); empty when one.
-    const std::vector<std::string>& further() const noexcept { return further_; }
-
-private:
-    std::vector<std::string> further_;
-    std::string file_;
-    int line_;
-    int column_;
-    std::string key_;
-    std::string message_;
-};
 
 /// What the observer is asked to do on a trial.
 enum class Task : std::uint8_t {

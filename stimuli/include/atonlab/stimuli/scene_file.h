@@ -1,6 +1,7 @@
 #pragma once
 // The scene file (TOML; docs/architecture.md "Units and colour"; every key in docs/scene-file.md).
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,29 @@ struct SceneOverride {
     SourceLocation origin;
     /// Parses "key=value"; throws InputError for a missing '=' or an empty key.
     static SceneOverride parse(std::string_view text);
+};
+
+/// A scene file read once (its TOML syntax checked), from which scenes are
+/// made with different overrides: a protocol's conditions change a few keys of
+/// one template per frame. Copies share the text, which never changes. (Each
+/// instantiate() still parses the text: toml++ drops source lines when a tree
+/// is copied, and errors must name the file's lines.)
+class SceneTemplate {
+public:
+    /// Parses `toml_text` (file_label names it in errors). Throws InputError
+    /// for a TOML syntax error; the schema is checked by instantiate().
+    static SceneTemplate parse(std::string_view toml_text, std::string_view file_label);
+    /// Reads and parses a scene file (up to text::kMaxInputFileBytes).
+    static SceneTemplate load(const std::filesystem::path& file);
+
+    /// The scene with `overrides` applied in order, validated as load_scene does.
+    Scene instantiate(const std::vector<SceneOverride>& overrides = {}) const;
+    const std::string& file_label() const noexcept;
+
+private:
+    struct Parsed;
+    explicit SceneTemplate(std::shared_ptr<const Parsed> parsed) : parsed_(std::move(parsed)) {}
+    std::shared_ptr<const Parsed> parsed_;
 };
 
 /// Loads and validates a scene file, applying overrides in order (each one

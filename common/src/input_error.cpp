@@ -1,4 +1,4 @@
-#include "atonlab/common/error.h"
+#include "atonlab/common/input_error.h"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,9 @@ namespace {
 
 std::string format_error(const SourceLocation& w, const std::string& message) {
     std::string s;
-    if (!w.file.empty()) {
+    if (!w.option.empty()) {
+        s += w.option + ": ";
+    } else if (!w.file.empty()) {
         s += w.file;
         if (w.line > 0) s += fmt::format(":{}", w.line);
         s += ": ";

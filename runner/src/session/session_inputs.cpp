@@ -1,0 +1,79 @@
+// A session's inputs, read and checked (session_inputs.h).
+#include "session/session_inputs.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "atonlab/protocols/protocol_file.h"
+#include "atonlab/stimuli/scene_file.h"
+#include "atonlab/store/sha256.h"
+#include "session/condition_scene.h"
+
+namespace atonlab::runner {
+
+namespace p = atonlab::protocols;
+namespace s = atonlab::stimuli;
+
+std::string read_text(const std::filesystem::path& file, std::string_view what, std::uintmax_t max_bytes) {
+    text::FileText read = text::read_text_file(file, max_bytes);  // only up to a limit (/dev/zero is refused)
+    if (!read.ok())
+        throw InputError(SourceLocation{file.string(), 0, 0, ""},
+                         fmt::format("cannot read the {}: {}.", what, read.error));
+    return std::move(read.text);
+}
+
+namespace {
+
+bool valid_observer_code(std::string_view code) {
+    if (code.empty() || code.size() > 32) return false;
+    return std::all_of(code.begin(), code.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    });
+}
+
+}  // namespace
+
+std::string checked_observer_code(const RunOptions& o) {
+    // A person answers at the screen; the model or a script answer anywhere.
+    const bool person = !o.model_observer && o.script.empty();
+    if (person && o.headless)
+        throw InputError(SourceLocation::command_line("--headless"),
+                         "a headless run has no screen for a person: give --model-observer or --script FILE with "
+                         "--headless, or leave --headless out to run full screen.");
+    if (person && o.observer.empty())
+        throw InputError(SourceLocation::command_line("--observer"),
+                         "give the observer's code with --observer ID (or answer with --model-observer or --script "
+                         "FILE).");
+    if (o.inject_stall_frames > 0 && !o.inject_stall_at_trial)
+        throw InputError(SourceLocation::command_line("--inject-stall-frames"),
+                         "name the trial to stall with --inject-stall-at-trial N.");
+    if (o.capture_trial && o.capture_dir.empty())
+        throw InputError(SourceLocation::command_line("--capture-trial"), "give the folder with --capture-dir DIR.");
+    const std::string code = o.model_observer ? std::string("model") : (o.observer.empty() ? "script" : o.observer);
+    if (!valid_observer_code(code))
+        throw InputError(SourceLocation::command_line("--observer"),
+                         fmt::format("the observer code \"{}\" must be 1 to 32 letters, digits, '_' or '-' (a code, "
+                                     "never a name).",
+                                     code));
+    return code;
+}
+
+SessionInputs load_session_inputs(const RunOptions& o) {
+    SessionInputs in;
+    in.protocol = p::load_protocol(o.protocol);
+    if (!o.script.empty()) in.script = p::ScriptedObserver::load(o.script);
+    in.protocol_text = p::with_conditions_files(read_text(o.protocol, "protocol file"), o.protocol);
+    in.protocol_sha = store::sha256_hex(in.protocol_text);
+    in.scene_file = in.protocol.scene;
+    in.scene_text = read_text(in.scene_file, "scene template");
+    // The template alone first: its own errors name its file and line.
+    std::vector<s::SceneOverride> display;
+    for (const std::string& d : in.protocol.display_overrides()) display.push_back(parsed_override(in.protocol, d));
+    in.display_scene = s::parse_scene(in.scene_text, in.scene_file.string(), display);
+    validate_conditions(in.protocol, in.scene_text, in.scene_file);
+    return in;
+}
+
+}  // namespace atonlab::runner

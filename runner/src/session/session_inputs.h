@@ -1,0 +1,45 @@
+#pragma once
+// What a session reads and checks before anything else: the options that need
+// no file, the protocol (and script), the scene template, every condition's
+// frames through the scene loader.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "atonlab/common/input_text.h"
+#include "atonlab/protocols/observer.h"
+#include "atonlab/protocols/protocol.h"
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/scene.h"
+#include "commands.h"
+
+namespace atonlab::runner {
+
+/// A file's text, up to max_bytes (so /dev/zero is refused); InputError naming
+/// `what` when it cannot be read.
+std::string read_text(const std::filesystem::path& file, std::string_view what,
+                      std::uintmax_t max_bytes = text::kMaxInputFileBytes);
+
+/// The options that need no file checked (InputError naming the option); the
+/// observer code the session is stored under ("model", "script" or --observer).
+std::string checked_observer_code(const RunOptions& o);
+
+struct SessionInputs {
+    protocols::Protocol protocol;
+    std::optional<protocols::ScriptedObserver> script;
+    /// The protocol file's text, with its conditions files (if any) appended as
+    /// comments: the study stores the whole design (protocol_file.h).
+    std::string protocol_text;
+    std::string protocol_sha;  ///< SHA-256 of protocol_text, hex
+    std::filesystem::path scene_file;
+    std::string scene_text;  ///< read once: a session renders the template as it was when it began
+    stimuli::Scene display_scene;  ///< the template with the protocol's [display]
+};
+
+/// Loads the protocol, the script and the scene template, and checks every
+/// condition's frames (condition_scene.h). Throws InputError.
+SessionInputs load_session_inputs(const RunOptions& o);
+
+}  // namespace atonlab::runner

@@ -1,0 +1,44 @@
+// The session's observer and what it is shown (session_observer.h).
+#include "session/session_observer.h"
+
+#include <fmt/format.h>
+
+#include "atonlab/protocols/rng.h"
+#include "session/scene_queries.h"
+
+namespace atonlab::runner {
+
+namespace p = atonlab::protocols;
+
+p::Shown shown_for(const p::ScheduledTrial& t, StimulusRenderer& renderer,
+                   std::vector<std::shared_ptr<const FrameViews>>& frames) {
+    frames.assign(t.stimulus.frames.size(), nullptr);
+    p::Shown shown;
+    shown.task = t.task;
+    shown.adjusted_view = t.stimulus.adjusted_view;
+    for (std::size_t f = 0; f < frames.size(); ++f)
+        frames[f] = renderer.views(t.stimulus.frames[f], judged_lights(t.stimulus, f));
+    std::vector<std::size_t> seen(frames.size(), 0);
+    for (const p::StimulusView& v : t.stimulus.views) {
+        const LightWindow& w = frames[v.frame]->windows[seen[v.frame]++];
+        shown.views.push_back(p::View{&w.image, w.light_px});
+    }
+    return shown;
+}
+
+SessionObserver::SessionObserver(const RunOptions& o, std::uint64_t observer_seed,
+                                 std::optional<p::ScriptedObserver> script)
+    : model_(o.model_observer), seed_(observer_seed), script_(std::move(script)) {}
+
+p::Answer SessionObserver::answer(const p::ScheduledTrial& t, StimulusRenderer* renderer) {
+    if (!model_) return script_->answer(p::Shown{t.task, {}, t.stimulus.adjusted_view});
+    const std::string match = fmt::format("{}#{}", t.procedure_id, t.proposal.trial);
+    if (!current_ || t.task != p::Task::Adjust || match != match_) {
+        current_ = std::make_unique<p::ModelObserver>(params_, p::derive_seed(seed_, t.step));
+        match_ = match;
+    }
+    std::vector<std::shared_ptr<const FrameViews>> frames;
+    return current_->answer(shown_for(t, *renderer, frames));
+}
+
+}  // namespace atonlab::runner

@@ -1,0 +1,53 @@
+#pragma once
+// Who answers a session's trials: the model observer (on the frames the
+// renderer makes), a script, or a person at the screen.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "atonlab/protocols/observer.h"
+#include "atonlab/protocols/protocol_schedule.h"
+#include "commands.h"
+#include "session/stimulus_renderer.h"
+
+namespace atonlab::runner {
+
+/// What the observer is shown in trial t: each view's window of its rendered
+/// frame (rendered or from the cache). `frames` keeps the frames alive while
+/// the returned Shown points into them.
+protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer& renderer,
+                           std::vector<std::shared_ptr<const FrameViews>>& frames);
+
+/// A model observer's answers are a pure function of (observer seed, the
+/// trial's first step, what it was shown): each trial (each adjustment match)
+/// gets a fresh ModelObserver seeded derive_seed(observer_seed, step), so a
+/// resumed session answers exactly as an uninterrupted one would have.
+class SessionObserver {
+public:
+    SessionObserver(const RunOptions& o, std::uint64_t observer_seed, std::optional<protocols::ScriptedObserver> script);
+
+    bool model() const noexcept { return model_; }
+    bool person() const noexcept { return !model_ && !script_; }  ///< a person answers at the screen
+    std::uint64_t seed() const noexcept { return seed_; }
+    const protocols::ModelObserverParams& params() const noexcept { return params_; }
+
+    /// The answer to trial `t`. Renders what the model observer looks at.
+    protocols::Answer answer(const protocols::ScheduledTrial& t, StimulusRenderer* renderer);
+
+    /// A scripted observer skips the lines the logged trials used.
+    void skip(protocols::Task task, std::optional<std::size_t> adjusted_view) {
+        if (script_) script_->answer(protocols::Shown{task, {}, adjusted_view});
+    }
+
+private:
+    bool model_;
+    std::uint64_t seed_;
+    protocols::ModelObserverParams params_{};
+    std::optional<protocols::ScriptedObserver> script_;
+    std::unique_ptr<protocols::ModelObserver> current_;
+    std::string match_;
+};
+
+}  // namespace atonlab::runner

@@ -1,0 +1,319 @@
+// StimulusRenderer (stimulus_renderer.h): frames rendered through the display
+// pipeline, cached, and cut into the windows the observer looks at.
+#include "session/stimulus_renderer.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "atonlab/stimuli/error.h"
+#include "atonlab/stimuli/glare_stage.h"
+#include "atonlab/stimuli/scene_file.h"
+#include "atonlab/stimuli/tonemap.h"
+#include "calibration_policy.h"
+#include "session/progress.h"
+#include "session/scene_queries.h"
+
+namespace atonlab::runner {
+
+namespace p = atonlab::protocols;
+namespace s = atonlab::stimuli;
+
+namespace {
+
+std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lights) {
+    std::string key;
+    for (const std::string& o : frame.overrides) (key += o) += '\n';
+    key += '\x1f';
+    for (const std::string& l : lights) (key += l) += '\n';
+    return key;
+}
+
+/// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
+/// (row 0 at the top) for the codes given: the display model's luminance,
+/// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
+std::vector<float> emitted_window(const s::EncodedImage& codes, const s::DisplayModel& display, int x0, int y0, int n) {
+    std::map<std::uint64_t, float> emitted;
+    std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
+    for (int v = 0; v < n; ++v) {
+        const int y = y0 + v;
+        if (y < 0 || y >= codes.height) continue;
+        for (int u = 0; u < n; ++u) {
+            const int x = x0 + u;
+            if (x < 0 || x >= codes.width) continue;
+            const std::size_t i =
+                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
+                3;
+            const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
+            const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
+                                    (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
+            auto [it, fresh] = emitted.try_emplace(k, 0.0f);
+            if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(display, code, codes.bits));
+            out[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)] = it->second;
+        }
+    }
+    return out;
+}
+
+/// The codes of window `w` (n x n pixels from (x0, y0), row 0 at the top)
+/// against the same pixels of `off` (the judged lights off; null: none).
+void summarise_codes(const s::EncodedImage& codes, const s::EncodedImage* off, int x0, int y0, int n, LightWindow& w) {
+    w.white_code = (1 << codes.bits) - 1;
+    for (int y = std::max(y0, 0); y < std::min(y0 + n, codes.height); ++y)
+        for (int x = std::max(x0, 0); x < std::min(x0 + n, codes.width); ++x)
+            for (int ch = 0; ch < 3; ++ch) {
+                const std::size_t i =
+                    (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
+                        3 +
+                    static_cast<std::size_t>(ch);
+                const int on = codes.rgb[i];
+                const int bg = off ? off->rgb[i] : 0;
+                w.peak_code = std::max(w.peak_code, on);
+                w.background_code = std::max(w.background_code, bg);
+                w.rise_codes = std::max(w.rise_codes, on - bg);
+                w.clipped = w.clipped || (on == w.white_code && bg < w.white_code);
+            }
+}
+
+}  // namespace
+
+StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
+                                   double interval_s, std::size_t cache_frames)
+    : scene_text_(std::move(scene_text)),
+      scene_file_(std::move(scene_file)),
+      window_radius_deg_(window_radius_deg),
+      interval_s_(interval_s),
+      capacity_(std::max<std::size_t>(cache_frames, 1)) {}
+
+s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
+    std::vector<s::SceneOverride> parsed;
+    parsed.reserve(overrides.size());
+    for (const std::string& o : overrides) parsed.push_back(s::SceneOverride::parse(o));
+    s::Scene scene = s::parse_scene(scene_text_, scene_file_.string(), parsed);
+    if (display_model_) apply_display_model(scene, *display_model_);
+    s::validate_output_settings(scene.output);
+    return scene;
+}
+
+std::shared_ptr<const FrameViews> StimulusRenderer::views(const p::Frame& frame,
+                                                          const std::vector<std::string>& lights) {
+    ++requested_;
+    const std::string key = cache_key(frame, lights);
+    if (auto it = index_.find(key); it != index_.end()) {
+        lru_.splice(lru_.begin(), lru_, it->second);
+        return it->second->second;
+    }
+    return render(frame, lights, nullptr, nullptr);
+}
+
+s::ImageRGBA32F StimulusRenderer::hdr(const p::Frame& frame, const std::vector<std::string>& lights,
+                                      double& degrees_per_pixel) {
+    s::ImageRGBA32F image;
+    render(frame, lights, &image, &degrees_per_pixel);
+    return image;
+}
+
+void StimulusRenderer::remember(const std::string& key, std::shared_ptr<const FrameViews> views) {
+    if (auto it = index_.find(key); it != index_.end()) {
+        it->second->second = std::move(views);
+        lru_.splice(lru_.begin(), lru_, it->second);
+        return;
+    }
+    lru_.emplace_front(key, std::move(views));
+    index_[key] = lru_.begin();
+    while (lru_.size() > capacity_) {
+        index_.erase(lru_.back().first);
+        lru_.pop_back();
+    }
+}
+
+s::EncodedImage StimulusRenderer::render_codes(const s::Scene& sc, double time_s) {
+    encode_scene(sc, time_s);
+    return display_.read_codes();
+}
+
+void StimulusRenderer::encode_scene(const s::Scene& sc, double time_s) {
+    // stimuli::Pipeline::render, with two differences that make a frame a pure
+    // function of its overrides (so a cached frame, and a resumed session, see
+    // exactly what an uninterrupted run saw): each frame adapts afresh
+    // (reset_adaptation, dt = 0: a dynamic scene adopts its own log-average; a
+    // fixed one is unaffected), and the dither pattern is that of frame 0
+    // instead of advancing with the number of frames rendered so far.
+    frame_.render(sc, time_s);
+    const s::OutputSettings& os = sc.output;
+    display_.reset_adaptation();
+    if (const gl::Texture2D* glare = frame_.glare_texture();
+        glare && os.ldr_glare && (sc.glare.model != s::GlareModel::none || s::any_light_glare(sc))) {
+        const s::ToneMapSettings& tm = os.tonemap;
+        const double white = tm.white_cd_m2
+                                 ? *tm.white_cd_m2
+                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / s::display_adaptation_cd_m2(tm);
+        display_.process_ldr(frame_.hdr_texture(), *glare, os, 0, 1.0 / white);
+    } else {
+        display_.process(frame_.hdr_texture(), os, 0.0, 0);
+    }
+    ++rendered_;
+}
+
+std::shared_ptr<const s::EncodedImage> StimulusRenderer::codes(const p::Frame& frame,
+                                                               const std::vector<std::string>& lights) {
+    const std::string key = cache_key(frame, lights);
+    for (auto it = codes_lru_.begin(); it != codes_lru_.end(); ++it)
+        if (it->first == key) {
+            codes_lru_.splice(codes_lru_.begin(), codes_lru_, it);
+            return codes_lru_.front().second;
+        }
+    const auto started = std::chrono::steady_clock::now();
+    const s::Scene sc = scene(frame.overrides);
+    auto out = std::make_shared<const s::EncodedImage>(render_codes(sc, brightest_moment_s(sc, lights, interval_s_)));
+    render_s_ += seconds_since(started);
+    codes_lru_.emplace_front(key, out);
+    constexpr std::size_t kKeep = 8;  // a trial's frames and its background, with room to spare
+    while (codes_lru_.size() > kKeep) codes_lru_.pop_back();
+    return out;
+}
+
+bool StimulusRenderer::animated(const p::Frame& frame) {
+    const s::Scene sc = scene(frame.overrides);
+    return std::any_of(sc.lights.begin(), sc.lights.end(), [](const s::Light& l) { return l.rhythm_period_s > 0; });
+}
+
+void StimulusRenderer::encode(const p::Frame& frame, double time_s) {
+    // Parsed once per frame, not once per flip.
+    const std::string key = cache_key(frame, {});
+    if (!last_scene_.second || last_scene_.first != key)
+        last_scene_ = {key, std::make_shared<const s::Scene>(scene(frame.overrides))};
+    encode_scene(*last_scene_.second, time_s);
+}
+
+void StimulusRenderer::present(int x, int y) const {
+    display_.present(x, y);
+}
+
+std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::string>& overrides) const {
+    std::vector<std::string> names;
+    for (const s::Light& l : scene(overrides).lights) names.push_back(l.name);
+    return names;
+}
+
+std::vector<std::string> StimulusRenderer::all_off(const std::vector<std::string>& overrides) const {
+    const s::Scene sc = scene(overrides);
+    std::vector<std::string> off;
+    for (const s::Light& l : sc.lights) off.push_back(fmt::format("light.{}.intensity_cd=0", l.name));
+    for (const s::Disc& d : sc.discs) off.push_back(fmt::format("disc.{}.diameter_deg=0", d.name));
+    return off;
+}
+
+const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame, const std::vector<std::string>& lights,
+                                                          double time_s) {
+    // The frame with every judged light off, at the same moment: what the
+    // screen shows around the lights without them. In a glare / no-glare
+    // comparison it is the same for every level of a condition, so a few
+    // cached frames serve a whole session.
+    p::Frame off = frame;
+    const s::Scene on = scene(frame.overrides);
+    for (const std::string& name : lights)
+        if (!name.empty()) off.overrides.push_back(judged_off_override(on, name));
+    const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
+    for (auto it = background_lru_.begin(); it != background_lru_.end(); ++it)
+        if (it->first == key) {
+            background_lru_.splice(background_lru_.begin(), background_lru_, it);
+            return background_lru_.front().second;
+        }
+    background_lru_.emplace_front(key, render_codes(scene(off.overrides), time_s));
+    constexpr std::size_t kBackgroundFrames = 8;
+    while (background_lru_.size() > kBackgroundFrames) background_lru_.pop_back();
+    return background_lru_.front().second;
+}
+
+std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
+                                                           const std::vector<std::string>& lights, s::ImageRGBA32F* hdr,
+                                                           double* degrees_per_pixel) {
+    const auto started = std::chrono::steady_clock::now();
+    const s::Scene sc = scene(frame.overrides);
+    auto out = std::make_shared<FrameViews>();
+    out->time_s = brightest_moment_s(sc, lights, interval_s_);
+
+    const s::EncodedImage codes = render_codes(sc, out->time_s);
+    const std::vector<s::LightDrawRecord> draws = frame_.read_light_draws();
+    const s::CameraProjection proj = frame_.projection();
+    const double dpp = proj.degrees_per_pixel_at_centre();
+    if (hdr) *hdr = frame_.read_hdr();
+    const int half = static_cast<int>(std::ceil(2.0 * window_radius_deg_ / dpp)) + 2;
+    const int n = 2 * half + 1;
+
+    struct Placed {
+        glm::ivec2 origin{0};
+        bool on_screen = false;
+    };
+    std::vector<Placed> placed;
+    for (const std::string& name : lights) {
+        // The light's centre in window coordinates (origin lower-left): the GPU's
+        // own projection when it drew the light, else the same pinhole on the CPU
+        // (a dark or culled light still has a place on the screen).
+        glm::dvec2 centre_win{0.5 * codes.width, 0.5 * codes.height};
+        bool behind = false;
+        if (!name.empty()) {
+            std::size_t index = sc.lights.size();
+            for (std::size_t i = 0; i < sc.lights.size() && index == sc.lights.size(); ++i)
+                if (sc.lights[i].name == name) index = i;
+            const s::Disc* disc = index == sc.lights.size() ? find_disc(sc, name) : nullptr;
+            if (index < draws.size() && draws[index].area_px2 > 0) {
+                centre_win = draws[index].centre_px;
+            } else if (index < sc.lights.size() || disc) {
+                // A disc's centre: the same pinhole (its outline is a circle of visual angle around it).
+                const glm::dvec3 v = proj.view_from_world((disc ? disc->position_m : sc.lights[index].position_m) -
+                                                          proj.eye_position_m);
+                if (v.z < 0) {
+                    centre_win = glm::dvec2(0.5 * proj.width_px, 0.5 * proj.height_px) +
+                                 proj.focal_px * glm::dvec2(v.x, v.y) / -v.z;
+                } else {
+                    behind = true;
+                }
+            }
+        }
+        // Row 0 at the top, as the codes are.
+        const glm::dvec2 centre{centre_win.x, static_cast<double>(codes.height) - centre_win.y};
+        LightWindow w;
+        w.image.width = n;
+        w.image.height = n;
+        w.image.deg_per_px = dpp;
+        const int x0 = static_cast<int>(std::floor(centre.x)) - half;
+        const int y0 = static_cast<int>(std::floor(centre.y)) - half;
+        w.light_px = centre - glm::dvec2(x0, y0);
+        const bool on_screen = !behind && std::isfinite(centre.x) && std::isfinite(centre.y);
+        w.image.luminance_cd_m2 = on_screen ? emitted_window(codes, sc.output.display, x0, y0, n)
+                                            : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+        placed.push_back({{x0, y0}, on_screen});
+        out->windows.push_back(std::move(w));
+    }
+    // What each window shows with the judged lights off, at the same pixels, so
+    // that the model observer judges what a light adds to its surround
+    // (observer.h window_light_lux), not the surround itself.
+    bool any_named = false;
+    for (const std::string& name : lights) any_named = any_named || !name.empty();
+    if (any_named) {
+        const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
+        for (std::size_t i = 0; i < out->windows.size(); ++i) {
+            out->windows[i].image.background_cd_m2 =
+                placed[i].on_screen
+                    ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
+                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+            if (placed[i].on_screen)
+                summarise_codes(codes, &off, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
+        }
+    } else {
+        for (std::size_t i = 0; i < out->windows.size(); ++i)
+            if (placed[i].on_screen)
+                summarise_codes(codes, nullptr, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
+    }
+    if (degrees_per_pixel) *degrees_per_pixel = dpp;
+    remember(cache_key(frame, lights), out);
+    render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return out;
+}
+
+}  // namespace atonlab::runner

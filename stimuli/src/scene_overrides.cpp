@@ -1,0 +1,218 @@
+// --set overrides applied to the parsed scene tree before it is read (scene_reader.h; docs/scene-file.md "Overrides with --set").
+#include "scene_reader.h"
+
+namespace atonlab::stimuli::scene_reader {
+
+// ---------------------------------------------------------------------------
+// Overrides.
+
+[[noreturn]] void override_error(const std::string& key, const std::string& message) {
+    throw InputError(SourceLocation::command_line(std::string(kSetOption), key), message);
+}
+
+/// A TOML basic string holding `text`, for values that are not valid TOML.
+std::string toml_quoted(std::string_view text) {
+    std::string q = "\"";
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (ch == '"' || ch == '\\') {
+            q += '\\';
+            q += ch;
+        } else if (c < 0x20 || c == 0x7f) {
+            q += fmt::format("\\u{:04X}", static_cast<unsigned>(c));
+        } else {
+            q += ch;
+        }
+    }
+    return q + "\"";
+}
+
+/// The parsed value of an override, with source path "--set KEY". A value that
+/// is not valid TOML is taken as a string (so `colour=red` needs no quotes);
+/// `note` then says so, for the type error that usually follows a typo.
+toml::table parse_override_value(const SceneOverride& o, std::string& note) {
+    const std::string source = std::string(kSetPrefix) + o.key;
+    try {
+        return toml::parse("v = " + o.value, std::string_view(source));
+    } catch (const toml::parse_error& e) {
+        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", text::echo(o.value),
+                           std::string(e.description()));
+    }
+    try {
+        return toml::parse("v = " + toml_quoted(o.value), std::string_view(source));
+    } catch (const toml::parse_error& e) {
+        override_error(o.key,
+                       fmt::format("the value \"{}\" cannot be read: {}.", text::echo(o.value),
+                                   std::string(e.description())));
+    }
+}
+
+bool is_number(const toml::node& n) {
+    return n.is_integer() || n.is_floating_point();
+}
+
+/// The table that holds the overridden key, created if absent (and remembered
+/// so that errors about it name the override).
+toml::table& table_for_override(Document& doc, toml::table& parent, std::string_view name, const std::string& typed,
+                                const std::string& shown) {
+    toml::node* n = parent.get(name);
+    if (n == nullptr) {
+        auto [it, inserted] = parent.insert(name, toml::table{});
+        doc.note_made_for_override(&it->second, typed);
+        return *it->second.as_table();
+    }
+    if (!n->is_table()) {
+        const SourceLocation w = doc.where(n, shown);
+        override_error(typed, fmt::format("cannot set {}: {} is {} in {}:{}, not a table.", typed, shown,
+                                          type_phrase(n->type()), w.file, w.line));
+    }
+    return *n->as_table();
+}
+
+/// The [[light]] or [[disc]] table (`array`: "light", "disc") an override
+/// addresses: "ARRAY[INDEX].key" or "ARRAY.NAME.key" (NAME may contain dots; the
+/// key after the last dot never does).
+std::pair<toml::table*, std::string> element_for_override(const Document& doc, toml::table& root,
+                                                          const SceneOverride& o, std::string& key,
+                                                          const std::string& array) {
+    const std::string written = fmt::format("a {0} key is written {0}.NAME.KEY or {0}[INDEX].KEY.", array);
+    toml::node* node = root.get(array);
+    if (node == nullptr || !node->is_array() || node->as_array()->empty())
+        override_error(o.key, fmt::format("the scene has no [[{}]] tables to override.", array));
+    toml::array& elements = *node->as_array();
+    const std::string& k = o.key;
+    const auto last_dot = k.rfind('.');
+    if (last_dot == std::string::npos || last_dot == k.size() - 1) override_error(o.key, written);
+    key = k.substr(last_dot + 1);
+
+    std::size_t index = 0;
+    const std::size_t skip = array.size() + 1;  // "light[" or "light."
+    if (k.starts_with(array + "[")) {
+        const auto close = k.find(']');
+        const std::string digits = k.substr(skip, close == std::string::npos ? 0 : close - skip);
+        if (close == std::string::npos || close + 1 != last_dot || digits.empty() ||
+            !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+            digits.size() > 6)
+            override_error(o.key, written);
+        index = static_cast<std::size_t>(std::stoul(digits));
+        if (index >= elements.size())
+            override_error(o.key, fmt::format("there is no {0}[{1}]: the scene has {2} {0}{3} ({0}[0] to {0}[{4}]).",
+                                              array, index, elements.size(), elements.size() == 1 ? "" : "s",
+                                              elements.size() - 1));
+    } else {
+        const std::string name = k.substr(skip, last_dot - skip);
+        std::vector<std::string> known;
+        bool found = false;
+        for (std::size_t i = 0; i < elements.size(); ++i) {
+            std::string element_name = fmt::format("{}{}", array, i);
+            if (const toml::table* t = elements.get(i)->as_table())
+                if (const toml::node* n = t->get("name"); n != nullptr && n->is_string())
+                    element_name = n->as_string()->get();
+            if (element_name == name && !found) {
+                index = i;
+                found = true;
+            }
+            known.push_back(element_name);
+        }
+        if (!found)
+            override_error(o.key, fmt::format("no {} is named \"{}\"; the {}s are {}.", array, text::echo(name), array,
+                                              join(known, "\"")));
+    }
+    toml::node* element = elements.get(index);
+    if (!element->is_table()) {
+        const SourceLocation w = doc.where(element, fmt::format("{}[{}]", array, index));
+        override_error(o.key, fmt::format("{}[{}] in {}:{} is not a table.", array, index, w.file, w.line));
+    }
+    return {element->as_table(), fmt::format("{}[{}]", array, index)};
+}
+
+void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
+    const std::string& k = o.key;
+    toml::table* target = nullptr;
+    std::string key;         // the key inside *target
+    std::string schema_key;  // canonical dotted path, e.g. "light[0].intensity_cd"
+
+    const auto unknown = [&](std::string_view section, KeyList allowed, std::string_view leaf) {
+        override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", text::echo(leaf),
+                                      text::echo(section),
+                                      did_you_mean(leaf, allowed), join(allowed)));
+    };
+
+    if (k == "light" || k.starts_with("light.") || k.starts_with("light[")) {
+        auto [table, path] = element_for_override(doc, root, o, key, "light");
+        if (!contains(kLightKeys, key)) unknown("[light]", kLightKeys, key);
+        target = table;
+        schema_key = path + "." + key;
+    } else if (k == "disc" || k.starts_with("disc.") || k.starts_with("disc[")) {
+        auto [table, path] = element_for_override(doc, root, o, key, "disc");
+        if (!contains(kDiscKeys, key)) unknown("[disc]", kDiscKeys, key);
+        target = table;
+        schema_key = path + "." + key;
+    } else if (k.starts_with("profiles.")) {
+        // profiles.KIND.NAME.KEY (NAME may contain dots)
+        const std::string rest = k.substr(9);
+        const auto kind_end = rest.find('.');
+        const auto last_dot = rest.rfind('.');
+        if (kind_end == std::string::npos || last_dot == kind_end)
+            override_error(k, "a profile key is written profiles.vertical.NAME.KEY or profiles.horizontal.NAME.KEY.");
+        const std::string kind = rest.substr(0, kind_end);
+        const std::string name = rest.substr(kind_end + 1, last_dot - kind_end - 1);
+        key = rest.substr(last_dot + 1);
+        if (!contains(kProfileKinds, kind))
+            override_error(k, fmt::format("unknown profile kind '{}'; it must be 'vertical' or 'horizontal'.", kind));
+        const KeyList allowed = kind == "vertical" ? KeyList(kVerticalKeys) : KeyList(kHorizontalKeys);
+        if (!contains(allowed, key)) unknown(fmt::format("profiles.{}.{}", kind, name), allowed, key);
+        toml::table& profiles = table_for_override(doc, root, "profiles", k, "profiles");
+        toml::table& kinds = table_for_override(doc, profiles, kind, k, "profiles." + kind);
+        target = &table_for_override(doc, kinds, name, k, fmt::format("profiles.{}.{}", kind, name));
+        schema_key = fmt::format("profiles.{}.{}.{}", kind, name, key);
+    } else {
+        const auto dot = k.find('.');
+        const std::string section = k.substr(0, dot);
+        if (!contains(kSections, section))
+            override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", text::echo(k),
+                                          join(kSections)));
+        if (dot == std::string::npos || dot + 1 == k.size())
+            override_error(k, fmt::format("--set takes a key inside [{}], e.g. {}.{}.", section, section,
+                                          section == "display" ? "width_px" : "yaw_deg"));
+        key = k.substr(dot + 1);
+        const KeyList allowed = section == "display"       ? KeyList(kDisplayKeys)
+                                : section == "camera"      ? KeyList(kCameraKeys)
+                                : section == "environment" ? KeyList(kEnvironmentKeys)
+                                : section == "glare"       ? KeyList(kGlareKeys)
+                                : section == "tonemap"     ? KeyList(kTonemapKeys)
+                                                           : KeyList(kEyeKeys);
+        if (!contains(allowed, key)) unknown(section, allowed, key);
+        target = &table_for_override(doc, root, section, k, section);
+        schema_key = k;
+    }
+
+    std::string note;
+    toml::table parsed = parse_override_value(o, note);
+    toml::node* value = parsed.get("v");
+
+    // The new value must have the type of the one it replaces (integers and
+    // floats are interchangeable); values the file leaves at their default are
+    // type-checked by the schema afterwards.
+    if (const toml::node* old = target->get(key)) {
+        const bool same = old->type() == value->type() || (is_number(*old) && is_number(*value));
+        if (!same) {
+            const SourceLocation w = doc.where(old, schema_key);
+            const std::string from =
+                w.from_command_line() ? std::string("an earlier --set") : fmt::format("{}:{}", w.file, w.line);
+            override_error(k, fmt::format("expected {} like the value it replaces ({}), got {}{}.",
+                                          is_number(*old) ? std::string_view("a number") : type_phrase(old->type()),
+                                          from, type_phrase(value->type()), note));
+        }
+    }
+    for (const auto& group : exclusive_groups()) {
+        if (std::find(group.begin(), group.end(), key) == group.end()) continue;
+        for (std::string_view other : group)
+            if (other != key) target->erase(other);
+    }
+    doc.note_override(k, schema_key, o.origin);
+    doc.note_string_fallback(k, note);
+    value->visit([&](auto& concrete) { target->insert_or_assign(key, std::move(concrete)); });
+}
+
+}  // namespace atonlab::stimuli::scene_reader
