@@ -12,6 +12,11 @@ Pipeline::Pipeline() {
 }
 
 void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
+    render_at(scene, time_s, dt_s, frame_index_);
+    ++frame_index_;
+}
+
+void Pipeline::render_at(const Scene& scene, double time_s, double dt_s, std::uint32_t frame_index) {
     validate_output_settings(scene.output);
     frame_.render(scene, time_s);
     const OutputSettings& out = scene.output;
@@ -21,11 +26,10 @@ void Pipeline::render(const Scene& scene, double time_s, double dt_s) {
         // operator's white (the adaptation luminance at the display's own
         // adaptation level), clipped; the glare is tone-mapped and added.
         const double white = display::linear_white_cd_m2(out.adaptation.fixed_cd_m2, out.tonemap);
-        display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index_, 1.0 / (white * frame_.pre_exposure()));
+        display_.process_ldr(frame_.hdr_texture(), *glare, out, frame_index, 1.0 / (white * frame_.pre_exposure()));
     } else {
-        display_.process(frame_.hdr_texture(), out, dt_s, frame_index_, frame_.pre_exposure());
+        display_.process(frame_.hdr_texture(), out, dt_s, frame_index, frame_.pre_exposure());
     }
-    ++frame_index_;
 }
 
 void Pipeline::render_ldr(const gl::Texture2D& ldr, const Scene& scene, double time_s) {

@@ -86,7 +86,11 @@ StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path
       scene_file_(std::move(scene_file)),
       window_radius_deg_(window_radius_deg),
       interval_s_(interval_s),
-      capacity_(std::max<std::size_t>(cache_frames, 1)) {}
+      views_(cache_frames) {
+    // The renderer's frames as they always were: no display skips (the
+    // Pipeline's default culls invisible lights and crops billboards).
+    pipeline_.set_frame_options(s::FrameOptions{});
+}
 
 s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
     std::vector<s::SceneOverride> parsed;
@@ -101,11 +105,7 @@ s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) cons
 std::shared_ptr<const FrameViews> StimulusRenderer::views(const p::Frame& frame,
                                                           const std::vector<std::string>& lights) {
     ++requested_;
-    const std::string key = cache_key(frame, lights);
-    if (auto it = index_.find(key); it != index_.end()) {
-        lru_.splice(lru_.begin(), lru_, it->second);
-        return it->second->second;
-    }
+    if (const auto* hit = views_.find(cache_key(frame, lights))) return *hit;
     return render(frame, lights, nullptr, nullptr);
 }
 
@@ -116,64 +116,30 @@ s::ImageRGBA32F StimulusRenderer::hdr(const p::Frame& frame, const std::vector<s
     return image;
 }
 
-void StimulusRenderer::remember(const std::string& key, std::shared_ptr<const FrameViews> views) {
-    if (auto it = index_.find(key); it != index_.end()) {
-        it->second->second = std::move(views);
-        lru_.splice(lru_.begin(), lru_, it->second);
-        return;
-    }
-    lru_.emplace_front(key, std::move(views));
-    index_[key] = lru_.begin();
-    while (lru_.size() > capacity_) {
-        index_.erase(lru_.back().first);
-        lru_.pop_back();
-    }
-}
-
 s::EncodedImage StimulusRenderer::render_codes(const s::Scene& sc, double time_s) {
     encode_scene(sc, time_s);
-    return display_.read_codes();
+    return pipeline_.display().read_codes();
 }
 
 void StimulusRenderer::encode_scene(const s::Scene& sc, double time_s) {
-    // stimuli::Pipeline::render, with two differences that make a frame a pure
-    // function of its overrides (so a cached frame, and a resumed session, see
-    // exactly what an uninterrupted run saw): each frame adapts afresh
-    // (reset_adaptation, dt = 0: a dynamic scene adopts its own log-average; a
-    // fixed one is unaffected), and the dither pattern is that of frame 0
-    // instead of advancing with the number of frames rendered so far.
-    frame_.render(sc, time_s);
-    const s::OutputSettings& os = sc.output;
-    display_.reset_adaptation();
-    if (const gl::Texture2D* glare = frame_.glare_texture();
-        glare && os.ldr_glare && (sc.glare.model != s::GlareModel::none || s::any_light_glare(sc))) {
-        const s::ToneMapSettings& tm = os.tonemap;
-        const double white = tm.white_cd_m2
-                                 ? *tm.white_cd_m2
-                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / s::display_adaptation_cd_m2(tm);
-        display_.process_ldr(frame_.hdr_texture(), *glare, os, 0, 1.0 / white);
-    } else {
-        display_.process(frame_.hdr_texture(), os, 0.0, 0);
-    }
+    // stimuli::Pipeline::render at dither frame 0 with fresh adaptation, so
+    // that a frame is a pure function of its overrides (a cached frame, and a
+    // resumed session, see exactly what an uninterrupted run saw): dt = 0
+    // makes a dynamic scene adopt its own log-average; a fixed one is unaffected.
+    pipeline_.display().reset_adaptation();
+    pipeline_.render_at(sc, time_s, 0.0, 0);
     ++rendered_;
 }
 
 std::shared_ptr<const s::EncodedImage> StimulusRenderer::codes(const p::Frame& frame,
                                                                const std::vector<std::string>& lights) {
     const std::string key = cache_key(frame, lights);
-    for (auto it = codes_lru_.begin(); it != codes_lru_.end(); ++it)
-        if (it->first == key) {
-            codes_lru_.splice(codes_lru_.begin(), codes_lru_, it);
-            return codes_lru_.front().second;
-        }
+    if (const auto* hit = codes_.find(key)) return *hit;
     const auto started = std::chrono::steady_clock::now();
     const s::Scene sc = scene(frame.overrides);
     auto out = std::make_shared<const s::EncodedImage>(render_codes(sc, brightest_moment_s(sc, lights, interval_s_)));
     render_s_ += seconds_since(started);
-    codes_lru_.emplace_front(key, out);
-    constexpr std::size_t kKeep = 8;  // a trial's frames and its background, with room to spare
-    while (codes_lru_.size() > kKeep) codes_lru_.pop_back();
-    return out;
+    return codes_.put(key, std::move(out));
 }
 
 bool StimulusRenderer::animated(const p::Frame& frame) {
@@ -190,7 +156,7 @@ void StimulusRenderer::encode(const p::Frame& frame, double time_s) {
 }
 
 void StimulusRenderer::present(int x, int y) const {
-    display_.present(x, y);
+    pipeline_.present(x, y);
 }
 
 std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::string>& overrides) const {
@@ -218,15 +184,8 @@ const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame,
     for (const std::string& name : lights)
         if (!name.empty()) off.overrides.push_back(judged_off_override(on, name));
     const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
-    for (auto it = background_lru_.begin(); it != background_lru_.end(); ++it)
-        if (it->first == key) {
-            background_lru_.splice(background_lru_.begin(), background_lru_, it);
-            return background_lru_.front().second;
-        }
-    background_lru_.emplace_front(key, render_codes(scene(off.overrides), time_s));
-    constexpr std::size_t kBackgroundFrames = 8;
-    while (background_lru_.size() > kBackgroundFrames) background_lru_.pop_back();
-    return background_lru_.front().second;
+    if (const auto* hit = background_.find(key)) return *hit;
+    return background_.put(key, render_codes(scene(off.overrides), time_s));
 }
 
 std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
@@ -238,10 +197,11 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
     out->time_s = brightest_moment_s(sc, lights, interval_s_);
 
     const s::EncodedImage codes = render_codes(sc, out->time_s);
-    const std::vector<s::LightDrawRecord> draws = frame_.read_light_draws();
-    const s::CameraProjection proj = frame_.projection();
+    const s::FrameRenderer& rendered = pipeline_.frame();
+    const std::vector<s::LightDrawRecord> draws = rendered.read_light_draws();
+    const s::CameraProjection proj = rendered.projection();
     const double dpp = proj.degrees_per_pixel_at_centre();
-    if (hdr) *hdr = frame_.read_hdr();
+    if (hdr) *hdr = rendered.read_hdr();
     const int half = static_cast<int>(std::ceil(2.0 * window_radius_deg_ / dpp)) + 2;
     const int n = 2 * half + 1;
 
@@ -311,7 +271,7 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
                 summarise_codes(codes, nullptr, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
     }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
-    remember(cache_key(frame, lights), out);
+    views_.put(cache_key(frame, lights), out);
     render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return out;
 }

@@ -7,19 +7,19 @@
 #include <cstdint>
 #include <filesystem>
 #include <glm/vec2.hpp>
-#include <list>
 #include <memory>
 #include <optional>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/scene.h"
+#include "session/lru_cache.h"
 
 namespace atonlab::runner {
 
@@ -101,7 +101,6 @@ public:
 private:
     std::shared_ptr<const FrameViews> render(const protocols::Frame& frame, const std::vector<std::string>& lights,
                                              stimuli::ImageRGBA32F* hdr, double* degrees_per_pixel);
-    void remember(const std::string& key, std::shared_ptr<const FrameViews> views);
     /// Renders a scene through the display pipeline: the code values the screen gets.
     stimuli::EncodedImage render_codes(const stimuli::Scene& scene, double time_s);
     /// render_codes without reading the codes back (they stay on the GPU).
@@ -115,14 +114,11 @@ private:
     std::optional<stimuli::DisplayModel> display_model_;  ///< use_display_model()
     double window_radius_deg_;
     double interval_s_;
-    std::size_t capacity_;
-    stimuli::FrameRenderer frame_;
-    stimuli::DisplayPipeline display_;
-    // LRU: most recent at the front.
-    std::list<std::pair<std::string, std::shared_ptr<const FrameViews>>> lru_;
-    std::unordered_map<std::string, decltype(lru_)::iterator> index_;
-    std::list<std::pair<std::string, stimuli::EncodedImage>> background_lru_;
-    std::list<std::pair<std::string, std::shared_ptr<const stimuli::EncodedImage>>> codes_lru_;
+    stimuli::Pipeline pipeline_;  ///< with the renderer's default options (no display skips)
+    LruCache<std::string, std::shared_ptr<const FrameViews>> views_;  ///< views(): cache_frames entries
+    LruCache<std::string, stimuli::EncodedImage> background_{8};       ///< background_codes()
+    /// codes(): a trial's frames and its background, with room to spare.
+    LruCache<std::string, std::shared_ptr<const stimuli::EncodedImage>> codes_{8};
     std::pair<std::string, std::shared_ptr<const stimuli::Scene>> last_scene_;  ///< encode()'s parsed scene
     std::size_t rendered_ = 0;
     std::size_t requested_ = 0;

@@ -1,12 +1,11 @@
 // The stored trial record (trial_record.h).
 #include "session/trial_record.h"
 
-#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 
 #include "atonlab/stimuli/glare_stage.h"
-#include "json_text.h"
 #include "session/scene_queries.h"
 
 namespace atonlab::runner {
@@ -14,6 +13,8 @@ namespace atonlab::runner {
 namespace p = atonlab::protocols;
 namespace s = atonlab::stimuli;
 namespace st = atonlab::store;
+/// Keys in the order written (nlohmann::json would sort them).
+using Json = nlohmann::ordered_json;
 
 std::string view_glare(const s::Scene& sc, const std::string& light) {
     for (const s::Light& l : sc.lights)
@@ -26,70 +27,70 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
                           const std::vector<double>& frame_times, const std::string& frames_shown_json,
                           const std::vector<std::string>& view_glares) {
     const p::Stimulus& stim = t.stimulus;
-    std::string j = "{";
-    j += fmt::format("\"task\":{},\"presentation\":{},", json_string(p::to_string(c.task)),
-                     json_string(p::to_string(c.presentation)));
-    j += fmt::format("\"level_key\":{},\"level_scale\":{},\"level_on\":{},\"level\":{},\"scene_value\":{},",
-                     json_string(c.level_key), json_string(p::to_string(c.level_scale)),
-                     json_string(p::to_string(c.level_on)), json_number(stim.level), json_number(stim.scene_value));
-    j += fmt::format("\"scene\":{},", json_string(protocol.scene.string()));
-    j += "\"frames\":[";
+    Json j;
+    j["task"] = std::string(p::to_string(c.task));
+    j["presentation"] = std::string(p::to_string(c.presentation));
+    j["level_key"] = c.level_key;
+    j["level_scale"] = std::string(p::to_string(c.level_scale));
+    j["level_on"] = std::string(p::to_string(c.level_on));
+    j["level"] = stim.level;
+    j["scene_value"] = stim.scene_value;
+    j["scene"] = protocol.scene.string();
+    Json frames = Json::array();
     for (std::size_t f = 0; f < stim.frames.size(); ++f) {
         const p::Frame& fr = stim.frames[f];
-        if (f) j += ',';
-        j += fmt::format("{{\"role\":{},\"time_s\":{},\"overrides\":[",
-                         fr.role ? json_string(p::to_string(*fr.role)) : std::string("\"both\""),
-                         json_number(f < frame_times.size() ? frame_times[f] : 0.0));
-        for (std::size_t i = 0; i < fr.overrides.size(); ++i) j += (i ? "," : "") + json_string(fr.overrides[i]);
-        j += "]}";
+        Json frame;
+        frame["role"] = fr.role ? std::string(p::to_string(*fr.role)) : std::string("both");
+        frame["time_s"] = f < frame_times.size() ? frame_times[f] : 0.0;
+        frame["overrides"] = fr.overrides;
+        frames.push_back(std::move(frame));
     }
-    j += "],\"views\":[";
+    j["frames"] = std::move(frames);
+    Json views = Json::array();
     for (std::size_t i = 0; i < stim.views.size(); ++i) {
         const p::StimulusView& v = stim.views[i];
-        j += fmt::format("{}{{\"frame\":{},\"light\":{},\"role\":{}", i ? "," : "", v.frame, json_string(v.light),
-                         json_string(p::to_string(v.role)));
-        if (i < view_glares.size()) j += fmt::format(",\"glare\":{}", json_string(view_glares[i]));
-        j += '}';
+        Json view;
+        view["frame"] = v.frame;
+        view["light"] = v.light;
+        view["role"] = std::string(p::to_string(v.role));
+        if (i < view_glares.size()) view["glare"] = view_glares[i];
+        views.push_back(std::move(view));
     }
-    j += "]";
-    if (stim.adjusted_view) j += fmt::format(",\"adjusted_view\":{}", *stim.adjusted_view);
+    j["views"] = std::move(views);
+    if (stim.adjusted_view) j["adjusted_view"] = *stim.adjusted_view;
     const p::Timing& tm = protocol.timing;
     // The durations asked for (s) and, in "frames", what the flips gave:
     // whole refreshes at the measured (on screen) or nominal (headless) rate.
-    j += fmt::format(",\"timing\":{{\"stimulus_s\":{},\"inter_stimulus_s\":{},\"inter_trial_s\":{},\"frames\":{}}}",
-                     json_number(tm.stimulus_s), json_number(tm.inter_stimulus_s), json_number(tm.inter_trial_s),
-                     frames_shown_json.empty() ? std::string("null") : frames_shown_json);
-    return j + "}";
+    Json timing;
+    timing["stimulus_s"] = tm.stimulus_s;
+    timing["inter_stimulus_s"] = tm.inter_stimulus_s;
+    timing["inter_trial_s"] = tm.inter_trial_s;
+    timing["frames"] = frames_shown_json.empty() ? Json(nullptr) : Json::parse(frames_shown_json);
+    j["timing"] = std::move(timing);
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s,
                        const std::optional<p::Response>& answer, const std::string& input, std::size_t step) {
-    std::string j =
-        fmt::format("{{\"schedule\":{},\"observer\":{},\"observer_seed\":{},\"answer_after_offset_s\":{},\"step\":{}",
-                    json_string(schedule.state()),
-                    json_string(observer.person()  ? "person"
-                                : observer.model() ? "model"
-                                                   : "script"),
-                    observer.seed(), json_number(answer_rt_s), step);
-    if (answer) j += fmt::format(",\"answer\":{}", json_string(p::response_word(*answer)));
-    if (!input.empty()) j += fmt::format(",\"input\":{}", json_string(input));
-    return j + "}";
+    Json j;
+    j["schedule"] = schedule.state();
+    j["observer"] = observer.person() ? "person" : observer.model() ? "model" : "script";
+    j["observer_seed"] = observer.seed();
+    j["answer_after_offset_s"] = answer_rt_s;
+    j["step"] = step;
+    if (answer) j["answer"] = std::string(p::response_word(*answer));
+    if (!input.empty()) j["input"] = input;
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::optional<std::uint64_t> logged_observer_seed(const std::vector<st::TrialRecord>& trials) {
     if (trials.empty()) return std::nullopt;
-    const std::string& j = trials.front().procedure_state_json;
-    const std::string tag = "\"observer_seed\":";
-    const auto at = j.find(tag);
-    if (at == std::string::npos) return std::nullopt;
-    std::size_t end = at + tag.size();
-    std::uint64_t v = 0;
-    bool any = false;
-    for (; end < j.size() && j[end] >= '0' && j[end] <= '9'; ++end) {
-        v = v * 10 + static_cast<std::uint64_t>(j[end] - '0');
-        any = true;
-    }
-    return any ? std::optional<std::uint64_t>(v) : std::nullopt;
+    // A state that does not parse, or has no unsigned observer_seed: none recorded.
+    const Json j = Json::parse(trials.front().procedure_state_json, nullptr, false);
+    if (!j.is_object()) return std::nullopt;
+    const auto it = j.find("observer_seed");
+    if (it == j.end() || !it->is_number_unsigned()) return std::nullopt;
+    return it->get<std::uint64_t>();
 }
 
 st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTrial& t, std::size_t row,

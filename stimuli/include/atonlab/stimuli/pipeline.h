@@ -31,12 +31,19 @@ public:
     /// Renders the scene at time_s (s) and runs adaptation over dt_s (s since
     /// the previous frame; 0 for the first). Validates scene.output first.
     void render(const Scene& scene, double time_s, double dt_s);
+    /// render() with the dither pattern of frame `frame_index`, leaving
+    /// frame_index() as it is: a frame that depends only on its arguments
+    /// (and, with dt_s > 0, on the adaptation state; display().reset_adaptation()
+    /// clears it). The runner renders every stimulus frame this way at index 0,
+    /// so a cached or resumed frame is the one an uninterrupted session showed.
+    void render_at(const Scene& scene, double time_s, double dt_s, std::uint32_t frame_index);
     /// The LDR path with the simulator's own display-referred frame `ldr`
     /// (linear RGB relative to the display's white, the scene's size): only the
     /// scene's lights are drawn, as glare, tone-mapped and added.
     void render_ldr(const gl::Texture2D& ldr, const Scene& scene, double time_s);
     void present(int x, int y) const { display_.present(x, y); }
 
+    /// The last frame's renderer (its HDR image, projection and light draws).
     const FrameRenderer& frame() const { return frame_; }
     const DisplayPipeline& display() const { return display_; }
     DisplayPipeline& display() { return display_; }
