@@ -8,6 +8,7 @@
 
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/pipeline.h"
+#include "atonlab/stimuli/tonemap.h"
 #include "gl_test_support.h"
 
 namespace atonlab::test {
@@ -127,7 +128,7 @@ TEST_F(DisplayPipelineGL, LogAverageMatchesTheCpuReference) {
     auto check = [&](const std::vector<float>& px, const char* what) {
         pipeline.reset_adaptation();
         pipeline.process(texture_of(px), s, 0.0, 0);
-        const double cpu = log_average_luminance(image_of(px), s.adaptation.epsilon_cd_m2);
+        const double cpu = atonlab::stimuli::log_average_luminance(image_of(px), s.adaptation.epsilon_cd_m2);
         EXPECT_NEAR(pipeline.log_average_cd_m2() / cpu, 1.0, 1e-4) << what;
         EXPECT_NEAR(pipeline.adaptation_cd_m2() / cpu, 1.0, 1e-4) << what << ": the first frame adopts it";
     };
@@ -151,7 +152,7 @@ TEST_F(DisplayPipelineGL, TemporalAdaptationReachesSixtyThreePercentAfterTau) {
     pipeline.process(texture_of(dark), s, 0.0, 0);
     const double start = pipeline.adaptation_cd_m2();
     const gl::Texture2D b = texture_of(bright);
-    const double target = log_average_luminance(image_of(bright), s.adaptation.epsilon_cd_m2);
+    const double target = atonlab::stimuli::log_average_luminance(image_of(bright), s.adaptation.epsilon_cd_m2);
     const double tau = adaptation_time_constant_s(target);
     const double dt = 1.0 / 60.0;
     const int frames = static_cast<int>(std::lround(tau / dt));

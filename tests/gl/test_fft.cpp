@@ -22,7 +22,6 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 using GpuFftTest = GLTest;
 
 ComplexImage<double> random_image(int n, unsigned seed) {

@@ -29,7 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 fs::path scratch(const std::string& name) {
     const fs::path dir =

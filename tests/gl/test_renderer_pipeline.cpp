@@ -16,7 +16,7 @@
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/pipeline.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "gl_test_support.h"
 #include "session/stimulus_renderer.h"
 #include "session/session_inputs.h"
@@ -37,10 +37,10 @@ s::EncodedImage old_runner_codes(const s::Scene& sc) {
     display.reset_adaptation();
     if (const gl::Texture2D* glare = frame.glare_texture();
         glare && os.ldr_glare && (sc.glare.model != s::GlareModel::none || s::any_light_glare(sc))) {
-        const s::ToneMapSettings& tm = os.tonemap;
+        const display::ToneMapSettings& tm = os.tonemap;
         const double white = tm.white_cd_m2
                                  ? *tm.white_cd_m2
-                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / s::display_adaptation_cd_m2(tm);
+                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / display::display_adaptation_cd_m2(tm);
         display.process_ldr(frame.hdr_texture(), *glare, os, 0, 1.0 / white);
     } else {
         display.process(frame.hdr_texture(), os, 0.0, 0);
@@ -80,7 +80,7 @@ TEST_F(RendererPipeline, RendererCodesAreThePipelinesAndTheOldCopysEveryPixel) {
         std::string what;
         for (const std::string& o : overrides) what += o + " ";
         const s::Scene sc = renderer.scene(overrides);
-        ASSERT_EQ(sc.output.encode.dither, s::Dither::spatiotemporal) << what;
+        ASSERT_EQ(sc.output.encode.dither, display::Dither::spatiotemporal) << what;
         const auto codes = renderer.codes(protocols::Frame{std::nullopt, overrides}, {});
         expect_same_codes(*codes, pipeline_codes(sc), what + "(Pipeline)");
         expect_same_codes(*codes, old_runner_codes(sc), what + "(the runner's copy before issue 13)");

@@ -11,7 +11,6 @@
 namespace {
 
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 constexpr double night = allard_threshold_night_lux;  // 2e-7 lux
 constexpr double day = allard_threshold_day_lux;      // 1e-3 lux

@@ -17,7 +17,6 @@ namespace atonlab::test {
 namespace {
 
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 

@@ -19,7 +19,6 @@
 namespace {
 
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 using atonlab::InputError;
 using atonlab::test::input_error_of;
 

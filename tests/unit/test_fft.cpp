@@ -20,7 +20,6 @@
 namespace {
 
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 ComplexImage<double> random_image(int n, unsigned seed) {
     std::mt19937 rng(seed);

@@ -22,7 +22,6 @@
 namespace fs = std::filesystem;
 using atonlab::InputError;
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 namespace {
 

@@ -16,7 +16,6 @@ namespace {
 
 using atonlab::InputError;
 using namespace atonlab::stimuli;
-using namespace atonlab::display;
 
 double rad(double deg) {
     return deg * std::numbers::pi / 180.0;

@@ -10,7 +10,7 @@
 
 #include "atonlab/protocols/procedure.h"
 #include "atonlab/stimuli/error.h"
-#include "atonlab/stimuli/tonemap.h"
+#include "atonlab/display/tonemap.h"
 #include "session/scene_queries.h"
 
 namespace atonlab::runner {

@@ -12,8 +12,8 @@
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "atonlab/stimuli/tonemap.h"
-#include "calibration_policy.h"
+#include "atonlab/display/tonemap.h"
+#include "calibrate/calibration_policy.h"
 #include "session/progress.h"
 #include "session/scene_queries.h"
 
@@ -35,7 +35,7 @@ std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lig
 /// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
 /// (row 0 at the top) for the codes given: the display model's luminance,
 /// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
-std::vector<float> emitted_window(const s::EncodedImage& codes, const s::DisplayModel& display, int x0, int y0, int n) {
+std::vector<float> emitted_window(const s::EncodedImage& codes, const display::DisplayModel& model, int x0, int y0, int n) {
     std::map<std::uint64_t, float> emitted;
     std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
     for (int v = 0; v < n; ++v) {
@@ -51,7 +51,7 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const s::Display
             const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
                                     (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
             auto [it, fresh] = emitted.try_emplace(k, 0.0f);
-            if (fresh) it->second = static_cast<float>(s::displayed_luminance_cd_m2(display, code, codes.bits));
+            if (fresh) it->second = static_cast<float>(display::displayed_luminance_cd_m2(model, code, codes.bits));
             out[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)] = it->second;
         }
     }

@@ -91,7 +91,7 @@ public:
 
     /// Encode every frame for this display model instead of the scene's (the
     /// display's measured calibration: calibration_policy.h). Set before the first frame.
-    void use_display_model(stimuli::DisplayModel model) { display_model_ = std::move(model); }
+    void use_display_model(display::DisplayModel model) { display_model_ = std::move(model); }
 
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
@@ -111,7 +111,7 @@ private:
 
     std::string scene_text_;
     std::filesystem::path scene_file_;
-    std::optional<stimuli::DisplayModel> display_model_;  ///< use_display_model()
+    std::optional<display::DisplayModel> display_model_;  ///< use_display_model()
     double window_radius_deg_;
     double interval_s_;
     stimuli::Pipeline pipeline_;  ///< with the renderer's default options (no display skips)
