@@ -65,9 +65,6 @@ int main(int argc, char** argv) {
     } catch (const atonlab::InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;
-    } catch (const atonlab::files::ReadError& e) {  // an input file that cannot be read is bad input too
-        std::fprintf(stderr, "atonlab: %s\n", e.what());
-        return 2;
     } catch (const atonlab::gl::ContextUnavailable& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 3;

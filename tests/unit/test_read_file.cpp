@@ -16,11 +16,11 @@ namespace {
 std::string error_of(const std::filesystem::path& file, std::uintmax_t max_bytes = text::kMaxInputFileBytes) {
     try {
         (void)read_text(file, "scene template", max_bytes);
-    } catch (const ReadError& e) {
-        EXPECT_EQ(e.file(), file);
+    } catch (const InputError& e) {
+        EXPECT_TRUE(e.where() && e.where()->file == file.string() && e.where()->line == 0);
         return e.what();
     }
-    return "(no ReadError)";
+    return "(no InputError)";
 }
 
 TEST(ReadFile, ReturnsTheWholeTextByteForByte) {
@@ -49,8 +49,8 @@ TEST(ReadFile, NamesTheFileItsRoleAndWhyItCannotBeRead) {
 TEST(ReadFile, TheMessageAloneLeavesTheFileToTheCaller) {
     try {
         (void)read_text("/nonexistent/answers.txt", "answer file");
-        FAIL() << "no ReadError";
-    } catch (const ReadError& e) {
+        FAIL() << "no InputError";
+    } catch (const InputError& e) {
         EXPECT_EQ(e.message(), "cannot read the answer file: No such file or directory.");
     }
 }

@@ -9,20 +9,13 @@
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/store/sha256.h"
+#include "atonlab/common/read_file.h"
 #include "session/condition_scene.h"
 
 namespace atonlab::runner {
 
 namespace p = atonlab::protocols;
 namespace s = atonlab::stimuli;
-
-std::string read_text(const std::filesystem::path& file, std::string_view what, std::uintmax_t max_bytes) {
-    text::FileText read = text::read_text_file(file, max_bytes);  // only up to a limit (/dev/zero is refused)
-    if (!read.ok())
-        throw InputError(SourceLocation{file.string(), 0, 0, ""},
-                         fmt::format("cannot read the {}: {}.", what, read.error));
-    return std::move(read.text);
-}
 
 namespace {
 
@@ -64,10 +57,10 @@ SessionInputs load_session_inputs(const RunOptions& o) {
     SessionInputs in;
     in.protocol = p::load_protocol(o.protocol);
     if (!o.script.empty()) in.script = p::ScriptedObserver::load(o.script);
-    in.protocol_text = p::with_conditions_files(read_text(o.protocol, "protocol file"), o.protocol);
+    in.protocol_text = p::with_conditions_files(files::read_text(o.protocol, "protocol file"), o.protocol);
     in.protocol_sha = store::sha256_hex(in.protocol_text);
     in.scene_file = in.protocol.scene;
-    in.scene_text = read_text(in.scene_file, "scene template");
+    in.scene_text = files::read_text(in.scene_file, "scene template");
     // The template alone first: its own errors name its file and line.
     std::vector<s::SceneOverride> display;
     for (const std::string& d : in.protocol.display_overrides()) display.push_back(parsed_override(in.protocol, d));

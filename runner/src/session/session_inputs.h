@@ -17,11 +17,6 @@
 
 namespace atonlab::runner {
 
-/// A file's text, up to max_bytes (so /dev/zero is refused); InputError naming
-/// `what` when it cannot be read.
-std::string read_text(const std::filesystem::path& file, std::string_view what,
-                      std::uintmax_t max_bytes = text::kMaxInputFileBytes);
-
 /// The options that need no file checked (InputError naming the option); the
 /// observer code the session is stored under ("model", "script" or --observer).
 std::string checked_observer_code(const RunOptions& o);

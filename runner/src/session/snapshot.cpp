@@ -10,6 +10,7 @@
 #include <string>
 #include <system_error>
 
+#include "atonlab/common/read_file.h"
 #include "session/scene_queries.h"
 #include "session/session_inputs.h"
 
@@ -49,7 +50,7 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
     s::write_exr(tmp, stacked, meta);
     std::string bytes;
     try {
-        bytes = read_text(tmp, "snapshot", std::numeric_limits<std::uintmax_t>::max());  // written just now
+        bytes = files::read_text(tmp, "snapshot", std::numeric_limits<std::uintmax_t>::max());  // written just now
     } catch (...) {
         std::error_code ec;
         std::filesystem::remove(tmp, ec);

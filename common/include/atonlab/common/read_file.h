@@ -4,32 +4,19 @@
 // error that names the file.
 #include <cstdint>
 #include <filesystem>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
 
 namespace atonlab::files {
 
-/// A file could not be read. what() is "FILE: MESSAGE" on one line, the form
-/// of an input error with a file and no line; message() is "cannot read the
-/// WHAT: REASON." alone, for a caller that names the file in its own error type.
-class ReadError : public std::runtime_error {
-public:
-    ReadError(std::filesystem::path file, std::string message);
-    const std::filesystem::path& file() const noexcept { return file_; }
-    const std::string& message() const noexcept { return message_; }
-
-private:
-    std::filesystem::path file_;
-    std::string message_;
-};
-
 /// The whole text of `file`, read up to `max_bytes` (/dev/zero or a video file
 /// given by mistake is refused, not read until the memory runs out). `what`
 /// names the file's role in the message ("scene template", "readings file").
-/// Throws ReadError: "FILE: cannot read the WHAT: REASON.", the reason being
+/// Throws InputError at the file (no line): "FILE: cannot read the WHAT: REASON.",
+/// message() without the file, the reason being
 /// the system's ("No such file or directory"), "it is a directory" or "it is
 /// larger than 16.0 MiB, the most an input file may be".
 std::string read_text(const std::filesystem::path& file, std::string_view what,
