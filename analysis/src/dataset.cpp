@@ -238,7 +238,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
             row.fail("test_on_left", "is needed to score the answer 'left' or 'right' (where was the test?)");
         const bool chose_test = (side == p::Response::Left) == *t.test_on_left;
         t.outcome = t.level_on == "test" ? chose_test : !chose_test;
-    } else if (t.response != "timeout") {
+    } else if (t.response != p::kTimeoutWord) {
         row.fail("response", fmt::format("'{}' is not an answer: give 1/0, yes/no or true/false (the outcome the "
                                          "psychometric function counts), left/right with test_on_left, or timeout",
                                          t.response));

@@ -231,6 +231,12 @@ std::vector<double> ProcedureSpec::level_bounds() const {
         params);
 }
 
+std::pair<double, double> ProcedureSpec::level_range() const {
+    const std::vector<double> bounds = level_bounds();
+    if (bounds.size() == 2) return {std::min(bounds[0], bounds[1]), std::max(bounds[0], bounds[1])};
+    return search_range();
+}
+
 std::pair<double, double> ProcedureSpec::search_range() const {
     return std::visit(
         [&](const auto& p) -> std::pair<double, double> {

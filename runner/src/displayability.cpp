@@ -17,15 +17,6 @@ namespace p = atonlab::protocols;
 
 namespace {
 
-/// The bottom and top of a condition's level range: its level bounds
-/// (min_level / max_level, or the constant-stimuli levels' extremes) where it
-/// has both, else the range its procedure searches.
-std::pair<double, double> level_range(const p::Condition& c) {
-    const std::vector<double> bounds = c.procedure.level_bounds();
-    if (bounds.size() == 2) return {std::min(bounds[0], bounds[1]), std::max(bounds[0], bounds[1])};
-    return c.procedure.search_range();
-}
-
 /// Every judged light of the condition's stimulus at `level` (the test first
 /// in 2AFC: the order does not change what each light looks like).
 LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c, double level,
@@ -135,7 +126,7 @@ Displayability check_displayability(StimulusRenderer& renderer, const p::Protoco
     d.deg_per_px = 2.0 * std::atan(0.5 * d.width_m / d.width_px / d.viewing_distance_m) * 180.0 / M_PI;
     for (const p::Block& b : protocol.blocks)
         for (const p::Condition& c : b.conditions) {
-            const auto [lo, hi] = level_range(c);
+            const auto [lo, hi] = c.procedure.level_range();
             ConditionDisplayability cd;
             cd.name = c.name;
             cd.line = c.line;

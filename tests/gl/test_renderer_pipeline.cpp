@@ -17,6 +17,7 @@
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/display/tonemap.h"
+#include "atonlab/common/read_file.h"
 #include "gl_test_support.h"
 #include "session/stimulus_renderer.h"
 #include "session/session_inputs.h"
@@ -69,7 +70,7 @@ void expect_same_codes(const s::EncodedImage& a, const s::EncodedImage& b, const
 class RendererPipeline : public test::GLTest {};
 
 TEST_F(RendererPipeline, RendererCodesAreThePipelinesAndTheOldCopysEveryPixel) {
-    const std::string text = runner::read_text(kScene, "scene");
+    const std::string text = files::read_text(kScene, "scene");
     runner::StimulusRenderer renderer(text, kScene, 0.5, 0.5);
     const std::vector<std::vector<std::string>> frames{
         {"display.dither=true"},
@@ -79,12 +80,22 @@ TEST_F(RendererPipeline, RendererCodesAreThePipelinesAndTheOldCopysEveryPixel) {
     for (const std::vector<std::string>& overrides : frames) {
         std::string what;
         for (const std::string& o : overrides) what += o + " ";
-        const s::Scene sc = renderer.scene(overrides);
+        const s::Scene sc = *renderer.scene(overrides);
         ASSERT_EQ(sc.output.encode.dither, display::Dither::spatiotemporal) << what;
         const auto codes = renderer.codes(protocols::Frame{std::nullopt, overrides}, {});
         expect_same_codes(*codes, pipeline_codes(sc), what + "(Pipeline)");
         expect_same_codes(*codes, old_runner_codes(sc), what + "(the runner's copy before issue 13)");
     }
+    // Each override list went through the scene loader once, though scene(),
+    // codes() and the frame's views each asked for its scene.
+    EXPECT_EQ(renderer.scenes_parsed(), frames.size());
+    (void)renderer.views(protocols::Frame{std::nullopt, frames[0]}, {});
+    EXPECT_TRUE(renderer.animated(protocols::Frame{std::nullopt, frames[1]}) == false);
+    EXPECT_EQ(renderer.scenes_parsed(), frames.size());
+    // A display model set later is a different scene: the cache starts again.
+    renderer.use_display_model(display::DisplayModel::srgb(80.0, 0.2));
+    EXPECT_EQ(renderer.scene(frames[0])->output.display.peak_cd_m2, 80.0);
+    EXPECT_EQ(renderer.scenes_parsed(), frames.size() + 1);
 }
 
 }  // namespace

@@ -140,6 +140,16 @@ TEST(ProcedureFacts, LevelBoundsAndSearchRanges) {
     const p::ProcedureSpec constant = spec_of(p::ProcedureKind::ConstantStimuli, c);
     EXPECT_EQ(constant.level_bounds(), (std::vector<double>{-0.2, 0.3}));
     EXPECT_EQ(constant.search_range(), (std::pair<double, double>{-1.2, 1.3}));
+    // level_range: both bounds where given (in either order), else the search range.
+    EXPECT_EQ(constant.level_range(), (std::pair<double, double>{-0.2, 0.3}));
+    EXPECT_EQ(bounded.level_range(), (std::pair<double, double>{-1.0, 3.0}));
+    s.min_level = 5.0;
+    s.max_level = -1.0;
+    EXPECT_EQ(spec_of(p::ProcedureKind::Staircase, s).level_range(), (std::pair<double, double>{-1.0, 5.0}));
+    s.max_level.reset();
+    EXPECT_EQ(spec_of(p::ProcedureKind::Staircase, s, {1.0, 4.0}).level_range(),
+              (std::pair<double, double>{5.0, 7.0}))
+        << "one bound: the search range, with that bound kept";
 }
 
 // The bound is checked against the schedule itself: answered to the end, the
@@ -187,6 +197,29 @@ TEST(ProcedureFacts, ResponseWordsRoundTrip) {
     }
     for (const char* other : {"", "Left", "first", "timeout", "quit", "continue"})
         EXPECT_FALSE(p::parse_response_word(other).has_value()) << other;
+}
+
+}  // namespace
+
+namespace {
+
+// The stored words of docs/store.md ("response" column): every answer word
+// reads back as its Response and is counted; "timeout" and "missed" are the
+// two words of trials the procedure never took, and neither names a Response.
+TEST(ProcedureFacts, ResponseWordsRoundTripAndOnlyTimeoutAndMissedGoUncounted) {
+    for (const p::Response r : {p::Response::No, p::Response::Yes, p::Response::Left, p::Response::Right,
+                                p::Response::CoarseUp, p::Response::CoarseDown, p::Response::FineUp,
+                                p::Response::FineDown, p::Response::Confirm}) {
+        const std::string_view word = p::response_word(r);
+        EXPECT_EQ(p::parse_response_word(word), r) << word;
+        EXPECT_TRUE(p::is_counted_response_word(word)) << word;
+    }
+    EXPECT_EQ(p::kTimeoutWord, "timeout");
+    EXPECT_EQ(p::kMissedWord, "missed");
+    EXPECT_FALSE(p::is_counted_response_word("timeout"));
+    EXPECT_FALSE(p::is_counted_response_word("missed"));
+    EXPECT_FALSE(p::parse_response_word("timeout").has_value());
+    EXPECT_FALSE(p::parse_response_word("missed").has_value());
 }
 
 }  // namespace

@@ -17,10 +17,6 @@ namespace atonlab::runner {
 namespace p = atonlab::protocols;
 namespace st = atonlab::store;
 
-bool is_uncounted(std::string_view response) {
-    return response == "missed" || response == "timeout";
-}
-
 std::optional<st::Store> read_existing_study(const std::string& db, const st::StoreOptions& options) {
     std::error_code ec;
     const std::filesystem::path path(db);
@@ -124,7 +120,8 @@ Replayed replay_logged(const p::Protocol& protocol, const SessionToRun& run, con
     for (std::size_t row = 0; row < run.logged.size(); ++row) {
         const st::TrialRecord& t = run.logged[row];
         const std::optional<p::ScheduledTrial> next = check.next();
-        const bool uncounted = is_uncounted(t.response);
+        // docs/running.md, "Missed frames and timeouts": shown again, skipped on replay.
+        const bool uncounted = !p::is_counted_response_word(t.response);
         const std::optional<p::Response> r = uncounted ? std::nullopt : p::parse_response_word(t.response);
         if (!next || (!uncounted && !r) || next->condition_id != t.condition_id ||
             next->procedure_id != t.procedure_id || next->proposal.level != t.level ||

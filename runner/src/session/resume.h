@@ -18,9 +18,6 @@
 
 namespace atonlab::runner {
 
-/// The response codes of trials the procedure never saw (docs/running.md,
-/// "Missed frames and timeouts"): shown again, skipped on replay.
-bool is_uncounted(std::string_view response);
 
 /// The study file opened read-only when it has content: checked by the store
 /// (an atonlab study, undamaged, no newer than this build) before anything is

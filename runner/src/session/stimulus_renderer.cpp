@@ -92,14 +92,18 @@ StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path
     pipeline_.set_frame_options(s::FrameOptions{});
 }
 
-s::Scene StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
+std::shared_ptr<const s::Scene> StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
+    std::string key;
+    for (const std::string& o : overrides) (key += o) += '\n';
+    if (const auto* hit = scenes_.find(key)) return *hit;
     std::vector<s::SceneOverride> parsed;
     parsed.reserve(overrides.size());
     for (const std::string& o : overrides) parsed.push_back(s::SceneOverride::parse(o));
-    s::Scene scene = s::parse_scene(scene_text_, scene_file_.string(), parsed);
-    if (display_model_) apply_display_model(scene, *display_model_);
-    s::validate_output_settings(scene.output);
-    return scene;
+    s::Scene sc = s::parse_scene(scene_text_, scene_file_.string(), parsed);
+    if (display_model_) apply_display_model(sc, *display_model_);
+    s::validate_output_settings(sc.output);
+    ++parsed_;
+    return scenes_.put(key, std::make_shared<const s::Scene>(std::move(sc)));
 }
 
 std::shared_ptr<const FrameViews> StimulusRenderer::views(const p::Frame& frame,
@@ -136,23 +140,21 @@ std::shared_ptr<const s::EncodedImage> StimulusRenderer::codes(const p::Frame& f
     const std::string key = cache_key(frame, lights);
     if (const auto* hit = codes_.find(key)) return *hit;
     const auto started = std::chrono::steady_clock::now();
-    const s::Scene sc = scene(frame.overrides);
+    const auto scene_ptr = scene(frame.overrides);
+    const s::Scene& sc = *scene_ptr;
     auto out = std::make_shared<const s::EncodedImage>(render_codes(sc, brightest_moment_s(sc, lights, interval_s_)));
     render_s_ += seconds_since(started);
     return codes_.put(key, std::move(out));
 }
 
 bool StimulusRenderer::animated(const p::Frame& frame) {
-    const s::Scene sc = scene(frame.overrides);
-    return std::any_of(sc.lights.begin(), sc.lights.end(), [](const s::Light& l) { return l.rhythm_period_s > 0; });
+    const auto sc = scene(frame.overrides);
+    return std::any_of(sc->lights.begin(), sc->lights.end(), [](const s::Light& l) { return l.rhythm_period_s > 0; });
 }
 
 void StimulusRenderer::encode(const p::Frame& frame, double time_s) {
-    // Parsed once per frame, not once per flip.
-    const std::string key = cache_key(frame, {});
-    if (!last_scene_.second || last_scene_.first != key)
-        last_scene_ = {key, std::make_shared<const s::Scene>(scene(frame.overrides))};
-    encode_scene(*last_scene_.second, time_s);
+    // Parsed once per frame (scene()'s cache), not once per flip.
+    encode_scene(*scene(frame.overrides), time_s);
 }
 
 void StimulusRenderer::present(int x, int y) const {
@@ -161,15 +163,15 @@ void StimulusRenderer::present(int x, int y) const {
 
 std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::string>& overrides) const {
     std::vector<std::string> names;
-    for (const s::Light& l : scene(overrides).lights) names.push_back(l.name);
+    for (const s::Light& l : scene(overrides)->lights) names.push_back(l.name);
     return names;
 }
 
 std::vector<std::string> StimulusRenderer::all_off(const std::vector<std::string>& overrides) const {
-    const s::Scene sc = scene(overrides);
+    const auto sc = scene(overrides);
     std::vector<std::string> off;
-    for (const s::Light& l : sc.lights) off.push_back(fmt::format("light.{}.intensity_cd=0", l.name));
-    for (const s::Disc& d : sc.discs) off.push_back(fmt::format("disc.{}.diameter_deg=0", d.name));
+    for (const s::Light& l : sc->lights) off.push_back(fmt::format("light.{}.intensity_cd=0", l.name));
+    for (const s::Disc& d : sc->discs) off.push_back(fmt::format("disc.{}.diameter_deg=0", d.name));
     return off;
 }
 
@@ -180,19 +182,20 @@ const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame,
     // comparison it is the same for every level of a condition, so a few
     // cached frames serve a whole session.
     p::Frame off = frame;
-    const s::Scene on = scene(frame.overrides);
+    const auto on = scene(frame.overrides);
     for (const std::string& name : lights)
-        if (!name.empty()) off.overrides.push_back(judged_off_override(on, name));
+        if (!name.empty()) off.overrides.push_back(judged_off_override(*on, name));
     const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
     if (const auto* hit = background_.find(key)) return *hit;
-    return background_.put(key, render_codes(scene(off.overrides), time_s));
+    return background_.put(key, render_codes(*scene(off.overrides), time_s));
 }
 
 std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame,
                                                            const std::vector<std::string>& lights, s::ImageRGBA32F* hdr,
                                                            double* degrees_per_pixel) {
     const auto started = std::chrono::steady_clock::now();
-    const s::Scene sc = scene(frame.overrides);
+    const auto scene_ptr = scene(frame.overrides);
+    const s::Scene& sc = *scene_ptr;
     auto out = std::make_shared<FrameViews>();
     out->time_s = brightest_moment_s(sc, lights, interval_s_);
 

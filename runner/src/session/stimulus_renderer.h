@@ -57,8 +57,10 @@ public:
                      double interval_s, std::size_t cache_frames = 4096);
 
     /// The scene a frame's overrides give. Throws InputError (the scene's own
-    /// errors, or "--set KEY" for an override).
-    stimuli::Scene scene(const std::vector<std::string>& overrides) const;
+    /// errors, or "--set KEY" for an override). Each distinct override list is
+    /// parsed once (a small LRU of scenes): a trial asks for its scenes from
+    /// views(), codes(), animated(), encode() and the backgrounds.
+    std::shared_ptr<const stimuli::Scene> scene(const std::vector<std::string>& overrides) const;
 
     /// The frame seen around `lights` (scene light names; "" = the screen's
     /// centre), from the cache or rendered.
@@ -91,10 +93,15 @@ public:
 
     /// Encode every frame for this display model instead of the scene's (the
     /// display's measured calibration: calibration_policy.h). Set before the first frame.
-    void use_display_model(display::DisplayModel model) { display_model_ = std::move(model); }
+    void use_display_model(display::DisplayModel model) {
+        display_model_ = std::move(model);
+        scenes_ = LruCache<std::string, std::shared_ptr<const stimuli::Scene>>(scenes_.capacity());
+    }
 
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
+    /// How many times the scene template was parsed with a frame's overrides.
+    std::size_t scenes_parsed() const noexcept { return parsed_; }
     /// Wall-clock seconds spent rendering and reading frames back.
     double render_seconds() const noexcept { return render_s_; }
 
@@ -119,7 +126,10 @@ private:
     LruCache<std::string, stimuli::EncodedImage> background_{8};       ///< background_codes()
     /// codes(): a trial's frames and its background, with room to spare.
     LruCache<std::string, std::shared_ptr<const stimuli::EncodedImage>> codes_{8};
-    std::pair<std::string, std::shared_ptr<const stimuli::Scene>> last_scene_;  ///< encode()'s parsed scene
+    /// scene(): the scenes of the override lists asked for lately (a trial's
+    /// frames, their lights-off backgrounds, the load-time checks' proposals).
+    mutable LruCache<std::string, std::shared_ptr<const stimuli::Scene>> scenes_{64};
+    mutable std::size_t parsed_ = 0;
     std::size_t rendered_ = 0;
     std::size_t requested_ = 0;
     double render_s_ = 0.0;

@@ -100,7 +100,8 @@ st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTria
     std::vector<double> frame_times;
     std::vector<std::string> view_glares(t.stimulus.views.size());
     for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
-        const s::Scene sc = renderer.scene(t.stimulus.frames[f].overrides);
+        const auto scene = renderer.scene(t.stimulus.frames[f].overrides);
+        const s::Scene& sc = *scene;
         frame_times.push_back(brightest_moment_s(sc, judged_lights(t.stimulus, f), protocol.timing.stimulus_s));
         for (std::size_t v = 0; v < t.stimulus.views.size(); ++v)
             if (t.stimulus.views[v].frame == f) view_glares[v] = view_glare(sc, t.stimulus.views[v].light);
@@ -114,7 +115,7 @@ st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTria
     tr.test_on_left = t.proposal.test_on_left;
     tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json, view_glares);
     tr.response = counted ? std::string(p::response_word(*shown.response))
-                          : std::string(shown.end == TrialEnd::timeout ? "timeout" : "missed");
+                          : std::string(shown.end == TrialEnd::timeout ? p::kTimeoutWord : p::kMissedWord);
     if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;
     tr.response_time_s = std::max(0.0, shown.response_time_s);  // onset to answer
     tr.onset_time_s = shown.onset_s;

@@ -72,6 +72,14 @@ std::string_view to_string(Response r) noexcept;
 std::string_view response_word(Response r) noexcept;
 /// The response a word names (the inverse of response_word); nullopt for any other word.
 std::optional<Response> parse_response_word(std::string_view word) noexcept;
+/// The words a trial the procedure never took is stored as: no answer within
+/// the response timeout, or a stimulus that missed a refresh (shown again).
+inline constexpr std::string_view kTimeoutWord = "timeout";
+inline constexpr std::string_view kMissedWord = "missed";
+/// A stored response word that the procedure took: not kTimeoutWord or kMissedWord.
+constexpr bool is_counted_response_word(std::string_view word) noexcept {
+    return word != kTimeoutWord && word != kMissedWord;
+}
 /// Yes for true, No for false.
 constexpr Response binary(bool yes) noexcept {
     return yes ? Response::Yes : Response::No;

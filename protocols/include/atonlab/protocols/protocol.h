@@ -105,6 +105,10 @@ struct ProcedureSpec {
     /// (staircases, QUEST), its levels ± 1 (constant stimuli), its start range
     /// ± 2 (adjustment).
     std::pair<double, double> search_range() const;
+    /// The bottom and top of the levels it can present: its level bounds where
+    /// it has both (either order), else search_range(). The displayability
+    /// check renders a condition at these two ends.
+    std::pair<double, double> level_range() const;
     /// The most answers one track takes; nullopt when it has no upper bound
     /// (a staircase without max_trials, adjustment).
     std::optional<std::size_t> max_trials_per_track() const;
