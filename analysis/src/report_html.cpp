@@ -238,6 +238,241 @@ private:
     std::vector<std::pair<std::string, std::string>> out_;
 };
 
+/// The summary table: one row per condition.
+std::string summary_html(const StudyResults& r, const std::map<std::string, std::string>& slugs, Footnotes& notes) {
+    std::string h;
+    h += "<h2>Summary</h2>\n";
+    h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
+         "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
+         "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
+    // Each number over its interval in one cell, so that the table fits 1280 px.
+    h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th>"
+         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>glare test / reference</th><th>test (cd)</th>"
+         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>enhancement [interval]</th>"
+         "<th>reliable</th></tr>\n";
+    for (const ConditionInfo& c : r.conditions) {
+        const GroupResult* g = r.main_group(c.condition);
+        if (!g) continue;
+        const HeadlineEstimate& e = g->headline;
+        std::string enh = "&ndash;";
+        if (g->match_ratio && g->match_ratio->value)
+            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci);
+        h += fmt::format(
+            "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
+            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}<br>{}</td>"
+            "<td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))),
+            esc(c.procedure.empty() ? "(not stated)" : c.procedure), g3(c.adaptation_cd_m2), esc(c.tone_operator),
+            esc(c.glare_test), esc(c.glare_reference), g3(c.test_intensity_cd), esc(g->observer), g->n_scored,
+            f3(e.value), ci_text(e.ci), esc(c.level_unit()), enh, yes_no(e.reliable, e.reason, notes));
+    }
+    h += "</table></div>\n" + notes.flush();
+    return h;
+}
+
+/// A condition's heading, its settings and the table of its fits, one row per observer.
+std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
+                                const std::map<std::string, std::string>& slugs, Footnotes& notes) {
+    std::string h;
+    h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(slugs.at(c.condition)), esc(c.condition));
+    h += fmt::format(
+        "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
+        "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "
+        "(guess rate {}, target P {}). {} trials.</p>\n",
+        esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure),
+        esc(c.level_key), esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
+        esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
+        esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
+        esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
+        c.task == Task::YesNo    ? "yes"
+        : c.task == Task::Adjust ? "the confirmed match"
+        : c.level_on == "test"   ? "chose the test"
+                                 : "chose the reference",
+        c.guess_rate, c.target_p, c.n_trials);
+    if (!r.factor_columns.empty()) {
+        // The design's other factors (fits.csv's factor columns), as the protocol set them.
+        std::string list;
+        for (const std::string& key : r.factor_columns) {
+            const auto it = c.settings.find(key);
+            const SettingValue v = setting_value(it == c.settings.end() ? std::string() : it->second);
+            const std::string shown = it == c.settings.end() ? std::string("(not set)")
+                                      : v.number             ? fmt::format("{:.6g}", *v.number)
+                                      : v.boolean            ? std::string(*v.boolean ? "true" : "false")
+                                                             : v.text;
+            list += fmt::format("{}<code>{}</code> = {}", list.empty() ? "" : ", ", esc(key), esc(shown));
+        }
+        h += "<p>Other factors of the design: " + list + ".</p>\n";
+    }
+    h += "<div "
+         "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</"
+         "th><th>how</th>"
+         "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
+         "<th>reliable</th></tr>\n";
+    for (const GroupResult& g : r.groups) {
+        if (g.condition != c.condition) continue;
+        std::string slope = "&ndash;", width = "&ndash;", lapse = "&ndash;", gof = "&ndash;";
+        if (g.fit && g.fit->estimate) {
+            const PsychometricEstimate& e = *g.fit->estimate;
+            slope = fmt::format("{:.3g}", e.slope);
+            width = fmt::format("{:.3g}", e.width);
+            lapse = fmt::format("{:.3f}", e.params.lambda);
+            gof = fmt::format("{:.2f}", e.deviance);
+            if (g.bootstrap) {
+                if (g.bootstrap->slope)
+                    slope += fmt::format(" [{:.3g}, {:.3g}]", g.bootstrap->slope->lower, g.bootstrap->slope->upper);
+                const GoodnessOfFit& gf = g.bootstrap->goodness_of_fit;
+                gof = fmt::format("{:.2f} ({}), {}", gf.deviance, gf.dof, g3(gf.p_value));
+            }
+        }
+        h += fmt::format(
+            "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>"
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+            "<td>{}</td></tr>\n",
+            esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method),
+            slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason, notes));
+    }
+    h += "</table></div>\n" + notes.flush();
+    return h;
+}
+
+/// The procedures' own estimates (staircase reversals, QUEST posteriors, adjustment matches) of a
+/// condition, per observer; empty when there are none.
+std::string procedure_estimates_html(const StudyResults& r, const ConditionInfo& c, Footnotes& notes) {
+    std::string h;
+    std::string tracks;
+    for (const GroupResult& g : r.groups) {
+        if (g.condition != c.condition || (g.observer == kPooled)) continue;
+        for (const TrackResult& t : g.tracks) {
+            if (t.reversals) {
+                const ReversalSummary& s = *t.reversals;
+                tracks += fmt::format(
+                    "<tr><td>{}</td><td>{}</td><td>staircase</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                    "<td>mean of the last {} of {} reversals, sd {}</td><td>{}</td><td>{}</td></tr>\n",
+                    esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(s.mean), s.n_used,
+                    s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason, notes));
+            }
+            if (t.quest) {
+                const QuestSummary& q = *t.quest;
+                tracks += fmt::format(
+                    "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                    "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+                    esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(q.mean), g3(q.sd),
+                    ci_text(q.interval), yes_no(q.reliable, q.reason, notes));
+            }
+        }
+        if (g.matches) {
+            const AdjustmentSummary& m = *g.matches;
+            tracks += fmt::format(
+                "<tr><td>{}</td><td>all matches</td><td>adjustment</td><td class=\"num\">{}</td>"
+                "<td class=\"num\">{}</td><td>mean match; median {} {}, sd {}</td><td class=\"num\">{}</td>"
+                "<td>{}</td></tr>\n",
+                esc(g.observer), m.n, f3(m.mean_log10_ratio), f3(m.median_log10_ratio), ci_text(m.median_ci),
+                g3(m.sd_log10_ratio), ci_text(m.mean_ci), yes_no(m.reliable, m.reason, notes));
+        }
+    }
+    if (!tracks.empty()) {
+        h += "<p>The procedures' own estimates:</p>\n<div "
+             "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
+             "<th>trials</th><th>estimate</th><th>how</th><th>interval</th><th>reliable</th></tr>\n" +
+             tracks + "</table></div>\n" + notes.flush();
+    }
+    return h;
+}
+
+/// The paired comparisons across observers; empty when there are none.
+std::string paired_html(const StudyResults& r, Footnotes& notes) {
+    std::string h;
+    if (!r.paired.empty()) {
+        h += "<h2>Paired comparisons across observers</h2>\n";
+        h += "<p>Conditions that differ in one stimulus parameter, compared within observers: the mean of each "
+             "observer's difference A &minus; B of the headline estimates, its bootstrap interval over observers, "
+             "and Student's paired t test.</p>\n";
+        h += "<div class=\"table-wrap\"><table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean "
+             "A &minus; B</th>"
+             "<th>interval</th><th>t (dof)</th><th>p</th><th>reliable</th></tr>\n";
+        for (const PairedResult& p : r.paired) {
+            const PairedComparison& c = p.comparison;
+            h += fmt::format(
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                "<td class=\"num\">{}</td><td class=\"num\">{} ({})</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+                esc(p.condition_a), esc(p.condition_b), esc(p.factor), c.n, f3(c.mean_difference), ci_text(c.ci),
+                g3(c.t), c.dof, g3(c.p_value), yes_no(c.reliable, c.reason, notes));
+        }
+        h += "</table></div>\n" + notes.flush();
+    }
+    return h;
+}
+
+/// The sessions' table: who, which protocol, and their frame timing.
+std::string sessions_html(const Dataset& d, const StudyResults& r, Footnotes& notes) {
+    std::string h;
+    h += "<h2>Sessions and frame timing</h2>\n<div class=\"table-wrap\"><table>\n<tr><th>session</th>"
+         "<th>observer</th><th>answered by</th><th>protocol</th><th>status</th><th>started</th><th>trials</th>"
+         "<th>dropped frames</th><th>trials with drops</th><th>missed deadlines</th><th>display check</th></tr>\n";
+    for (const SessionInfo& s : d.sessions) {
+        const SessionTiming* t = nullptr;
+        for (const SessionTiming& x : r.timing)
+            if (x.session == s.key) t = &x;
+        h += fmt::format(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            esc(s.key), esc(s.observer), esc(s.answered_by.empty() ? "(not recorded)" : s.answered_by),
+            esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0, t ? t->dropped_frames : 0,
+            t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
+            !s.displayable   ? std::string("not recorded")
+            : *s.displayable ? std::string("displayable")
+                             : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",
+                                               fmt::join(s.undisplayable, ", "))));
+    }
+    h += "</table></div>\n" + notes.flush();
+    return h;
+}
+
+/// The display calibrations: their geometry, the fitted models' parameters, figures and drift.
+std::string calibration_html(const Dataset& d, const ReportContext& ctx, const std::filesystem::path& out_dir,
+                             Footnotes& notes) {
+    std::string h;
+    h += "<h2>Display calibration</h2>\n";
+    if (d.calibrations.empty()) {
+        h += "<p>No calibration is recorded for these sessions (a CSV input has none).</p>\n";
+    } else {
+        h += "<div class=\"table-wrap\"><table>\n<tr><th>display</th><th>file</th><th>measured</th><th>how</th>"
+             "<th>geometry</th><th>readings</th></tr>\n";
+        for (const CalibrationInfo& c : d.calibrations) {
+            h += fmt::format(
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} × {} px, {:.3f} × {:.3f} m at {:.3f} m</td>"
+                "<td class=\"num\">{}</td></tr>\n",
+                esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px, c.width_m,
+                c.height_m, c.viewing_distance_m, c.readings.size());
+        }
+        h += "</table></div>\n" + notes.flush();
+        // The fitted model's parameters (fit_json, docs/calibration.md), one row each.
+        for (const CalibrationInfo& c : d.calibrations) {
+            h += fmt::format(
+                "<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
+                esc(c.display_name), c.id, esc(c.source));
+            h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
+            for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
+                // Numbers to 6 significant digits (summary.json keeps them whole).
+                double x = 0.0;
+                const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
+                const bool number = ec == std::errc() && end == value.data() + value.size();
+                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key),
+                                 number ? fmt::format("{:.6g}", x) : esc(value));
+            }
+            h += "</table></div>\n";
+        }
+        if (ctx.plots)
+            for (const Figure& f : ctx.plots->figures)
+                if (f.kind == "calibration") h += figure_html(out_dir, f);
+        h += drift_html(d);
+        if (ctx.plots)
+            for (const Figure& f : ctx.plots->figures)
+                if (f.kind == "calibration-drift") h += figure_html(out_dir, f);
+    }
+    return h;
+}
+
 }  // namespace
 
 std::string base64(const std::string& bytes) {
@@ -318,133 +553,14 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     }
 
     // --- summary table
-    h += "<h2>Summary</h2>\n";
-    h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
-         "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
-         "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
-    // Each number over its interval in one cell, so that the table fits 1280 px.
-    h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th>"
-         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>glare test / reference</th><th>test (cd)</th>"
-         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>enhancement [interval]</th>"
-         "<th>reliable</th></tr>\n";
-    for (const ConditionInfo& c : r.conditions) {
-        const GroupResult* g = r.main_group(c.condition);
-        if (!g) continue;
-        const HeadlineEstimate& e = g->headline;
-        std::string enh = "&ndash;";
-        if (g->match_ratio && g->match_ratio->value)
-            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci);
-        h += fmt::format(
-            "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
-            "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}<br>{}</td>"
-            "<td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))),
-            esc(c.procedure.empty() ? "(not stated)" : c.procedure), g3(c.adaptation_cd_m2), esc(c.tone_operator),
-            esc(c.glare_test), esc(c.glare_reference), g3(c.test_intensity_cd), esc(g->observer), g->n_scored,
-            f3(e.value), ci_text(e.ci), esc(c.level_unit()), enh, yes_no(e.reliable, e.reason, notes));
-    }
-    h += "</table></div>\n" + notes.flush();
+    h += summary_html(r, slugs, notes);
     for (const char* kind : {"pse", "enhancement"})
         if (by_kind.count(kind)) h += figure_html(out_dir, *by_kind[kind]);
 
     // --- per condition
     for (const ConditionInfo& c : r.conditions) {
-        h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(slugs.at(c.condition)), esc(c.condition));
-        h += fmt::format(
-            "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
-            "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "
-            "(guess rate {}, target P {}). {} trials.</p>\n",
-            esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure),
-            esc(c.level_key), esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
-            esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
-            esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
-            esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
-            c.task == Task::YesNo    ? "yes"
-            : c.task == Task::Adjust ? "the confirmed match"
-            : c.level_on == "test"   ? "chose the test"
-                                     : "chose the reference",
-            c.guess_rate, c.target_p, c.n_trials);
-        if (!r.factor_columns.empty()) {
-            // The design's other factors (fits.csv's factor columns), as the protocol set them.
-            std::string list;
-            for (const std::string& key : r.factor_columns) {
-                const auto it = c.settings.find(key);
-                const SettingValue v = setting_value(it == c.settings.end() ? std::string() : it->second);
-                const std::string shown = it == c.settings.end() ? std::string("(not set)")
-                                          : v.number             ? fmt::format("{:.6g}", *v.number)
-                                          : v.boolean            ? std::string(*v.boolean ? "true" : "false")
-                                                                 : v.text;
-                list += fmt::format("{}<code>{}</code> = {}", list.empty() ? "" : ", ", esc(key), esc(shown));
-            }
-            h += "<p>Other factors of the design: " + list + ".</p>\n";
-        }
-        h += "<div "
-             "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>trials</th><th>estimate</th><th>interval</"
-             "th><th>how</th>"
-             "<th>slope [interval]</th><th>width</th><th>lapse λ</th><th>deviance (dof), p</th>"
-             "<th>reliable</th></tr>\n";
-        for (const GroupResult& g : r.groups) {
-            if (g.condition != c.condition) continue;
-            std::string slope = "&ndash;", width = "&ndash;", lapse = "&ndash;", gof = "&ndash;";
-            if (g.fit && g.fit->estimate) {
-                const PsychometricEstimate& e = *g.fit->estimate;
-                slope = fmt::format("{:.3g}", e.slope);
-                width = fmt::format("{:.3g}", e.width);
-                lapse = fmt::format("{:.3f}", e.params.lambda);
-                gof = fmt::format("{:.2f}", e.deviance);
-                if (g.bootstrap) {
-                    if (g.bootstrap->slope)
-                        slope += fmt::format(" [{:.3g}, {:.3g}]", g.bootstrap->slope->lower, g.bootstrap->slope->upper);
-                    const GoodnessOfFit& gf = g.bootstrap->goodness_of_fit;
-                    gof = fmt::format("{:.2f} ({}), {}", gf.deviance, gf.dof, g3(gf.p_value));
-                }
-            }
-            h += fmt::format(
-                "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>"
-                "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-                "<td>{}</td></tr>\n",
-                esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method),
-                slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason, notes));
-        }
-        h += "</table></div>\n" + notes.flush();
-        // The procedures' own estimates.
-        std::string tracks;
-        for (const GroupResult& g : r.groups) {
-            if (g.condition != c.condition || (g.observer == kPooled)) continue;
-            for (const TrackResult& t : g.tracks) {
-                if (t.reversals) {
-                    const ReversalSummary& s = *t.reversals;
-                    tracks += fmt::format(
-                        "<tr><td>{}</td><td>{}</td><td>staircase</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-                        "<td>mean of the last {} of {} reversals, sd {}</td><td>{}</td><td>{}</td></tr>\n",
-                        esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(s.mean), s.n_used,
-                        s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason, notes));
-                }
-                if (t.quest) {
-                    const QuestSummary& q = *t.quest;
-                    tracks += fmt::format(
-                        "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-                        "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-                        esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(q.mean), g3(q.sd),
-                        ci_text(q.interval), yes_no(q.reliable, q.reason, notes));
-                }
-            }
-            if (g.matches) {
-                const AdjustmentSummary& m = *g.matches;
-                tracks += fmt::format(
-                    "<tr><td>{}</td><td>all matches</td><td>adjustment</td><td class=\"num\">{}</td>"
-                    "<td class=\"num\">{}</td><td>mean match; median {} {}, sd {}</td><td class=\"num\">{}</td>"
-                    "<td>{}</td></tr>\n",
-                    esc(g.observer), m.n, f3(m.mean_log10_ratio), f3(m.median_log10_ratio), ci_text(m.median_ci),
-                    g3(m.sd_log10_ratio), ci_text(m.mean_ci), yes_no(m.reliable, m.reason, notes));
-            }
-        }
-        if (!tracks.empty()) {
-            h += "<p>The procedures' own estimates:</p>\n<div "
-                 "class=\"table-wrap\"><table>\n<tr><th>observer</th><th>track</th><th>procedure</th>"
-                 "<th>trials</th><th>estimate</th><th>how</th><th>interval</th><th>reliable</th></tr>\n" +
-                 tracks + "</table></div>\n" + notes.flush();
-        }
+        h += condition_fits_html(r, c, slugs, notes);
+        h += procedure_estimates_html(r, c, notes);
         if (const auto it = by_condition.find(c.condition); it != by_condition.end())
             for (const Figure* f : it->second) h += figure_html(out_dir, *f);
         for (const SnapshotImage& s : ctx.snapshots) {
@@ -458,45 +574,10 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     }
 
     // --- paired comparisons
-    if (!r.paired.empty()) {
-        h += "<h2>Paired comparisons across observers</h2>\n";
-        h += "<p>Conditions that differ in one stimulus parameter, compared within observers: the mean of each "
-             "observer's difference A &minus; B of the headline estimates, its bootstrap interval over observers, "
-             "and Student's paired t test.</p>\n";
-        h += "<div class=\"table-wrap\"><table>\n<tr><th>A</th><th>B</th><th>differ in</th><th>observers</th><th>mean "
-             "A &minus; B</th>"
-             "<th>interval</th><th>t (dof)</th><th>p</th><th>reliable</th></tr>\n";
-        for (const PairedResult& p : r.paired) {
-            const PairedComparison& c = p.comparison;
-            h += fmt::format(
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-                "<td class=\"num\">{}</td><td class=\"num\">{} ({})</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-                esc(p.condition_a), esc(p.condition_b), esc(p.factor), c.n, f3(c.mean_difference), ci_text(c.ci),
-                g3(c.t), c.dof, g3(c.p_value), yes_no(c.reliable, c.reason, notes));
-        }
-        h += "</table></div>\n" + notes.flush();
-    }
+    h += paired_html(r, notes);
 
     // --- sessions and timing
-    h += "<h2>Sessions and frame timing</h2>\n<div class=\"table-wrap\"><table>\n<tr><th>session</th>"
-         "<th>observer</th><th>answered by</th><th>protocol</th><th>status</th><th>started</th><th>trials</th>"
-         "<th>dropped frames</th><th>trials with drops</th><th>missed deadlines</th><th>display check</th></tr>\n";
-    for (const SessionInfo& s : d.sessions) {
-        const SessionTiming* t = nullptr;
-        for (const SessionTiming& x : r.timing)
-            if (x.session == s.key) t = &x;
-        h += fmt::format(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
-            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-            esc(s.key), esc(s.observer), esc(s.answered_by.empty() ? "(not recorded)" : s.answered_by),
-            esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0, t ? t->dropped_frames : 0,
-            t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
-            !s.displayable   ? std::string("not recorded")
-            : *s.displayable ? std::string("displayable")
-                             : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",
-                                               fmt::join(s.undisplayable, ", "))));
-    }
-    h += "</table></div>\n" + notes.flush();
+    h += sessions_html(d, r, notes);
     if (by_kind.count("timing"))
         h += figure_html(out_dir, *by_kind["timing"]);
     else if (!r.timing.empty() && !has_display_timing(d, r))
@@ -505,44 +586,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
              "display, so no timing figure is drawn.</p>\n";
 
     // --- calibration
-    h += "<h2>Display calibration</h2>\n";
-    if (d.calibrations.empty()) {
-        h += "<p>No calibration is recorded for these sessions (a CSV input has none).</p>\n";
-    } else {
-        h += "<div class=\"table-wrap\"><table>\n<tr><th>display</th><th>file</th><th>measured</th><th>how</th>"
-             "<th>geometry</th><th>readings</th></tr>\n";
-        for (const CalibrationInfo& c : d.calibrations) {
-            h += fmt::format(
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} × {} px, {:.3f} × {:.3f} m at {:.3f} m</td>"
-                "<td class=\"num\">{}</td></tr>\n",
-                esc(c.display_name), esc(c.source), esc(c.measured_at), esc(c.how), c.width_px, c.height_px, c.width_m,
-                c.height_m, c.viewing_distance_m, c.readings.size());
-        }
-        h += "</table></div>\n" + notes.flush();
-        // The fitted model's parameters (fit_json, docs/calibration.md), one row each.
-        for (const CalibrationInfo& c : d.calibrations) {
-            h += fmt::format(
-                "<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
-                esc(c.display_name), c.id, esc(c.source));
-            h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
-            for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
-                // Numbers to 6 significant digits (summary.json keeps them whole).
-                double x = 0.0;
-                const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
-                const bool number = ec == std::errc() && end == value.data() + value.size();
-                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key),
-                                 number ? fmt::format("{:.6g}", x) : esc(value));
-            }
-            h += "</table></div>\n";
-        }
-        if (ctx.plots)
-            for (const Figure& f : ctx.plots->figures)
-                if (f.kind == "calibration") h += figure_html(out_dir, f);
-        h += drift_html(d);
-        if (ctx.plots)
-            for (const Figure& f : ctx.plots->figures)
-                if (f.kind == "calibration-drift") h += figure_html(out_dir, f);
-    }
+    h += calibration_html(d, ctx, out_dir, notes);
 
     // --- methods and files
     h += "<h2>Methods</h2>\n<ul>\n"

@@ -108,11 +108,15 @@ std::optional<DriveScale> drive_scale_from_name(std::string_view name) {
     return std::nullopt;
 }
 
-std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name,
-                                               const CalibrationFileOptions& options) {
-    std::vector<Measurement> out;
-    const auto lines = split_lines(text);
-    // Column index of the level, channel and reading columns; -1 until the header is read.
+namespace {
+
+const char* const csv_header_help =
+    "the header names the drive level (level, level_fraction, level_8bit or level_10bit), channel, and the "
+    "reading (cd_m2, fL, or X,Y,Z)";
+
+/// The columns of a calibration CSV, as its header names them.
+struct CsvHeader {
+    // Column index of the level, channel and reading columns; -1 when absent.
     int col_level = -1, col_channel = -1, col_cd = -1, col_x = -1, col_z = -1;
     std::string level_key = "level", reading_key = "cd_m2";
     std::optional<DriveScale> named_scale;  // from the level column's name
@@ -120,87 +124,107 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
     DriveScale scale = DriveScale::fraction;
     std::size_t n_columns = 0;
     int header_line = 0;
-    const char* header_help =
-        "the header names the drive level (level, level_fraction, level_8bit or level_10bit), channel, and the "
-        "reading (cd_m2, fL, or X,Y,Z)";
+};
+
+/// A CSV line's comma-separated fields, trimmed, with their 1-based columns.
+std::vector<std::pair<std::string_view, int>> csv_fields(std::string_view line) {
+    std::vector<std::pair<std::string_view, int>> fields;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = line.find(',', start);
+        const std::string_view raw =
+            line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
+        const auto lead = raw.find_first_not_of(" \t");
+        const int column = static_cast<int>(start + (lead == std::string_view::npos ? 0 : lead)) + 1;
+        fields.emplace_back(trim(raw), column);
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return fields;
+}
+
+/// The header (the first non-comment line, number line_no): which column holds what, and the drive scale.
+CsvHeader parse_csv_header(const std::vector<std::pair<std::string_view, int>>& fields, int line_no,
+                           const std::string& file_name, const CalibrationFileOptions& options) {
+    CsvHeader h;
+    h.header_line = line_no;
+    h.n_columns = fields.size();
+    int col_y = -1;
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+        const auto name = fields[i].first;
+        const bool level_name =
+            name == "level" || name == "level_fraction" || name == "level_8bit" || name == "level_10bit";
+        const bool reading_name = name == "cd_m2" || name == "fL";
+        int* slot = level_name              ? &h.col_level
+                    : name == "channel"     ? &h.col_channel
+                    : reading_name          ? &h.col_cd
+                    : name == "X"           ? &h.col_x
+                    : name == "Y"           ? &col_y
+                    : name == "Z"           ? &h.col_z
+                                            : nullptr;
+        if (slot == nullptr)
+            throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
+                             fmt::format("unknown column; {}", csv_header_help));
+        if (*slot >= 0)
+            throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
+                             level_name || reading_name ? "a second drive-level or reading column"
+                                                        : "this column appears twice in the header");
+        *slot = static_cast<int>(i);
+        if (level_name) {
+            h.level_key = std::string(name);
+            if (name != "level") h.named_scale = drive_scale_from_name(name.substr(6));  // after "level_"
+        }
+        if (reading_name) {
+            h.reading_key = std::string(name);
+            // 1 fL = (1/π) cd/ft², 1 ft = 0.3048 m: 3.4262591 cd/m² (NIST SP 811, B.9).
+            h.reading_scale = name == "fL" ? 3.4262590996353905 : 1.0;
+        }
+    }
+    const bool xyz = h.col_x >= 0 || col_y >= 0 || h.col_z >= 0;
+    if (xyz && (h.col_x < 0 || col_y < 0 || h.col_z < 0))
+        throw InputError(SourceLocation{file_name, line_no, 0, h.col_x < 0 ? "X" : col_y < 0 ? "Y" : "Z"},
+                         "XYZ readings need all three columns X, Y and Z");
+    if (xyz && h.col_cd >= 0)
+        throw InputError(SourceLocation{file_name, line_no, 0, h.reading_key},
+                         "the header has both X,Y,Z and a luminance column; give one reading per row");
+    if (xyz) {
+        h.col_cd = col_y;
+        h.reading_key = std::string("Y");  // moved in: GCC 12 misreads assigning a literal (-Wrestrict)
+    }
+    for (const auto& [slot, name] :
+         {std::pair{h.col_level, "level"}, {h.col_channel, "channel"}, {h.col_cd, "cd_m2"}})
+        if (slot < 0)
+            throw InputError(SourceLocation{file_name, line_no, 0, name},
+                             fmt::format("the header lacks this column; {}", csv_header_help));
+    if (h.named_scale && options.drive_scale && *h.named_scale != *options.drive_scale)
+        throw InputError(SourceLocation{file_name, line_no, fields[static_cast<std::size_t>(h.col_level)].second,
+                                        h.level_key},
+                         fmt::format("the column says the drive levels are {} but --drive-scale says {}",
+                                     drive_scale_name(*h.named_scale), drive_scale_name(*options.drive_scale)));
+    h.scale = h.named_scale.value_or(options.drive_scale.value_or(DriveScale::fraction));
+    return h;
+}
+
+}  // namespace
+
+std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name,
+                                               const CalibrationFileOptions& options) {
+    std::vector<Measurement> out;
+    const auto lines = split_lines(text);
+    std::optional<CsvHeader> header;  // once the header line is read
     for (std::size_t li = 0; li < lines.size(); ++li) {
         const int line_no = static_cast<int>(li) + 1;
         std::string_view line = lines[li];
         if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
         if (trim(line).empty()) continue;
 
-        // Fields with their 1-based columns.
-        std::vector<std::pair<std::string_view, int>> fields;
-        std::size_t start = 0;
-        while (true) {
-            const std::size_t comma = line.find(',', start);
-            const std::string_view raw =
-                line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
-            const auto lead = raw.find_first_not_of(" \t");
-            const int column = static_cast<int>(start + (lead == std::string_view::npos ? 0 : lead)) + 1;
-            fields.emplace_back(trim(raw), column);
-            if (comma == std::string_view::npos) break;
-            start = comma + 1;
-        }
-
-        if (header_line == 0) {
-            header_line = line_no;
-            n_columns = fields.size();
-            int col_y = -1;
-            for (std::size_t i = 0; i < fields.size(); ++i) {
-                const auto name = fields[i].first;
-                const bool level_name =
-                    name == "level" || name == "level_fraction" || name == "level_8bit" || name == "level_10bit";
-                const bool reading_name = name == "cd_m2" || name == "fL";
-                int* slot = level_name              ? &col_level
-                            : name == "channel"     ? &col_channel
-                            : reading_name          ? &col_cd
-                            : name == "X"           ? &col_x
-                            : name == "Y"           ? &col_y
-                            : name == "Z"           ? &col_z
-                                                    : nullptr;
-                if (slot == nullptr)
-                    throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
-                                     fmt::format("unknown column; {}", header_help));
-                if (*slot >= 0)
-                    throw InputError(SourceLocation{file_name, line_no, fields[i].second, std::string(name)},
-                                     level_name || reading_name ? "a second drive-level or reading column"
-                                                                : "this column appears twice in the header");
-                *slot = static_cast<int>(i);
-                if (level_name) {
-                    level_key = std::string(name);
-                    if (name != "level") named_scale = drive_scale_from_name(name.substr(6));  // after "level_"
-                }
-                if (reading_name) {
-                    reading_key = std::string(name);
-                    // 1 fL = (1/π) cd/ft², 1 ft = 0.3048 m: 3.4262591 cd/m² (NIST SP 811, B.9).
-                    reading_scale = name == "fL" ? 3.4262590996353905 : 1.0;
-                }
-            }
-            const bool xyz = col_x >= 0 || col_y >= 0 || col_z >= 0;
-            if (xyz && (col_x < 0 || col_y < 0 || col_z < 0))
-                throw InputError(SourceLocation{file_name, line_no, 0, col_x < 0 ? "X" : col_y < 0 ? "Y" : "Z"},
-                                 "XYZ readings need all three columns X, Y and Z");
-            if (xyz && col_cd >= 0)
-                throw InputError(SourceLocation{file_name, line_no, 0, reading_key},
-                                 "the header has both X,Y,Z and a luminance column; give one reading per row");
-            if (xyz) {
-                col_cd = col_y;
-                reading_key = std::string("Y");  // moved in: GCC 12 misreads assigning a literal (-Wrestrict)
-            }
-            for (const auto& [slot, name] :
-                 {std::pair{col_level, "level"}, {col_channel, "channel"}, {col_cd, "cd_m2"}})
-                if (slot < 0)
-                    throw InputError(SourceLocation{file_name, line_no, 0, name},
-                                     fmt::format("the header lacks this column; {}", header_help));
-            if (named_scale && options.drive_scale && *named_scale != *options.drive_scale)
-                throw InputError(SourceLocation{file_name, line_no, fields[static_cast<std::size_t>(col_level)].second,
-                                                level_key},
-                                 fmt::format("the column says the drive levels are {} but --drive-scale says {}",
-                                             drive_scale_name(*named_scale), drive_scale_name(*options.drive_scale)));
-            scale = named_scale.value_or(options.drive_scale.value_or(DriveScale::fraction));
+        const auto fields = csv_fields(line);
+        if (!header) {
+            header = parse_csv_header(fields, line_no, file_name, options);
             continue;
         }
+        const auto& [col_level, col_channel, col_cd, col_x, col_z, level_key, reading_key, named_scale,
+                     reading_scale, scale, n_columns, header_line] = *header;
 
         if (fields.size() != n_columns)
             throw InputError(SourceLocation{file_name, line_no, 0, ""},
@@ -277,10 +301,11 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
         }
         out.push_back(m);
     }
-    if (header_line == 0)
+    if (!header)
         throw InputError(SourceLocation{file_name, 0, 0, ""},
-                         fmt::format("the file is empty; {}", header_help));
-    if (out.empty()) throw InputError(SourceLocation{file_name, header_line, 0, ""}, "the file has no measurements");
+                         fmt::format("the file is empty; {}", csv_header_help));
+    if (out.empty())
+        throw InputError(SourceLocation{file_name, header->header_line, 0, ""}, "the file has no measurements");
     return out;
 }
 
@@ -332,19 +357,28 @@ struct Keyword {
     int line;
 };
 
-}  // namespace
+InputError ti3_error(const std::string& file_name, int line, int column, std::string key, const std::string& message) {
+    return InputError(SourceLocation{file_name, line, column, std::move(key)}, message);
+}
 
-std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::string& file_name) {
-    auto error = [&](int line, int column, std::string key, const std::string& message) {
-        return InputError(SourceLocation{file_name, line, column, std::move(key)}, message);
-    };
-    const auto lines = split_lines(text);
-    enum class State { identifier, header, format, data, done } state = State::identifier;
+/// A .ti3 file's structure: its keywords, data format and data lines, not yet read as measurements.
+struct Ti3Table {
     std::map<std::string, Keyword> keywords;
     std::vector<std::string> fields;
     int format_line = 0, data_line = 0, end_line = 0;
     std::optional<std::pair<long, int>> number_of_fields, number_of_sets;  // value, line
     std::vector<std::pair<std::vector<Token>, int>> rows;                  // tokens, line
+};
+
+/// Reads the lines of a .ti3 file into its table; throws where the file's structure is broken (no CTI3,
+/// an unclosed data format or table, no table).
+Ti3Table read_ti3_table(const std::vector<std::string_view>& lines, const std::string& file_name) {
+    auto error = [&](int line, int column, std::string key, const std::string& message) {
+        return ti3_error(file_name, line, column, std::move(key), message);
+    };
+    enum class State { identifier, header, format, data, done } state = State::identifier;
+    Ti3Table table;
+    auto& [keywords, fields, format_line, data_line, end_line, number_of_fields, number_of_sets, rows] = table;
 
     auto parse_count = [&](const std::vector<Token>& t, int line_no) {
         const auto v = t.size() == 2 ? parse_number(t[1].text) : std::nullopt;
@@ -428,6 +462,46 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
         case State::done:
             break;
     }
+    return table;
+}
+
+/// cd/m² per unit of the file's XYZ values: 1, or white's Y / 100 when NORMALIZED_TO_Y_100 is YES.
+double ti3_absolute_scale(const std::map<std::string, Keyword>& keywords, const std::string& file_name) {
+    // XYZ are absolute cd/m² unless NORMALIZED_TO_Y_100 is YES; then white Y = 100 and
+    // LUMINANCE_XYZ_CDM2 holds white's absolute XYZ (Argyll's own readers do the same).
+    double scale = 1.0;
+    if (const auto it = keywords.find("NORMALIZED_TO_Y_100"); it != keywords.end() && it->second.value == "YES") {
+        const auto lum = keywords.find("LUMINANCE_XYZ_CDM2");
+        if (lum == keywords.end())
+            throw ti3_error(file_name, it->second.line, 1, "LUMINANCE_XYZ_CDM2",
+                            "NORMALIZED_TO_Y_100 is YES but there is no LUMINANCE_XYZ_CDM2 to give the absolute scale");
+        std::istringstream ss(lum->second.value);
+        std::string xs, ys, zs, extra;
+        ss >> xs >> ys >> zs;
+        const auto x = parse_number(xs), y = parse_number(ys), z = parse_number(zs);
+        if (!x || !y || !z || (ss >> extra) || *y <= 0.0)
+            throw ti3_error(file_name, lum->second.line, 1, "LUMINANCE_XYZ_CDM2",
+                            fmt::format("expects the white's X Y Z in cd/m² (three numbers, Y > 0), not \"{}\"",
+                                        lum->second.value));
+        scale = *y / 100.0;
+    }
+    return scale;
+}
+
+}  // namespace
+
+std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::string& file_name) {
+    auto error = [&](int line, int column, std::string key, const std::string& message) {
+        return ti3_error(file_name, line, column, std::move(key), message);
+    };
+    const Ti3Table table = read_ti3_table(split_lines(text), file_name);
+    // References, not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+    const auto& keywords = table.keywords;
+    const auto& fields = table.fields;
+    const int format_line = table.format_line, data_line = table.data_line, end_line = table.end_line;
+    const auto& number_of_fields = table.number_of_fields;
+    const auto& number_of_sets = table.number_of_sets;
+    const auto& rows = table.rows;
 
     if (number_of_fields && static_cast<std::size_t>(number_of_fields->first) != fields.size())
         throw error(number_of_fields->second, 1, "NUMBER_OF_FIELDS",
@@ -450,24 +524,7 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
     if (const auto it = keywords.find("DEVICE_CLASS"); it != keywords.end() && it->second.value != "DISPLAY")
         throw error(it->second.line, 1, "DEVICE_CLASS",
                     fmt::format("the measurements are of a '{}' device, not a DISPLAY", it->second.value));
-    // XYZ are absolute cd/m² unless NORMALIZED_TO_Y_100 is YES; then white Y = 100 and
-    // LUMINANCE_XYZ_CDM2 holds white's absolute XYZ (Argyll's own readers do the same).
-    double scale = 1.0;
-    if (const auto it = keywords.find("NORMALIZED_TO_Y_100"); it != keywords.end() && it->second.value == "YES") {
-        const auto lum = keywords.find("LUMINANCE_XYZ_CDM2");
-        if (lum == keywords.end())
-            throw error(it->second.line, 1, "LUMINANCE_XYZ_CDM2",
-                        "NORMALIZED_TO_Y_100 is YES but there is no LUMINANCE_XYZ_CDM2 to give the absolute scale");
-        std::istringstream ss(lum->second.value);
-        std::string xs, ys, zs, extra;
-        ss >> xs >> ys >> zs;
-        const auto x = parse_number(xs), y = parse_number(ys), z = parse_number(zs);
-        if (!x || !y || !z || (ss >> extra) || *y <= 0.0)
-            throw error(lum->second.line, 1, "LUMINANCE_XYZ_CDM2",
-                        fmt::format("expects the white's X Y Z in cd/m² (three numbers, Y > 0), not \"{}\"",
-                                    lum->second.value));
-        scale = *y / 100.0;
-    }
+    const double scale = ti3_absolute_scale(keywords, file_name);
 
     std::vector<Measurement> out;
     out.reserve(rows.size());

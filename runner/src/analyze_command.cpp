@@ -115,6 +115,97 @@ std::vector<std::pair<int, int>> frame_rows(const std::string& note, int height)
     return out;
 }
 
+struct Tile {
+    int x0, y0, w, h;
+};
+
+/// Per frame (rows r0-r1), a tile of up to 2*half pixels square around its brightest pixel.
+std::vector<Tile> brightest_tiles(const stimuli::ImageRGBA32F& hdr, const std::vector<std::pair<int, int>>& frames,
+                                  int half) {
+    std::vector<Tile> tiles;
+    for (const auto& [r0, r1] : frames) {
+        int bx = hdr.width / 2, by = (r0 + r1) / 2;
+        double best = -1.0;
+        for (int y = r0; y <= r1; ++y) {
+            for (int x = 0; x < hdr.width; ++x) {
+                const float* p = hdr.pixel(x, y);
+                const double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                if (lum > best) {
+                    best = lum;
+                    bx = x;
+                    by = y;
+                }
+            }
+        }
+        const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
+        const int x0 = std::clamp(bx - w / 2, 0, hdr.width - w);
+        const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
+        tiles.push_back({x0, y0, w, h});
+    }
+    return tiles;
+}
+
+// Each frame tone-mapped (display-relative linear values, 0..1), then drawn
+// twice: as is (top row) and, beneath it, stretched about its background
+// (the tile's median) by a power of two that brings its brightest pixel
+// near white, so that a dim light and its glare can be seen (docs/analysis.md,
+// "Stimulus pictures"). The factors are stated in the caption.
+struct Mapped {
+    std::vector<glm::dvec3> v;
+    glm::dvec3 background{0.0};  ///< per channel: the tile's median (a dim light leaves it the background)
+    double stretch = 1.0;
+};
+
+/// The tile tone-mapped, with its background and the stretch that shows a dim light.
+Mapped map_tile(const stimuli::ImageRGBA32F& hdr, const Tile& t, double adaptation,
+                const display::ToneMapSettings& tm) {
+    Mapped m;
+    std::array<std::vector<double>, 3> channel;
+    for (int y = 0; y < t.h; ++y)
+        for (int x = 0; x < t.w; ++x) {
+            const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
+            glm::dvec3 d = display::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
+            for (int k = 0; k < 3; ++k) {
+                d[k] = std::clamp(d[k], 0.0, 1.0);
+                channel[static_cast<std::size_t>(k)].push_back(d[k]);
+            }
+            m.v.push_back(d);
+        }
+    for (int k = 0; k < 3; ++k) {
+        std::vector<double>& values = channel[static_cast<std::size_t>(k)];
+        if (values.empty()) continue;
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
+                         values.end());
+        m.background[k] = values[values.size() / 2];
+    }
+    // A power of two, 1 to 4096: the largest that keeps every channel's
+    // rise above the background at or below 90% of white, or, where a glare
+    // halo covers more than 1% of the tile, the one that brings the halo's
+    // edge there (the rise of the pixel ranked at 1%) to half of that,
+    // letting the core clip: what the reader needs to see is the halo.
+    std::vector<double> rises;
+    double room = 1.0, top = 0.0;
+    for (const glm::dvec3& d : m.v) {
+        double r = 0.0;
+        for (int k = 0; k < 3; ++k)
+            if (d[k] - m.background[k] > r) r = d[k] - m.background[k];
+        rises.push_back(r);
+        if (r > top) {
+            top = r;
+            room = 0.9 - std::max({m.background.r, m.background.g, m.background.b});
+        }
+    }
+    if (top > 0.0 && room > 0.0) {
+        double factor = room / top;
+        const std::size_t rank = rises.size() / 100;
+        std::nth_element(rises.begin(), rises.begin() + static_cast<std::ptrdiff_t>(rank), rises.end(),
+                         std::greater<>());
+        if (rises[rank] > 0.0) factor = std::max(factor, 0.5 * room / rises[rank]);
+        m.stretch = std::clamp(std::exp2(std::floor(std::log2(factor))), 1.0, 4096.0);
+    }
+    return m;
+}
+
 /// The condition's snapshot as a PNG: each frame tone-mapped (the condition's
 /// operator at its adaptation luminance, CPU reference) and sRGB-encoded,
 /// cropped to a square of `crop_deg` around its brightest pixel, side by side.
@@ -147,87 +238,9 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
                          ? std::max(8, static_cast<int>(std::lround(0.5 * crop_deg / img.meta.degrees_per_pixel)))
                          : 128;
     const auto frames = frame_rows(img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "", hdr.height);
-    struct Tile {
-        int x0, y0, w, h;
-    };
-    std::vector<Tile> tiles;
-    for (const auto& [r0, r1] : frames) {
-        int bx = hdr.width / 2, by = (r0 + r1) / 2;
-        double best = -1.0;
-        for (int y = r0; y <= r1; ++y) {
-            for (int x = 0; x < hdr.width; ++x) {
-                const float* p = hdr.pixel(x, y);
-                const double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-                if (lum > best) {
-                    best = lum;
-                    bx = x;
-                    by = y;
-                }
-            }
-        }
-        const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
-        const int x0 = std::clamp(bx - w / 2, 0, hdr.width - w);
-        const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
-        tiles.push_back({x0, y0, w, h});
-    }
-    // Each frame tone-mapped (display-relative linear values, 0..1), then drawn
-    // twice: as is (top row) and, beneath it, stretched about its background
-    // (the tile's median) by a power of two that brings its brightest pixel
-    // near white, so that a dim light and its glare can be seen (docs/analysis.md,
-    // "Stimulus pictures"). The factors are stated in the caption.
-    struct Mapped {
-        std::vector<glm::dvec3> v;
-        glm::dvec3 background{0.0};  ///< per channel: the tile's median (a dim light leaves it the background)
-        double stretch = 1.0;
-    };
+    const std::vector<Tile> tiles = brightest_tiles(hdr, frames, half);
     std::vector<Mapped> mapped;
-    for (const Tile& t : tiles) {
-        Mapped m;
-        std::array<std::vector<double>, 3> channel;
-        for (int y = 0; y < t.h; ++y)
-            for (int x = 0; x < t.w; ++x) {
-                const float* p = hdr.pixel(t.x0 + x, t.y0 + y);
-                glm::dvec3 d = display::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation, tm);
-                for (int k = 0; k < 3; ++k) {
-                    d[k] = std::clamp(d[k], 0.0, 1.0);
-                    channel[static_cast<std::size_t>(k)].push_back(d[k]);
-                }
-                m.v.push_back(d);
-            }
-        for (int k = 0; k < 3; ++k) {
-            std::vector<double>& values = channel[static_cast<std::size_t>(k)];
-            if (values.empty()) continue;
-            std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
-                             values.end());
-            m.background[k] = values[values.size() / 2];
-        }
-        // A power of two, 1 to 4096: the largest that keeps every channel's
-        // rise above the background at or below 90% of white, or, where a glare
-        // halo covers more than 1% of the tile, the one that brings the halo's
-        // edge there (the rise of the pixel ranked at 1%) to half of that,
-        // letting the core clip: what the reader needs to see is the halo.
-        std::vector<double> rises;
-        double room = 1.0, top = 0.0;
-        for (const glm::dvec3& d : m.v) {
-            double r = 0.0;
-            for (int k = 0; k < 3; ++k)
-                if (d[k] - m.background[k] > r) r = d[k] - m.background[k];
-            rises.push_back(r);
-            if (r > top) {
-                top = r;
-                room = 0.9 - std::max({m.background.r, m.background.g, m.background.b});
-            }
-        }
-        if (top > 0.0 && room > 0.0) {
-            double factor = room / top;
-            const std::size_t rank = rises.size() / 100;
-            std::nth_element(rises.begin(), rises.begin() + static_cast<std::ptrdiff_t>(rank), rises.end(),
-                             std::greater<>());
-            if (rises[rank] > 0.0) factor = std::max(factor, 0.5 * room / rises[rank]);
-            m.stretch = std::clamp(std::exp2(std::floor(std::log2(factor))), 1.0, 4096.0);
-        }
-        mapped.push_back(std::move(m));
-    }
+    for (const Tile& t : tiles) mapped.push_back(map_tile(hdr, t, adaptation, tm));
     const int gap = 8;
     int width = 0, row = 0;
     for (const Tile& t : tiles) {

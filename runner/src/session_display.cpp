@@ -43,6 +43,90 @@ std::string join_keys(const std::vector<std::string>& keys) {
     return out;
 }
 
+/// A trial's steps: the fixation screen (when n_iti > 0), then each frame for n_stim refreshes with a
+/// blank of n_isi between frames, and, when the stimulus loops, a blank after the last frame too.
+struct TrialSteps {
+    std::vector<Step> steps;
+    std::vector<int> frame_of_step;   ///< the frame each step shows; -1 for a fixation or blank
+    std::size_t last_frame_step = 0;  ///< the last interval's step, where 2AFC and yes-no answers are taken from
+};
+
+TrialSteps trial_steps(const std::vector<Screen>& frames, const Screen& bg, const Screen& fix, int n_stim, int n_isi,
+                       int n_iti, bool loop) {
+    TrialSteps plan;
+    std::vector<Step>& steps = plan.steps;
+    std::vector<int>& frame_of_step = plan.frame_of_step;
+    if (n_iti > 0) {
+        steps.push_back({fix, n_iti, false});
+        frame_of_step.push_back(-1);
+    }
+    const std::size_t first_stimulus_step = steps.size();
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+        if (f > 0 && n_isi > 0) {
+            steps.push_back({bg, n_isi, true});
+            frame_of_step.push_back(-1);
+        }
+        steps.push_back({frames[f], n_stim, true});
+        frame_of_step.push_back(static_cast<int>(f));
+    }
+    // Looping alternation: the blank after the last interval too, before the first again.
+    if (loop && frames.size() > 1 && n_isi > 0) {
+        steps.push_back({bg, n_isi, true});
+        frame_of_step.push_back(-1);
+    }
+    std::size_t& last_frame_step = plan.last_frame_step;
+    last_frame_step = first_stimulus_step;
+    for (std::size_t i = 0; i < steps.size(); ++i)
+        if (frame_of_step[i] >= 0) last_frame_step = i;
+    return plan;
+}
+
+// Headless the flips are k / rate exactly; times within the trial are then
+// whole numbers of refreshes, written without the subtraction's rounding
+// (so a resumed session stores the same text as an uninterrupted one).
+double trial_time(double dt, bool on_screen, double hz) { return on_screen ? dt : std::round(dt * hz) / hz; }
+
+/// A trial's timing: the first stimulus onset, the last interval's onset, the offset, and the shown steps as
+/// the timing JSON's "shown" objects.
+struct ShownTimes {
+    double onset = 0.0, window = 0.0, offset = 0.0;
+    std::string shown;
+};
+
+/// The timing of what play() showed; adds the stimulus's dropped frames and missed deadlines to `out`.
+ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_screen, double hz, TrialShown& out) {
+    const std::vector<Step>& steps = plan.steps;
+    const std::vector<int>& frame_of_step = plan.frame_of_step;
+    const std::size_t last_frame_step = plan.last_frame_step;
+    auto rel = [&](double dt) { return trial_time(dt, on_screen, hz); };
+    double onset = 0.0, window = 0.0, offset = played.intervals.back().onset_s;
+    bool onset_seen = false, window_seen = false;
+    std::string shown;
+    for (std::size_t i = 0; i < played.intervals.size(); ++i) {
+        const IntervalTiming& iv = played.intervals[i];
+        const std::size_t step = played.step_of[i];
+        const bool stimulus = step < steps.size() ? steps[step].stimulus : true;  // the offset flip counts
+        if (step < steps.size() && frame_of_step[step] >= 0 && !onset_seen) {
+            onset = iv.onset_s;
+            onset_seen = true;
+        }
+        if (step == last_frame_step && !window_seen) {
+            window = iv.onset_s;
+            window_seen = true;
+        }
+        if (stimulus && onset_seen) {
+            if (step < steps.size() || iv.late_onset) out.dropped_frames += iv.dropped;
+            out.missed_deadline = out.missed_deadline || (step < steps.size() ? iv.missed : iv.late_onset);
+        }
+        if (step < steps.size() && onset_seen && i < 16)
+            shown += fmt::format("{}{{\"step\":\"{}\",\"onset_s\":{},\"duration_s\":{},\"flips\":{},\"dropped\":{}}}",
+                                 shown.empty() ? "" : ",",
+                                 frame_of_step[step] >= 0 ? fmt::format("frame{}", frame_of_step[step]) : "blank",
+                                 rel(iv.onset_s - onset), rel(iv.duration_s()), iv.flips, iv.dropped);
+    }
+    return {onset, window, offset, shown};
+}
+
 }  // namespace
 
 SessionDisplay::SessionDisplay(Presenter& presenter, StimulusRenderer& renderer, const p::Protocol& protocol,
@@ -256,31 +340,10 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
         frames.push_back(std::move(sc));
     }
 
-    std::vector<Step> steps;
-    std::vector<int> frame_of_step;
-    if (n_iti > 0) {
-        Screen fix = bg;
-        if (on_screen && protocol_.screens.fixation) fix.overlays.push_back(fixation_overlay());
-        steps.push_back({fix, n_iti, false});
-        frame_of_step.push_back(-1);
-    }
-    const std::size_t first_stimulus_step = steps.size();
-    for (std::size_t f = 0; f < frames.size(); ++f) {
-        if (f > 0 && n_isi > 0) {
-            steps.push_back({bg, n_isi, true});
-            frame_of_step.push_back(-1);
-        }
-        steps.push_back({frames[f], n_stim, true});
-        frame_of_step.push_back(static_cast<int>(f));
-    }
-    // Looping alternation: the blank after the last interval too, before the first again.
-    if (loop && frames.size() > 1 && n_isi > 0) {
-        steps.push_back({bg, n_isi, true});
-        frame_of_step.push_back(-1);
-    }
-    std::size_t last_frame_step = first_stimulus_step;
-    for (std::size_t i = 0; i < steps.size(); ++i)
-        if (frame_of_step[i] >= 0) last_frame_step = i;
+    Screen fix = bg;  // shown before the stimulus when n_iti > 0
+    if (n_iti > 0 && on_screen && protocol_.screens.fixation) fix.overlays.push_back(fixation_overlay());
+    const TrialSteps plan = trial_steps(frames, bg, fix, n_stim, n_isi, n_iti, loop);
+    const std::vector<int>& frame_of_step = plan.frame_of_step;
 
     Screen then = bg;
     if (on_screen && !c.prompt.empty() && !adjust) then.overlays.push_back(text_overlay(c.prompt, cue_ink_, 0.75));
@@ -305,47 +368,19 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
             return q.find(sequence_start, [&](const InputEvent& e) { return answer_action(e).has_value(); }) != nullptr;
         };
     trace(fmt::format("trial {}: presenting", t.step + 1));
-    const Played played = presenter_.play(steps, then, po);
+    const Played played = presenter_.play(plan.steps, then, po);
 
-    // Timing: the first stimulus onset, the last interval's onset (where 2AFC
-    // and yes-no answers are taken from), the offset, what was missed.
+    // Timing: onsets, offset and what was missed (shown_times).
     TrialShown out;
-    // Headless the flips are k / rate exactly; times within the trial are then
-    // whole numbers of refreshes, written without the subtraction's rounding
-    // (so a resumed session stores the same text as an uninterrupted one).
     const double hz = on_screen ? 1.0 / period : protocol_.timing.refresh_hz.value_or(60.0);
-    auto rel = [&](double dt) { return on_screen ? dt : std::round(dt * hz) / hz; };
-    double onset = 0.0, window = 0.0, offset = played.intervals.back().onset_s;
-    bool onset_seen = false, window_seen = false;
-    std::string shown;
-    for (std::size_t i = 0; i < played.intervals.size(); ++i) {
-        const IntervalTiming& iv = played.intervals[i];
-        const std::size_t step = played.step_of[i];
-        const bool stimulus = step < steps.size() ? steps[step].stimulus : true;  // the offset flip counts
-        if (step < steps.size() && frame_of_step[step] >= 0 && !onset_seen) {
-            onset = iv.onset_s;
-            onset_seen = true;
-        }
-        if (step == last_frame_step && !window_seen) {
-            window = iv.onset_s;
-            window_seen = true;
-        }
-        if (stimulus && onset_seen) {
-            if (step < steps.size() || iv.late_onset) out.dropped_frames += iv.dropped;
-            out.missed_deadline = out.missed_deadline || (step < steps.size() ? iv.missed : iv.late_onset);
-        }
-        if (step < steps.size() && onset_seen && i < 16)
-            shown += fmt::format("{}{{\"step\":\"{}\",\"onset_s\":{},\"duration_s\":{},\"flips\":{},\"dropped\":{}}}",
-                                 shown.empty() ? "" : ",",
-                                 frame_of_step[step] >= 0 ? fmt::format("frame{}", frame_of_step[step]) : "blank",
-                                 rel(iv.onset_s - onset), rel(iv.duration_s()), iv.flips, iv.dropped);
-    }
-    const double presented = rel(offset - onset);
+    const ShownTimes times = shown_times(played, plan, on_screen, hz, out);
+    const double onset = times.onset, window = times.window, offset = times.offset;
+    const double presented = trial_time(offset - onset, on_screen, hz);
     out.onset_s = onset + clock_offset_s_;
     out.timing_json = fmt::format(
         "{{\"refresh_hz\":{},\"stimulus_frames\":{},\"inter_stimulus_frames\":{},\"inter_trial_frames\":{},"
         "\"presented_s\":{},\"shown\":[{}]}}",
-        hz, n_stim, n_isi, n_iti, presented, shown);
+        hz, n_stim, n_isi, n_iti, presented, times.shown);
 
     auto is_quit = [&](const InputEvent& e) { return answer_action(e) == p::Action::Quit; };
     if (played.stopped && !(loop && presenter_.input().find(sequence_start, [&](const InputEvent& e) {

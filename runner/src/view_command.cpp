@@ -149,6 +149,71 @@ std::vector<float> read_displayed(int x, int y, int w, int h) {
     return out;
 }
 
+/// GLFW started, or ContextUnavailable saying why not.
+void start_glfw() {
+    if (!glfwInit()) {
+        const char* display = std::getenv("DISPLAY");
+        throw gl::ContextUnavailable(
+            fmt::format("the preview window needs a display server, and GLFW could not start ({})",
+                        display ? fmt::format("DISPLAY is {}", display) : std::string("DISPLAY is unset")));
+    }
+}
+
+/// The window shows the frame pixel for pixel; a display larger than the
+/// screen is previewed at a lower resolution with the same field of view.
+void fit_display_to_screen(stimuli::Scene& scene) {
+    GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+    if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
+        const double s =
+            std::min({1.0, 0.9 * mode->width / scene.display.width_px, 0.9 * mode->height / scene.display.height_px});
+        if (s < 1.0) {
+            const int w = std::max(1, static_cast<int>(std::lround(scene.display.width_px * s)));
+            const int h = std::max(1, static_cast<int>(std::lround(scene.display.height_px * s)));
+            std::printf(
+                "the scene's display (%d x %d) is larger than the screen (%d x %d): previewing at %d x %d, "
+                "same field of view\n",
+                scene.display.width_px, scene.display.height_px, mode->width, mode->height, w, h);
+            scene.display.width_px = w;
+            scene.display.height_px = h;
+        }
+    }
+}
+
+/// The window's keys, mouse button and cursor feed the WindowInput its user pointer holds.
+void install_input_callbacks(GLFWwindow* win) {
+    glfwSetKeyCallback(win, [](GLFWwindow* w, int key, int, int action, int) {
+        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
+        if (action != GLFW_PRESS) return;
+        if (const auto k = key_of(key); k && !is_held_key(*k)) in->pressed.push_back(*k);
+    });
+    glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
+        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
+        if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+        in->dragging = action == GLFW_PRESS;
+        glfwGetCursorPos(w, &in->last_x, &in->last_y);
+    });
+    glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) {
+        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
+        if (in->dragging) {
+            in->drag_x += x - in->last_x;
+            in->drag_y += y - in->last_y;
+        }
+        in->last_x = x;
+        in->last_y = y;
+    });
+}
+
+/// The speed of held movement keys: 10 with Shift, 0.1 with Control, else 1.
+double held_speed(GLFWwindow* win) {
+    double speed = 1.0;
+    if (glfwGetKey(win, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(win, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
+        speed = 10.0;
+    if (glfwGetKey(win, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+        glfwGetKey(win, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+        speed = 0.1;
+    return speed;
+}
+
 }  // namespace
 
 void add_view_command(CLI::App& app, ViewOptions& o) {
@@ -196,29 +261,8 @@ int run_view(const ViewOptions& o) {
         }
     }
 
-    // The window shows the frame pixel for pixel; a display larger than the
-    // screen is previewed at a lower resolution with the same field of view.
-    if (!glfwInit()) {
-        const char* display = std::getenv("DISPLAY");
-        throw gl::ContextUnavailable(
-            fmt::format("the preview window needs a display server, and GLFW could not start ({})",
-                        display ? fmt::format("DISPLAY is {}", display) : std::string("DISPLAY is unset")));
-    }
-    GLFWmonitor* monitor = glfwGetPrimaryMonitor();
-    if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
-        const double s =
-            std::min({1.0, 0.9 * mode->width / scene.display.width_px, 0.9 * mode->height / scene.display.height_px});
-        if (s < 1.0) {
-            const int w = std::max(1, static_cast<int>(std::lround(scene.display.width_px * s)));
-            const int h = std::max(1, static_cast<int>(std::lround(scene.display.height_px * s)));
-            std::printf(
-                "the scene's display (%d x %d) is larger than the screen (%d x %d): previewing at %d x %d, "
-                "same field of view\n",
-                scene.display.width_px, scene.display.height_px, mode->width, mode->height, w, h);
-            scene.display.width_px = w;
-            scene.display.height_px = h;
-        }
-    }
+    start_glfw();
+    fit_display_to_screen(scene);
     gl::WindowOptions wo;
     wo.width = scene.display.width_px;
     wo.height = scene.display.height_px;
@@ -229,26 +273,7 @@ int run_view(const ViewOptions& o) {
     GLFWwindow* win = window->glfw_window();
     WindowInput input;
     glfwSetWindowUserPointer(win, &input);
-    glfwSetKeyCallback(win, [](GLFWwindow* w, int key, int, int action, int) {
-        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
-        if (action != GLFW_PRESS) return;
-        if (const auto k = key_of(key); k && !is_held_key(*k)) in->pressed.push_back(*k);
-    });
-    glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
-        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
-        if (button != GLFW_MOUSE_BUTTON_LEFT) return;
-        in->dragging = action == GLFW_PRESS;
-        glfwGetCursorPos(w, &in->last_x, &in->last_y);
-    });
-    glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) {
-        auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
-        if (in->dragging) {
-            in->drag_x += x - in->last_x;
-            in->drag_y += y - in->last_y;
-        }
-        in->last_x = x;
-        in->last_y = y;
-    });
+    install_input_callbacks(win);
 
     std::printf("%s: %d x %d, %s\n%s", o.scene.c_str(), scene.display.width_px, scene.display.height_px,
                 window->info().renderer.c_str(), kViewHelp);
@@ -285,12 +310,7 @@ int run_view(const ViewOptions& o) {
             script.pop_front();
             (is_held_key(k) ? held : pressed).push_back(k);
         }
-        double speed = 1.0;
-        if (glfwGetKey(win, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(win, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
-            speed = 10.0;
-        if (glfwGetKey(win, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
-            glfwGetKey(win, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
-            speed = 0.1;
+        const double speed = held_speed(win);
         const double adapted = first ? scene.output.adaptation.fixed_cd_m2 : pipeline.display().adaptation_cd_m2();
         for (const ViewKey k : pressed) {
             const std::string said = controls.press(k, adapted);

@@ -114,6 +114,11 @@ struct FrameRenderer::Impl {
         return f == HdrFormat::rgba16f ? gl::PixelFormat::rgba16f : gl::PixelFormat::rgba32f;
     }
     std::vector<double> invisible_lux(const Scene& scene, const CameraProjection& P);
+    // Parts of render()'s passes (frame_renderer.cpp).
+    void set_background_uniforms(const Scene& scene, const CameraProjection& P);
+    void draw_discs(const Scene& scene, const CameraProjection& P);
+    void upload_light_tables(const Scene& scene, const GpuLightTables& tables);
+    void convolve_veil(const Scene& scene, const CameraProjection& P, bool ldr);
 
     void resize(int w, int h) {
         const gl::PixelFormat format = pixel_format(options.hdr_format);
@@ -191,7 +196,102 @@ void upload(gl::Buffer& buffer, const void* data, std::size_t bytes, gl::BufferU
     }
     if (data) buffer.upload(0, bytes, data);
 }
+
+/// Which glare paths a frame's lights take (each light's own glare model, else the eye's).
+struct GlarePaths {
+    bool direct = false, billboard = false, veil = false;
+};
+
+GlarePaths glare_paths(const Scene& scene) {
+    GlarePaths any;
+    for (const Light& L : scene.lights) {
+        const GlarePath path = glare_path(light_glare_model(scene, L));
+        any.direct |= path == GlarePath::direct;
+        any.billboard |= path == GlarePath::billboard;
+        any.veil |= path == GlarePath::veil;
+    }
+    return any;
+}
 }  // namespace
+
+// The uniforms of pass 1, the background and linear view depth.
+void FrameRenderer::Impl::set_background_uniforms(const Scene& scene, const CameraProjection& P) {
+    const auto w = static_cast<float>(P.width_px), h = static_cast<float>(P.height_px);
+    const auto f = static_cast<float>(P.focal_px);
+    const glm::mat3 world_from_view(P.world_from_view);
+    const auto pre = static_cast<float>(pre_exposure);
+    const Environment& env = scene.environment;
+    background.set("principal_px", 0.5f * w, 0.5f * h);
+    background.set("focal_px", f);
+    background.set_mat3("world_from_view", glm::value_ptr(world_from_view));
+    background.set("eye_position_m", static_cast<float>(P.eye_position_m.x), static_cast<float>(P.eye_position_m.y),
+                   static_cast<float>(P.eye_position_m.z));
+    background.set("sky_luminance", static_cast<float>(env.luminance_cd_m2));
+    background.set("sea_f0", static_cast<float>(env.sea_reflectance_f0));
+    background.set("sky_sea", env.background == Background::sky_sea ? 1 : 0);
+    background.set("pre_exposure", pre);
+}
+
+// Pass 1b of render(): the discs, alpha-blended into the colour target only.
+void FrameRenderer::Impl::draw_discs(const Scene& scene, const CameraProjection& P) {
+    const auto w = static_cast<float>(P.width_px), h = static_cast<float>(P.height_px);
+    const auto f = static_cast<float>(P.focal_px);
+    const GLenum only_colour[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+    glNamedFramebufferDrawBuffers(fbo.id(), 2, only_colour);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    disc.set("principal_px", 0.5f * w, 0.5f * h);
+    disc.set("focal_px", f);
+    for (const Disc& d : scene.discs) {
+        const glm::dvec3 c = disc_direction_view(d, P);
+        if (!(d.diameter_deg > 0.0) || glm::length(c) == 0.0) continue;
+        const glm::dvec3 rgb = d.rgb_per_cd_m2 * d.luminance_cd_m2 * pre_exposure;
+        disc.set("centre_view", static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
+        disc.set("radius_rad", static_cast<float>(0.5 * d.diameter_deg * std::numbers::pi / 180.0));
+        disc.set("rgb", static_cast<float>(rgb.r), static_cast<float>(rgb.g), static_cast<float>(rgb.b));
+        disc.use();
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    glDisable(GL_BLEND);
+    const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(fbo.id(), 2, both);
+}
+
+// The frame's light tables into the storage buffers light_eval.comp reads (bindings 0-3).
+void FrameRenderer::Impl::upload_light_tables(const Scene& scene, const GpuLightTables& tables) {
+    light_count = static_cast<int>(scene.lights.size());
+    upload(lights, tables.lights.data(), tables.lights.size() * sizeof(float), gl::BufferUsage::stream_draw);
+    upload(profiles, tables.profile_values.data(), tables.profile_values.size() * sizeof(float),
+           gl::BufferUsage::stream_draw);
+    upload(knots, tables.rhythm_knots.data(), tables.rhythm_knots.size() * sizeof(glm::vec2),
+           gl::BufferUsage::stream_draw);
+    upload(draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * kDrawFloats * sizeof(float),
+           gl::BufferUsage::dynamic_read);
+    lights.bind_storage(0);
+    profiles.bind_storage(1);
+    knots.bind_storage(2);
+    draws.bind_storage(3);
+}
+
+// The `cie` veil: the veil lights' direct images (already drawn into the glare
+// buffer, cd/m²) convolved with the CIE 146 GSF; the result is the glare buffer
+// of the LDR path, or is added to the HDR frame.
+void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjection& P, bool ldr) {
+    const auto pre = static_cast<float>(pre_exposure);
+    std::vector<float> light = glare_only.download_floats();
+    veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
+    veil_report.applied = true;
+    veil_report.observer = scene.glare.cie;
+    if (ldr) {
+        glare_only.upload(light.data());
+    } else {
+        std::vector<float> frame = hdr.download_floats();
+        for (std::size_t i = 0; i < frame.size(); ++i)
+            if (i % 4 != 3) frame[i] += light[i] * pre;
+        hdr.upload(frame.data());
+    }
+}
 
 FrameRenderer::FrameRenderer() : impl_(std::make_unique<Impl>()) {}
 FrameRenderer::~FrameRenderer() = default;
@@ -250,43 +350,14 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     const Environment& env = scene.environment;
-    m.background.set("principal_px", 0.5f * w, 0.5f * h);
-    m.background.set("focal_px", f);
-    m.background.set_mat3("world_from_view", glm::value_ptr(world_from_view));
-    m.background.set("eye_position_m", static_cast<float>(P.eye_position_m.x), static_cast<float>(P.eye_position_m.y),
-                     static_cast<float>(P.eye_position_m.z));
-    m.background.set("sky_luminance", static_cast<float>(env.luminance_cd_m2));
-    m.background.set("sea_f0", static_cast<float>(env.sea_reflectance_f0));
-    m.background.set("sky_sea", env.background == Background::sky_sea ? 1 : 0);
-    m.background.set("pre_exposure", pre);
+    m.set_background_uniforms(scene, P);
     m.background.use();
     m.vao.bind();
     begin(0);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // 1b. Discs (scene.h Disc): uniform patches over the background, under the
     // lights; colour only, the depth target keeps the background's depth.
-    if (!scene.discs.empty()) {
-        const GLenum only_colour[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-        glNamedFramebufferDrawBuffers(m.fbo.id(), 2, only_colour);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-        glBlendEquation(GL_FUNC_ADD);
-        m.disc.set("principal_px", 0.5f * w, 0.5f * h);
-        m.disc.set("focal_px", f);
-        for (const Disc& d : scene.discs) {
-            const glm::dvec3 c = disc_direction_view(d, P);
-            if (!(d.diameter_deg > 0.0) || glm::length(c) == 0.0) continue;
-            const glm::dvec3 rgb = d.rgb_per_cd_m2 * d.luminance_cd_m2 * m.pre_exposure;
-            m.disc.set("centre_view", static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
-            m.disc.set("radius_rad", static_cast<float>(0.5 * d.diameter_deg * std::numbers::pi / 180.0));
-            m.disc.set("rgb", static_cast<float>(rgb.r), static_cast<float>(rgb.g), static_cast<float>(rgb.b));
-            m.disc.use();
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-        }
-        glDisable(GL_BLEND);
-        const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-        glNamedFramebufferDrawBuffers(m.fbo.id(), 2, both);
-    }
+    if (!scene.discs.empty()) m.draw_discs(scene, P);
     end(0);
 
     // 2. Per-light evaluation, projection and occlusion (compute).
@@ -297,28 +368,11 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     const double glare_extent_px = m.glare.prepare(scene, P, time_s);
     m.cpu_timings.glare_prepare_cpu_ms = ms_since(prepare_started);
     // Which paths this frame's lights take (each light's own glare model, else the eye's).
-    bool any_direct = false, any_billboard = false, any_veil = false;
-    for (const Light& L : scene.lights) {
-        const GlarePath path = glare_path(light_glare_model(scene, L));
-        any_direct |= path == GlarePath::direct;
-        any_billboard |= path == GlarePath::billboard;
-        any_veil |= path == GlarePath::veil;
-    }
+    const auto [any_direct, any_billboard, any_veil] = glare_paths(scene);
     const bool glare = any_billboard || any_veil;
     const std::vector<double> invisible = m.invisible_lux(scene, P);
     const GpuLightTables tables = pack_lights(scene, P.eye_position_m, m.glare.light_groups(), invisible);
-    m.light_count = static_cast<int>(scene.lights.size());
-    upload(m.lights, tables.lights.data(), tables.lights.size() * sizeof(float), gl::BufferUsage::stream_draw);
-    upload(m.profiles, tables.profile_values.data(), tables.profile_values.size() * sizeof(float),
-           gl::BufferUsage::stream_draw);
-    upload(m.knots, tables.rhythm_knots.data(), tables.rhythm_knots.size() * sizeof(glm::vec2),
-           gl::BufferUsage::stream_draw);
-    upload(m.draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * kDrawFloats * sizeof(float),
-           gl::BufferUsage::dynamic_read);
-    m.lights.bind_storage(0);
-    m.profiles.bind_storage(1);
-    m.knots.bind_storage(2);
-    m.draws.bind_storage(3);
+    m.upload_light_tables(scene, tables);
     const bool skips = !invisible.empty();
     const bool crop = skips && any_billboard && m.options.skips.crop_billboards && m.glare.envelope_stride() > 0;
     (any_billboard && m.glare.envelope_stride() > 0 ? m.glare.envelope_buffer() : m.no_envelope).bind_storage(4);
@@ -389,18 +443,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
             // path. Lights with another model are not in the convolution.
             const auto veil_started = Clock::now();
             draw_direct(1.0f, static_cast<int>(GlarePath::veil));
-            std::vector<float> light = m.glare_only.download_floats();
-            m.veil_report.outside_frame = m.veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
-            m.veil_report.applied = true;
-            m.veil_report.observer = scene.glare.cie;
-            if (ldr) {
-                m.glare_only.upload(light.data());
-            } else {
-                std::vector<float> frame = m.hdr.download_floats();
-                for (std::size_t i = 0; i < frame.size(); ++i)
-                    if (i % 4 != 3) frame[i] += light[i] * pre;
-                m.hdr.upload(frame.data());
-            }
+            m.convolve_veil(scene, P, ldr);
             m.veil_report.cpu_ms = ms_since(veil_started);
             m.cpu_timings.veil_cpu_ms = m.veil_report.cpu_ms;
         }
