@@ -23,21 +23,12 @@ namespace p = atonlab::protocols;
 
 namespace {
 
-std::string input_error_text(const std::string& file, int line, const std::string& column, const std::string& msg) {
-    std::string out = file;
-    if (line > 0) out += fmt::format(":{}", line);
-    if (!column.empty()) out += fmt::format(": column '{}'", column);
-    return out + ": " + msg;
+/// A CSV file's bad value (line 0: the whole file; column "": no one column).
+InputError csv_error(const std::string& file, int line, std::string column, const std::string& message) {
+    return InputError(SourceLocation::csv(file, line, std::move(column)), message);
 }
 
 }  // namespace
-
-InputError::InputError(std::string file, int line, std::string column, const std::string& message)
-    : std::runtime_error(input_error_text(file, line, column, message)),
-      file_(std::move(file)),
-      line_(line),
-      column_(std::move(column)),
-      message_(message) {}
 
 std::string_view to_string(Task t) noexcept {
     switch (t) {
@@ -154,7 +145,7 @@ public:
         return b;
     }
     [[noreturn]] void fail(const std::string& column, const std::string& message) const {
-        throw InputError(file_, line_, column, message);
+        throw csv_error(file_, line_, column, message);
     }
 
     static std::optional<bool> parse_bool(std::string_view v) {
@@ -294,30 +285,30 @@ constexpr std::uintmax_t kMaxCsvBytes = 256u << 20;
 Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     const std::string file = csv_file.string();
     std::error_code ec;
-    if (std::filesystem::is_directory(csv_file, ec)) throw InputError(file, 0, "", "is a directory, not a CSV file");
+    if (std::filesystem::is_directory(csv_file, ec)) throw csv_error(file, 0, "", "is a directory, not a CSV file");
     // Read whole, up to a limit (docs/fuzzing.md "Limits on input"): a trials
     // CSV of a large study is tens of MB; /dev/zero or a mistaken binary file
     // would otherwise be read until the memory runs out.
     const text::FileText read = text::read_text_file(csv_file, kMaxCsvBytes);
-    if (!read.opened) throw InputError(file, 0, "", "cannot be opened for reading (does it exist?)");
-    if (!read.ok()) throw InputError(file, 0, "", fmt::format("cannot be read: {}", read.error));
+    if (!read.opened) throw csv_error(file, 0, "", "cannot be opened for reading (does it exist?)");
+    if (!read.ok()) throw csv_error(file, 0, "", fmt::format("cannot be read: {}", read.error));
     std::istringstream in(read.text);
     int line = 0;
     std::string error;
     auto header = detail::read_csv_record(in, line, error);
-    if (!header) throw InputError(file, 1, "", error.empty() ? "is empty: it needs a header row" : error);
+    if (!header) throw csv_error(file, 1, "", error.empty() ? "is empty: it needs a header row" : error);
     std::map<std::string, std::size_t> index;
     for (std::size_t i = 0; i < header->fields.size(); ++i) {
         std::string name = RowReader::trim(header->fields[i]);
         if (i == 0 && name.rfind("\xEF\xBB\xBF", 0) == 0) name.erase(0, 3);  // a UTF-8 byte-order mark
-        if (name.empty()) throw InputError(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
-        if (!index.emplace(name, i).second) throw InputError(file, 1, name, "appears twice in the header");
+        if (name.empty()) throw csv_error(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
+        if (!index.emplace(name, i).second) throw csv_error(file, 1, name, "appears twice in the header");
     }
     for (const std::string& col : required_csv_columns()) {
         if (!index.count(col)) {
             std::string have;
             for (const std::string& f : header->fields) have += (have.empty() ? "" : ", ") + f;
-            throw InputError(file, 1, col,
+            throw csv_error(file, 1, col,
                              fmt::format("the header has no column '{}', which is required (required: observer, "
                                          "condition, level, response; the header has: {})",
                                          col, have));
@@ -344,12 +335,12 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     while (true) {
         auto rec = detail::read_csv_record(in, line, error);
         if (!rec) {
-            if (!error.empty()) throw InputError(file, line, "", error);
+            if (!error.empty()) throw csv_error(file, line, "", error);
             break;
         }
         if (rec->fields.size() == 1 && RowReader::trim(rec->fields[0]).empty()) continue;  // a blank line
         if (rec->fields.size() != header->fields.size())
-            throw InputError(file, rec->line, "",
+            throw csv_error(file, rec->line, "",
                              fmt::format("the row has {} fields where the header has {}", rec->fields.size(),
                                          header->fields.size()));
         const RowReader row(file, rec->line, index, rec->fields);
@@ -361,7 +352,7 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
         if (!index.count("trial_index")) t.trial_index = next_index[t.session]++;
         d.trials.push_back(std::move(t));
     }
-    if (d.trials.empty()) throw InputError(file, 0, "", "has a header but no trials");
+    if (d.trials.empty()) throw csv_error(file, 0, "", "has a header but no trials");
     // One SessionInfo per session key, in order of appearance.
     std::map<std::string, std::size_t> session_at;
     for (const Trial& t : d.trials) {
@@ -373,7 +364,7 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
             s.observer = t.observer;
             d.sessions.push_back(std::move(s));
         } else if (d.sessions[it->second].observer != t.observer) {
-            throw InputError(file, 0, "session",
+            throw csv_error(file, 0, "session",
                              fmt::format("session '{}' has trials of two observers, '{}' and '{}'", t.session,
                                          d.sessions[it->second].observer, t.observer));
         }
@@ -503,7 +494,7 @@ void merge(Dataset& into, Dataset&& more) {
     }
     for (const SessionInfo& s : more.sessions)
         if (keys.count(s.key))
-            throw InputError(s.source, 0, "",
+            throw csv_error(s.source, 0, "",
                              fmt::format("session '{}' is given twice (the same input named twice?)", s.key));
     auto append = [](auto& a, auto& b) {
         a.insert(a.end(), std::make_move_iterator(b.begin()), std::make_move_iterator(b.end()));

@@ -607,7 +607,7 @@ std::optional<double> model_grey_luminance_cd_m2(const std::string& fit_json, do
         double sum = 0.0;
         for (int c = 0; c < 3; ++c) sum += model.channel_luminance_cd_m2(c, v);
         return std::isfinite(sum) ? std::optional<double>(sum) : std::nullopt;
-    } catch (const atonlab::InputError&) {  // common/error.h (analysis::InputError is the CSV reader's)
+    } catch (const atonlab::InputError&) {  // a fit_json the display model refuses (common/input_error.h)
         return std::nullopt;
     }
 }

@@ -16,7 +16,7 @@ std::string format_error(const SourceLocation& w, const std::string& message) {
         if (w.line > 0) s += fmt::format(":{}", w.line);
         s += ": ";
     }
-    if (!w.key.empty()) s += fmt::format("key '{}': ", text::echo(w.key));
+    if (!w.key.empty()) s += fmt::format("{} '{}': ", w.key_is_column ? "column" : "key", text::echo(w.key));
     s += message;
     // One line of bounded length, whatever the message echoes.
     return text::one_line(s);

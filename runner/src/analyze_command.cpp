@@ -374,7 +374,7 @@ int run_analyze(const AnalyzeOptions& o) {
     } catch (const store::StoreError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return is_bad_input(e.kind()) ? 2 : 4;
-    } catch (const an::InputError& e) {
+    } catch (const InputError& e) {
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 2;
     }

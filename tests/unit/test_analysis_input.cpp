@@ -39,7 +39,7 @@ InputError expect_input_error(F&& f) {
         return e;
     }
     ADD_FAILURE() << "no InputError";
-    return InputError("", 0, "", "");
+    return InputError("");
 }
 
 // --- CSV --------------------------------------------------------------------------
@@ -100,8 +100,10 @@ TEST(AnalysisCsv, MissingRequiredColumnNamesItAndLineOne) {
     TempDir dir;
     write(dir / "t.csv", "observer,condition,response\nP,c,1\n");
     const InputError e = expect_input_error([&] { read_trials_csv(dir / "t.csv"); });
-    EXPECT_EQ(e.line(), 1);
-    EXPECT_EQ(e.column(), "level");
+    ASSERT_TRUE(e.where());
+    EXPECT_EQ(e.where()->line, 1);
+    EXPECT_EQ(e.where()->key, "level");
+    EXPECT_TRUE(e.where()->key_is_column);
     EXPECT_NE(std::string(e.what()).find("t.csv:1: column 'level'"), std::string::npos) << e.what();
 }
 
@@ -117,26 +119,27 @@ TEST(AnalysisCsv, BadValuesNameLineAndColumn) {
                                                             : "observer,condition,level,response\n";
         write(dir / "t.csv", header + "P,c,1,1" + (c.column == "guess_rate" ? ",0" : "") + "\n" + c.row + "\n");
         const InputError e = expect_input_error([&] { read_trials_csv(dir / "t.csv"); });
-        EXPECT_EQ(e.line(), 3) << c.row << ": " << e.what();
-        EXPECT_EQ(e.column(), c.column) << c.row << ": " << e.what();
+        ASSERT_TRUE(e.where()) << c.row;
+        EXPECT_EQ(e.where()->line, 3) << c.row << ": " << e.what();
+        EXPECT_EQ(e.where()->key, c.column) << c.row << ": " << e.what();
     }
 }
 
 TEST(AnalysisCsv, StructuralErrors) {
     TempDir dir;
     write(dir / "empty.csv", "");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "empty.csv"); }).line(), 1);
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "empty.csv"); }).where().value_or(SourceLocation{}).line, 1);
     write(dir / "header-only.csv", "observer,condition,level,response\n");
     EXPECT_NE(
         std::string(expect_input_error([&] { read_trials_csv(dir / "header-only.csv"); }).what()).find("no trials"),
         std::string::npos);
     write(dir / "short.csv", "observer,condition,level,response\nP,c,1\n");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "short.csv"); }).line(), 2);
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "short.csv"); }).where().value_or(SourceLocation{}).line, 2);
     write(dir / "quote.csv", "observer,condition,level,response\nP,\"c,1,1\n");
     EXPECT_NE(std::string(expect_input_error([&] { read_trials_csv(dir / "quote.csv"); }).what()).find("never closed"),
               std::string::npos);
     write(dir / "dup.csv", "observer,condition,level,level,response\nP,c,1,1,1\n");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "dup.csv"); }).column(), "level");
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "dup.csv"); }).where().value_or(SourceLocation{}).key, "level");
     EXPECT_NE(
         std::string(expect_input_error([&] { read_trials_csv(dir / "missing.csv"); }).what()).find("cannot be opened"),
         std::string::npos);

@@ -24,28 +24,14 @@
 #include <vector>
 
 #include "atonlab/analysis/calibration_drift.h"
+#include "atonlab/common/input_error.h"
 
 namespace atonlab::analysis {
 
-/// Bad input for an analysis (a CSV without a required column, a value that is
-/// not a number, a study file given twice): one sentence that names the file
-/// and, where there is one, the line and the column. what() is
-/// "FILE:LINE: column 'COLUMN': MESSAGE" with the parts that are known.
-class InputError : public std::runtime_error {
-public:
-    InputError(std::string file, int line, std::string column, const std::string& message);
-
-    const std::string& file() const noexcept { return file_; }
-    int line() const noexcept { return line_; }  ///< 1-based; 0 when unknown
-    const std::string& column() const noexcept { return column_; }
-    const std::string& message() const noexcept { return message_; }
-
-private:
-    std::string file_;
-    int line_;
-    std::string column_;
-    std::string message_;
-};
+// Bad input for an analysis (a CSV without a required column, a value that is
+// not a number, a study file given twice) is the one InputError
+// (common/input_error.h): what() is "FILE:LINE: column 'COLUMN': MESSAGE" with
+// the parts that are known (SourceLocation::csv).
 
 /// What the observer was asked (docs/protocol-file.md, `task`).
 enum class Task : std::uint8_t { TwoAfc, YesNo, Adjust };

@@ -19,6 +19,7 @@ struct SourceLocation {
     int column = 0;      ///< 1-based; 0 when unknown
     std::string key;     ///< dotted key path; empty when the error is about the whole file or option
     std::string option = {};  ///< the command-line option that gave the value ("--set"); empty for a file
+    bool key_is_column = false;  ///< `key` names a CSV file's column: what() says "column 'NAME'"
 
     /// A value given on the command line by `option` (and, for --set, its key).
     static SourceLocation command_line(std::string option, std::string key = {}) {
@@ -27,12 +28,19 @@ struct SourceLocation {
         w.option = std::move(option);
         return w;
     }
+    /// A value in a CSV file: its line and the column's name (may be empty).
+    static SourceLocation csv(std::string file, int line, std::string column) {
+        SourceLocation w{std::move(file), line, 0, std::move(column)};
+        w.key_is_column = true;
+        return w;
+    }
     bool from_command_line() const noexcept { return !option.empty(); }
 };
 
 /// Bad input from a user: a message that is one clear sentence, and where it
 /// happened. what() gives "FILE:LINE: key 'KEY': MESSAGE" (parts omitted when
-/// unknown), or "OPTION: key 'KEY': MESSAGE" for a command-line value.
+/// unknown; "column 'NAME'" for a CSV column), or "OPTION: key 'KEY': MESSAGE"
+/// for a command-line value.
 class InputError : public std::runtime_error {
 public:
     InputError(SourceLocation where, const std::string& message);
