@@ -24,9 +24,15 @@ namespace s = atonlab::stimuli;
 
 namespace {
 
-std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lights) {
+/// An override list as one cache key (each override ends in a newline).
+std::string overrides_key(const std::vector<std::string>& overrides) {
     std::string key;
-    for (const std::string& o : frame.overrides) (key += o) += '\n';
+    for (const std::string& o : overrides) (key += o) += '\n';
+    return key;
+}
+
+std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lights) {
+    std::string key = overrides_key(frame.overrides);
     key += '\x1f';
     for (const std::string& l : lights) (key += l) += '\n';
     return key;
@@ -93,8 +99,7 @@ StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path
 }
 
 std::shared_ptr<const s::Scene> StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
-    std::string key;
-    for (const std::string& o : overrides) (key += o) += '\n';
+    const std::string key = overrides_key(overrides);
     if (const auto* hit = scenes_.find(key)) return *hit;
     std::vector<s::SceneOverride> parsed;
     parsed.reserve(overrides.size());
