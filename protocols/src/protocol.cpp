@@ -80,8 +80,8 @@ std::string position_text(const std::array<double, 3>& p) {
     return fmt::format("[{}, {}, {}]", number_text(p[0]), number_text(p[1]), number_text(p[2]));
 }
 
-void append(std::vector<std::string>& out, const std::vector<Override>& overrides) {
-    for (const Override& o : overrides) out.push_back(o.text());
+void append(std::vector<Override>& out, const std::vector<Override>& overrides) {
+    out.insert(out.end(), overrides.begin(), overrides.end());
 }
 
 }  // namespace
@@ -297,11 +297,27 @@ const Condition* Protocol::find_condition(std::string_view condition_name) const
     return nullptr;
 }
 
-std::vector<std::string> Protocol::display_overrides() const {
-    return {fmt::format("display.width_px={}", display.width_px),
-            fmt::format("display.height_px={}", display.height_px),
-            fmt::format("display.width_m={}", number_text(display.width_m)),
-            fmt::format("display.viewing_distance_m={}", number_text(display.viewing_distance_m))};
+std::vector<Override> Protocol::display_overrides() const {
+    // Each at its [display] line; a value with no line there came from the
+    // command line (`atonlab check --set display.KEY=VALUE`).
+    const auto at_line = [&](const std::string& key, std::string value) {
+        const std::string scene_key = "display." + key;
+        const auto it = display.lines.find(key);
+        return Override{scene_key, std::move(value),
+                        it == display.lines.end() ? SourceLocation::command_line("--set", scene_key)
+                                                  : SourceLocation{file, it->second, 0, scene_key}};
+    };
+    return {at_line("width_px", fmt::format("{}", display.width_px)),
+            at_line("height_px", fmt::format("{}", display.height_px)),
+            at_line("width_m", number_text(display.width_m)),
+            at_line("viewing_distance_m", number_text(display.viewing_distance_m))};
+}
+
+std::vector<std::string> Frame::override_texts() const {
+    std::vector<std::string> texts;
+    texts.reserve(overrides.size());
+    for (const Override& o : overrides) texts.push_back(o.text());
+    return texts;
 }
 
 std::unique_ptr<Procedure> make_track(const Condition& condition, std::size_t track, std::uint64_t seed) {
@@ -350,7 +366,11 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
     Stimulus s;
     s.level = proposal.level;
     s.scene_value = condition.scene_value(proposal.level);
-    const std::string level_override = fmt::format("{}={}", condition.level_key, number_text(s.scene_value));
+    // The values the protocol makes for the condition stand at its line.
+    const auto made = [&](std::string key, std::string value, std::string_view from) {
+        return Override{std::move(key), std::move(value), SourceLocation{protocol.file, condition.line, 0, std::string(from)}};
+    };
+    const Override level_override = made(condition.level_key, number_text(s.scene_value), "level_key");
     const bool test_first = proposal.test_on_left.value_or(true);
 
     auto frame_for = [&](Role role) {
@@ -388,12 +408,14 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
             // The parser makes sure both positions and both lights are given.
             const std::array<double, 3> left = condition.left_position_m.value_or(std::array<double, 3>{});
             const std::array<double, 3> right = condition.right_position_m.value_or(std::array<double, 3>{});
-            f.overrides.push_back(
-                fmt::format("light.{}.position_m={}", condition.test_light, position_text(test_first ? left : right)));
+            const char* const left_key = "left_position_m";
+            const char* const right_key = "right_position_m";
+            f.overrides.push_back(made(fmt::format("light.{}.position_m", condition.test_light),
+                                       position_text(test_first ? left : right), test_first ? left_key : right_key));
             // A reference disc moves like a light (scene.h Disc: its centre's direction).
             const char* reference_table = condition.reference_disc.empty() ? "light" : "disc";
-            f.overrides.push_back(fmt::format("{}.{}.position_m={}", reference_table, condition.judged(Role::Reference),
-                                              position_text(test_first ? right : left)));
+            f.overrides.push_back(made(fmt::format("{}.{}.position_m", reference_table, condition.judged(Role::Reference)),
+                                       position_text(test_first ? right : left), test_first ? right_key : left_key));
             s.frames.push_back(std::move(f));
             const Role left_role = test_first ? Role::Test : Role::Reference;
             const Role right_role = test_first ? Role::Reference : Role::Test;

@@ -438,11 +438,11 @@ private:
                          const std::string& level_key_path) const {
         const bool side_by_side = c.presentation == Presentation::SideBySide;
         auto conflict = [&](const Written& a, const Written& b, const std::string& why) {
-            doc_.fail_at_line(b.o.line, b.path,
+            doc_.fail_at_line(b.o.origin.line, b.path,
                               r.context() + fmt::format("{} is set to {} here and to {} by {} (line {}): {} Remove one "
                                                         "of them (docs/protocol-file.md \"When two overrides set one "
                                                         "key\").",
-                                                        b.o.key, b.o.value, a.o.value, a.path, a.o.line, why));
+                                                        b.o.key, b.o.value, a.o.value, a.path, a.o.origin.line, why));
         };
         // Frames of the condition, by the scopes that apply to each.
         std::vector<std::vector<Scope>> frames;
@@ -465,7 +465,7 @@ private:
                 if (!applies(b)) continue;
                 if (has_level && b.o.key == c.level_key)
                     doc_.fail_at_line(
-                        b.o.line, b.path,
+                        b.o.origin.line, b.path,
                         r.context() +
                             fmt::format("{} is set to {} here, but it is the level_key ({}): the procedure's level "
                                         "sets it on every trial in the {} frame. Remove this override (docs/protocol-"
@@ -474,7 +474,7 @@ private:
                 if (side_by_side && (b.o.key == fmt::format("light.{}.position_m", c.test_light) ||
                                      b.o.key == fmt::format("light.{}.position_m", c.reference_light)))
                     doc_.fail_at_line(
-                        b.o.line, b.path,
+                        b.o.origin.line, b.path,
                         r.context() + fmt::format("{} is set to {} here, but a side-by-side frame places its lights "
                                                   "at left_position_m and right_position_m. Remove this override.",
                                                   b.o.key, b.o.value));

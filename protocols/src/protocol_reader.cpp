@@ -93,8 +93,11 @@ Override Document::scene_override(const toml::node* n, const std::string& key, c
     Override o;
     o.key = std::string(trim(std::string_view(text).substr(0, eq)));
     o.value = std::string(trim(std::string_view(text).substr(eq + 1)));
-    o.line = line_of(n);
-    o.column = column_of(n);
+    // Where it was written: the protocol's line and key, or a conditions
+    // file's row and column; errors about the value name it (scene loader).
+    o.origin = where(n, key);
+    std::string no_message;
+    relocate(o.origin, no_message);
     if (!is_scene_key(o.key))
         fail(n, key,
              context + fmt::format("\"{}\" is not a scene key: write section.key as in the scene file, e.g. "

@@ -15,7 +15,7 @@
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/read_file.h"
 #include "atonlab/protocols/protocol_file.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
@@ -43,6 +43,7 @@ void apply_display_set(p::Display& display, const std::string& set) {
         throw InputError(SourceLocation::command_line("--set", key),
                          "check sets only the display: display.width_px, display.height_px, display.width_m or "
                          "display.viewing_distance_m.");
+    display.lines.erase(key.substr(std::string_view("display.").size()));  // its errors name --set, not the file
     double v = 0.0;
     const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
     if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(v) || !(v > 0))
@@ -80,7 +81,8 @@ void add_check_command(CLI::App& app, CheckOptions& o) {
 int run_check(const CheckOptions& o) {
     p::Protocol protocol = p::load_protocol(o.protocol);
     for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
-    const std::string scene_text = files::read_text(protocol.scene, "scene template");
+    stimuli::SceneTemplate scene =
+        stimuli::SceneTemplate::parse(files::read_text(protocol.scene, "scene template"), protocol.scene.string());
 
     std::optional<display::DisplayModel> model;
     if (!o.db.empty()) {
@@ -96,7 +98,7 @@ int run_check(const CheckOptions& o) {
     }
     auto context = gl::create_headless_context();
     const p::ModelObserverParams params{};
-    StimulusRenderer renderer(scene_text, protocol.scene, params.window_radius_deg, protocol.timing.stimulus_s);
+    StimulusRenderer renderer(std::move(scene), params.window_radius_deg, protocol.timing.stimulus_s);
     if (model) renderer.use_display_model(*model);
     const Displayability d = check_displayability(renderer, protocol);
     std::printf("%s", displayability_table(d).c_str());

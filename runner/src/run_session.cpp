@@ -15,7 +15,7 @@
 #include "atonlab/runner/presenter.h"
 #include "atonlab/runner/screen_presenter.h"
 #include "atonlab/runner/text.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/store.h"
 #include "calibrate/calibration_policy.h"
@@ -140,7 +140,7 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
     start.displayability_json = displayability_json(displayability, o.allow_undisplayable);
     start.calibration = calibration.calibration     ? *calibration.calibration
                         : calibration.from_profiles ? copy_into_study(store, *calibration.from_profiles)
-                                                    : record_display(store, in.display_scene, in.scene_file);
+                                                    : record_display(store, in.display_scene, in.protocol.scene);
     return store.begin_session(start);
 }
 
@@ -192,7 +192,7 @@ int run_session(const RunOptions& o) {
     } else {
         presenter = open_screen(o, protocol, in.display_scene, screen);
     }
-    StimulusRenderer renderer(in.scene_text, in.scene_file, observer.params().window_radius_deg,
+    StimulusRenderer renderer(*in.scene, observer.params().window_radius_deg,
                               protocol.timing.stimulus_s);
     if (calibration.display) renderer.use_display_model(*calibration.display);
     // A level range that cannot produce a match is refused, before anything is written.

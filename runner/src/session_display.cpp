@@ -10,7 +10,7 @@
 
 #include "atonlab/runner/screen_presenter.h"
 #include "atonlab/display/display_model.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/image_io.h"
 #include "run_session.h"
 
@@ -225,8 +225,8 @@ Screen SessionDisplay::background_screen(const p::Condition& c) {
     // and what the observer adapts to (docs/protocol-file.md, [[block]]).
     p::Frame bg;
     bg.overrides = protocol_.display_overrides();
-    for (const p::Override& o : c.set) bg.overrides.push_back(o.text());
-    for (const std::string& off : all_off_) bg.overrides.push_back(off);
+    bg.overrides.insert(bg.overrides.end(), c.set.begin(), c.set.end());
+    bg.overrides.insert(bg.overrides.end(), all_off_.begin(), all_off_.end());
     sc.picture = renderer_.codes(bg, {});
     return sc;
 }

@@ -115,7 +115,7 @@ private:
     double text_luminance_cd_m2_ = 0.0, cue_luminance_cd_m2_ = 0.0;
     double text_px_ = 24.0;
     double pixels_per_degree_ = 0.0;
-    std::vector<std::string> all_off_;  ///< every light dark and disc gone (StimulusRenderer::all_off)
+    std::vector<SceneOverride> all_off_;  ///< every light dark and disc gone (StimulusRenderer::all_off)
 };
 
 /// Opens the full-screen presenter for a session (RunOptions' on-screen

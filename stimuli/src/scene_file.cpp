@@ -1,12 +1,16 @@
 // The scene file (scene_file.h; every key documented in docs/scene-file.md).
 //
-// Three steps: parse the TOML text (syntax errors keep the parser's line),
-// apply the --set overrides to the parsed tree, then validate the tree against
-// the schema while building the Scene. Every value's error names the file,
-// line and dotted key; a value that came from --set names "--set KEY" instead
-// (override values are parsed with the source path "--set KEY", and toml++
-// keeps a node's source when it is moved into the scene's tree).
+// Three steps: parse the TOML text once (SceneTemplate; syntax errors keep the
+// parser's line), apply the overrides to the parsed tree, then validate the
+// tree against the schema while building the Scene (and undo the overrides).
+// Every value's error names the file, line and dotted key; a value that an
+// override gave names where the override was written: its protocol line, or
+// "--set KEY" (override values are parsed with the source path "--set KEY",
+// toml++ keeps a node's source when it is moved into the tree, and the
+// Document maps that path to the override's origin).
 #include "atonlab/stimuli/scene_file.h"
+
+#include <mutex>
 
 #include "scene_reader.h"
 
@@ -67,40 +71,22 @@ Scene build_scene(Document& doc, const toml::table& root_table) {
 
 }  // namespace
 
-SceneOverride SceneOverride::parse(std::string_view text) {
-    const auto trim = [](std::string_view s) {
-        while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-        while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-        return s;
-    };
-    const auto eq = text.find('=');
-    if (eq == std::string_view::npos)
-        throw InputError(SourceLocation::command_line(std::string(kSetOption), std::string(trim(text))),
-                         fmt::format("expected KEY=VALUE, e.g. camera.yaw_deg=45, got \"{}\".", text::echo(text)));
-    SceneOverride o;
-    o.key = std::string(trim(text.substr(0, eq)));
-    o.value = std::string(trim(text.substr(eq + 1)));
-    if (o.key.empty())
-        throw InputError(SourceLocation::command_line(std::string(kSetOption)),
-                         fmt::format("the key before '=' is empty in \"{}\".", text::echo(text)));
-    return o;
-}
-
-// The text is kept and parsed again by each instantiate(): toml++ drops a
-// node's source region when it is copied ("does not copy source information"),
-// and every error must keep the file's line, so a copy of one parsed tree
-// cannot serve. The template checks the syntax once, and reads the file once.
+// The tree is parsed once. instantiate() applies the overrides to it in place
+// and undoes them after the scene is built (TreeEdits: the nodes are moved,
+// never copied, so they keep their source lines; toml++ drops a node's source
+// when it is copied, and every error must name the file's line). The mutex
+// makes concurrent instantiate() calls on copies of one template safe.
 struct SceneTemplate::Parsed {
     std::string file_label;
-    std::string text;
+    mutable std::mutex mutex;
+    mutable toml::table root;  ///< the file's tree; changed only inside instantiate(), under the mutex
 };
 
 SceneTemplate SceneTemplate::parse(std::string_view toml_text, std::string_view file_label) {
     auto parsed = std::make_shared<Parsed>();
     parsed->file_label = std::string(file_label);
-    parsed->text = std::string(toml_text);
     try {
-        (void)toml::parse(toml_text, file_label);
+        parsed->root = toml::parse(toml_text, file_label);
     } catch (const toml::parse_error& e) {
         throw InputError(SourceLocation{std::string(file_label), static_cast<int>(e.source().begin.line),
                                         static_cast<int>(e.source().begin.column), ""},
@@ -122,10 +108,11 @@ SceneTemplate SceneTemplate::load(const std::filesystem::path& file) {
 const std::string& SceneTemplate::file_label() const noexcept { return parsed_->file_label; }
 
 Scene SceneTemplate::instantiate(const std::vector<SceneOverride>& overrides) const {
+    const std::lock_guard<std::mutex> lock(parsed_->mutex);
     Document doc{parsed_->file_label};
-    toml::table root = toml::parse(parsed_->text, parsed_->file_label);
-    for (const SceneOverride& o : overrides) apply_override(doc, root, o);
-    return build_scene(doc, root);
+    TreeEdits edits;  // undone on the way out, scene made or refused: the tree is the file's again
+    for (const SceneOverride& o : overrides) apply_override(doc, parsed_->root, o, edits);
+    return build_scene(doc, parsed_->root);
 }
 
 Scene parse_scene(std::string_view toml_text, std::string_view file_label,

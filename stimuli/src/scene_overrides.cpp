@@ -4,10 +4,66 @@
 namespace atonlab::stimuli::scene_reader {
 
 // ---------------------------------------------------------------------------
+// The template's tree, changed and restored.
+
+namespace {
+/// into[key] = node, moving it (so that it keeps its source).
+void move_into(toml::table& into, const toml::key& key, toml::node& node) {
+    node.visit([&](auto& concrete) { into.insert_or_assign(key, std::move(concrete)); });
+}
+}  // namespace
+
+void TreeEdits::save(toml::table& table, std::string_view key) {
+    Edit e;
+    e.table = &table;
+    e.key = toml::key(key);
+    if (auto it = table.find(key); it != table.end()) {
+        e.key = it->first;  // a copy keeps the key's source
+        move_into(e.saved, toml::key("v"), it->second);
+    }
+    edits_.push_back(std::move(e));
+}
+
+void TreeEdits::assign(toml::table& table, std::string_view key, toml::node& value) {
+    save(table, key);
+    move_into(table, toml::key(key), value);
+}
+
+void TreeEdits::erase(toml::table& table, std::string_view key) {
+    if (!table.contains(key)) return;
+    save(table, key);
+    table.erase(key);
+}
+
+toml::table& TreeEdits::insert_table(toml::table& parent, std::string_view key) {
+    Edit e;
+    e.table = &parent;
+    e.key = toml::key(key);
+    edits_.push_back(std::move(e));
+    return *parent.insert(key, toml::table{}).first->second.as_table();
+}
+
+void TreeEdits::undo() noexcept {
+    // Newest first: a table made for an override goes after the values set in it.
+    for (auto e = edits_.rbegin(); e != edits_.rend(); ++e) {
+        if (toml::node* old = e->saved.get("v"))
+            move_into(*e->table, e->key, *old);
+        else
+            e->table->erase(e->key.str());
+    }
+    edits_.clear();
+}
+
+// ---------------------------------------------------------------------------
 // Overrides.
 
-[[noreturn]] void override_error(const std::string& key, const std::string& message) {
-    throw InputError(SourceLocation::command_line(std::string(kSetOption), key), message);
+/// An error about override `o`, at its origin: the protocol line that wrote
+/// it, or "--set KEY".
+[[noreturn]] void override_error(const SceneOverride& o, const std::string& message) {
+    SourceLocation where = o.origin;
+    if (where.file.empty()) where = SourceLocation::command_line(std::string(kSetOption));
+    where.key = o.key;
+    throw InputError(std::move(where), message);
 }
 
 /// A TOML basic string holding `text`, for values that are not valid TOML.
@@ -41,7 +97,7 @@ toml::table parse_override_value(const SceneOverride& o, std::string& note) {
     try {
         return toml::parse("v = " + toml_quoted(o.value), std::string_view(source));
     } catch (const toml::parse_error& e) {
-        override_error(o.key,
+        override_error(o,
                        fmt::format("the value \"{}\" cannot be read: {}.", text::echo(o.value),
                                    std::string(e.description())));
     }
@@ -53,17 +109,18 @@ bool is_number(const toml::node& n) {
 
 /// The table that holds the overridden key, created if absent (and remembered
 /// so that errors about it name the override).
-toml::table& table_for_override(Document& doc, toml::table& parent, std::string_view name, const std::string& typed,
-                                const std::string& shown) {
+toml::table& table_for_override(Document& doc, TreeEdits& edits, toml::table& parent, std::string_view name,
+                                const SceneOverride& o, const std::string& shown) {
+    const std::string& typed = o.key;
     toml::node* n = parent.get(name);
     if (n == nullptr) {
-        auto [it, inserted] = parent.insert(name, toml::table{});
-        doc.note_made_for_override(&it->second, typed);
-        return *it->second.as_table();
+        toml::table& made = edits.insert_table(parent, name);
+        doc.note_made_for_override(&made, typed);
+        return made;
     }
     if (!n->is_table()) {
         const SourceLocation w = doc.where(n, shown);
-        override_error(typed, fmt::format("cannot set {}: {} is {} in {}:{}, not a table.", typed, shown,
+        override_error(o, fmt::format("cannot set {}: {} is {} in {}:{}, not a table.", typed, shown,
                                           type_phrase(n->type()), w.file, w.line));
     }
     return *n->as_table();
@@ -78,11 +135,11 @@ std::pair<toml::table*, std::string> element_for_override(const Document& doc, t
     const std::string written = fmt::format("a {0} key is written {0}.NAME.KEY or {0}[INDEX].KEY.", array);
     toml::node* node = root.get(array);
     if (node == nullptr || !node->is_array() || node->as_array()->empty())
-        override_error(o.key, fmt::format("the scene has no [[{}]] tables to override.", array));
+        override_error(o, fmt::format("the scene has no [[{}]] tables to override.", array));
     toml::array& elements = *node->as_array();
     const std::string& k = o.key;
     const auto last_dot = k.rfind('.');
-    if (last_dot == std::string::npos || last_dot == k.size() - 1) override_error(o.key, written);
+    if (last_dot == std::string::npos || last_dot == k.size() - 1) override_error(o, written);
     key = k.substr(last_dot + 1);
 
     std::size_t index = 0;
@@ -93,10 +150,10 @@ std::pair<toml::table*, std::string> element_for_override(const Document& doc, t
         if (close == std::string::npos || close + 1 != last_dot || digits.empty() ||
             !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
             digits.size() > 6)
-            override_error(o.key, written);
+            override_error(o, written);
         index = static_cast<std::size_t>(std::stoul(digits));
         if (index >= elements.size())
-            override_error(o.key, fmt::format("there is no {0}[{1}]: the scene has {2} {0}{3} ({0}[0] to {0}[{4}]).",
+            override_error(o, fmt::format("there is no {0}[{1}]: the scene has {2} {0}{3} ({0}[0] to {0}[{4}]).",
                                               array, index, elements.size(), elements.size() == 1 ? "" : "s",
                                               elements.size() - 1));
     } else {
@@ -115,25 +172,25 @@ std::pair<toml::table*, std::string> element_for_override(const Document& doc, t
             known.push_back(element_name);
         }
         if (!found)
-            override_error(o.key, fmt::format("no {} is named \"{}\"; the {}s are {}.", array, text::echo(name), array,
+            override_error(o, fmt::format("no {} is named \"{}\"; the {}s are {}.", array, text::echo(name), array,
                                               join(known, "\"")));
     }
     toml::node* element = elements.get(index);
     if (!element->is_table()) {
         const SourceLocation w = doc.where(element, fmt::format("{}[{}]", array, index));
-        override_error(o.key, fmt::format("{}[{}] in {}:{} is not a table.", array, index, w.file, w.line));
+        override_error(o, fmt::format("{}[{}] in {}:{} is not a table.", array, index, w.file, w.line));
     }
     return {element->as_table(), fmt::format("{}[{}]", array, index)};
 }
 
-void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
+void apply_override(Document& doc, toml::table& root, const SceneOverride& o, TreeEdits& edits) {
     const std::string& k = o.key;
     toml::table* target = nullptr;
     std::string key;         // the key inside *target
     std::string schema_key;  // canonical dotted path, e.g. "light[0].intensity_cd"
 
     const auto unknown = [&](std::string_view section, KeyList allowed, std::string_view leaf) {
-        override_error(k, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", text::echo(leaf),
+        override_error(o, fmt::format("unknown key '{}' in [{}].{} Allowed keys: {}.", text::echo(leaf),
                                       text::echo(section),
                                       did_you_mean(leaf, allowed), join(allowed)));
     };
@@ -154,26 +211,26 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
         const auto kind_end = rest.find('.');
         const auto last_dot = rest.rfind('.');
         if (kind_end == std::string::npos || last_dot == kind_end)
-            override_error(k, "a profile key is written profiles.vertical.NAME.KEY or profiles.horizontal.NAME.KEY.");
+            override_error(o, "a profile key is written profiles.vertical.NAME.KEY or profiles.horizontal.NAME.KEY.");
         const std::string kind = rest.substr(0, kind_end);
         const std::string name = rest.substr(kind_end + 1, last_dot - kind_end - 1);
         key = rest.substr(last_dot + 1);
         if (!contains(kProfileKinds, kind))
-            override_error(k, fmt::format("unknown profile kind '{}'; it must be 'vertical' or 'horizontal'.", kind));
+            override_error(o, fmt::format("unknown profile kind '{}'; it must be 'vertical' or 'horizontal'.", kind));
         const KeyList allowed = kind == "vertical" ? KeyList(kVerticalKeys) : KeyList(kHorizontalKeys);
         if (!contains(allowed, key)) unknown(fmt::format("profiles.{}.{}", kind, name), allowed, key);
-        toml::table& profiles = table_for_override(doc, root, "profiles", k, "profiles");
-        toml::table& kinds = table_for_override(doc, profiles, kind, k, "profiles." + kind);
-        target = &table_for_override(doc, kinds, name, k, fmt::format("profiles.{}.{}", kind, name));
+        toml::table& profiles = table_for_override(doc, edits, root, "profiles", o, "profiles");
+        toml::table& kinds = table_for_override(doc, edits, profiles, kind, o, "profiles." + kind);
+        target = &table_for_override(doc, edits, kinds, name, o, fmt::format("profiles.{}.{}", kind, name));
         schema_key = fmt::format("profiles.{}.{}.{}", kind, name, key);
     } else {
         const auto dot = k.find('.');
         const std::string section = k.substr(0, dot);
         if (!contains(kSections, section))
-            override_error(k, fmt::format("unknown key '{}'; a scene has the tables {}.", text::echo(k),
+            override_error(o, fmt::format("unknown key '{}'; a scene has the tables {}.", text::echo(k),
                                           join(kSections)));
         if (dot == std::string::npos || dot + 1 == k.size())
-            override_error(k, fmt::format("--set takes a key inside [{}], e.g. {}.{}.", section, section,
+            override_error(o, fmt::format("an override takes a key inside [{}], e.g. {}.{}.", section, section,
                                           section == "display" ? "width_px" : "yaw_deg"));
         key = k.substr(dot + 1);
         const KeyList allowed = section == "display"       ? KeyList(kDisplayKeys)
@@ -183,7 +240,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
                                 : section == "tonemap"     ? KeyList(kTonemapKeys)
                                                            : KeyList(kEyeKeys);
         if (!contains(allowed, key)) unknown(section, allowed, key);
-        target = &table_for_override(doc, root, section, k, section);
+        target = &table_for_override(doc, edits, root, section, o, section);
         schema_key = k;
     }
 
@@ -200,7 +257,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
             const SourceLocation w = doc.where(old, schema_key);
             const std::string from =
                 w.from_command_line() ? std::string("an earlier --set") : fmt::format("{}:{}", w.file, w.line);
-            override_error(k, fmt::format("expected {} like the value it replaces ({}), got {}{}.",
+            override_error(o, fmt::format("expected {} like the value it replaces ({}), got {}{}.",
                                           is_number(*old) ? std::string_view("a number") : type_phrase(old->type()),
                                           from, type_phrase(value->type()), note));
         }
@@ -208,11 +265,11 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o) {
     for (const auto& group : exclusive_groups()) {
         if (std::find(group.begin(), group.end(), key) == group.end()) continue;
         for (std::string_view other : group)
-            if (other != key) target->erase(other);
+            if (other != key) edits.erase(*target, other);
     }
     doc.note_override(k, schema_key, o.origin);
     doc.note_string_fallback(k, note);
-    value->visit([&](auto& concrete) { target->insert_or_assign(key, std::move(concrete)); });
+    edits.assign(*target, key, *value);
 }
 
 }  // namespace atonlab::stimuli::scene_reader

@@ -29,7 +29,7 @@
 #include "atonlab/common/toml_text.h"
 #include "atonlab/display/calibration.h"
 #include "atonlab/display/colour.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -262,7 +262,41 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
 // ---------------------------------------------------------------------------
 // Overrides (scene_overrides.cpp).
 
-/// Applies one override to the parsed tree, type-checked against the value it replaces.
-void apply_override(Document& doc, toml::table& root, const SceneOverride& o);
+/// The changes overrides make to a template's tree, undone (newest first) when
+/// it goes out of scope, so that the tree is the file's again: a template is
+/// parsed once and every scene is made from the same tree. A replaced or
+/// erased node is moved aside, never copied, because toml++ keeps a node's
+/// source line when it is moved and drops it when it is copied, and every
+/// later error must name the file's line.
+class TreeEdits {
+public:
+    TreeEdits() = default;
+    TreeEdits(const TreeEdits&) = delete;
+    TreeEdits& operator=(const TreeEdits&) = delete;
+    ~TreeEdits() { undo(); }
+
+    /// table[key] = value, the value moved out of `value`.
+    void assign(toml::table& table, std::string_view key, toml::node& value);
+    /// Removes table[key] when present.
+    void erase(toml::table& table, std::string_view key);
+    /// An empty table made at parent[key], which must be absent.
+    toml::table& insert_table(toml::table& parent, std::string_view key);
+    /// Restores every change, newest first.
+    void undo() noexcept;
+
+private:
+    /// Moves table[key] aside (when present) and records the change.
+    void save(toml::table& table, std::string_view key);
+    struct Edit {
+        toml::table* table = nullptr;
+        toml::key key;       ///< as the table held it (with its source), or as made
+        toml::table saved;   ///< "v": the node it held; empty when the key was absent
+    };
+    std::vector<Edit> edits_;
+};
+
+/// Applies one override to the parsed tree (each change recorded in `edits`),
+/// type-checked against the value it replaces.
+void apply_override(Document& doc, toml::table& root, const SceneOverride& o, TreeEdits& edits);
 
 }  // namespace atonlab::stimuli::scene_reader

@@ -65,7 +65,7 @@ Displayability check(const fs::path& file, int width_px, int height_px, double w
     protocol.display.height_px = height_px;
     protocol.display.width_m = width_m;
     const p::ModelObserverParams params{};
-    runner::StimulusRenderer renderer(file_bytes(protocol.scene), protocol.scene, params.window_radius_deg,
+    runner::StimulusRenderer renderer(stimuli::SceneTemplate::parse(file_bytes(protocol.scene), protocol.scene.string()), params.window_radius_deg,
                                       protocol.timing.stimulus_s);
     return runner::check_displayability(renderer, protocol);
 }

@@ -38,17 +38,6 @@ std::string example(const std::string& name) {
     return std::string(ATONLAB_SOURCE_DIR) + "/protocols/examples/" + name;
 }
 
-std::string read_file(const std::string& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw std::runtime_error("cannot read " + path);
-    std::string text;
-    char buf[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-    std::fclose(f);
-    return text;
-}
-
 /// P(level stimulus chosen) at `level` for a 2AFC condition, on real frames.
 double p_level_chosen(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c, double level,
                       const p::ModelObserverParams& params) {
@@ -133,7 +122,7 @@ void expect_convergence(const std::string& name) {
     protocol.display.width_px /= kDisplayDivisor;
     protocol.display.height_px /= kDisplayDivisor;
     const p::ModelObserverParams params{};  // what `atonlab run --model-observer` uses
-    StimulusRenderer renderer(read_file(protocol.scene.string()), protocol.scene, params.window_radius_deg,
+    StimulusRenderer renderer(atonlab::stimuli::SceneTemplate::load(protocol.scene), params.window_radius_deg,
                               protocol.timing.stimulus_s);
 
     std::map<std::string, double> truth;

@@ -70,16 +70,17 @@ void expect_same_codes(const s::EncodedImage& a, const s::EncodedImage& b, const
 class RendererPipeline : public test::GLTest {};
 
 TEST_F(RendererPipeline, RendererCodesAreThePipelinesAndTheOldCopysEveryPixel) {
-    const std::string text = files::read_text(kScene, "scene");
-    runner::StimulusRenderer renderer(text, kScene, 0.5, 0.5);
-    const std::vector<std::vector<std::string>> frames{
-        {"display.dither=true"},
-        {"display.dither=true", "eye.glare=spencer"},
-        {"display.dither=true", "eye.glare=spencer", "tonemap.ldr_glare=true"},
+    runner::StimulusRenderer renderer(s::SceneTemplate::load(kScene), 0.5, 0.5);
+    const SceneOverride dither{"display.dither", "true"};
+    const SceneOverride spencer{"eye.glare", "spencer"};
+    const std::vector<std::vector<SceneOverride>> frames{
+        {dither},
+        {dither, spencer},
+        {dither, spencer, {"tonemap.ldr_glare", "true"}},
     };
-    for (const std::vector<std::string>& overrides : frames) {
+    for (const std::vector<SceneOverride>& overrides : frames) {
         std::string what;
-        for (const std::string& o : overrides) what += o + " ";
+        for (const SceneOverride& o : overrides) what += o.text() + " ";
         const s::Scene sc = *renderer.scene(overrides);
         ASSERT_EQ(sc.output.encode.dither, display::Dither::spatiotemporal) << what;
         const auto codes = renderer.codes(protocols::Frame{std::nullopt, overrides}, {});

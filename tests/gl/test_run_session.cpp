@@ -201,7 +201,7 @@ TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
         EXPECT_EQ(t.level, next->proposal.level);
         EXPECT_EQ(t.test_on_left, next->proposal.test_on_left);
         for (const auto& frame : next->stimulus.frames)
-            for (const std::string& o : frame.overrides)
+            for (const std::string& o : frame.override_texts())
                 EXPECT_NE(t.stimulus_json.find("\"" + json_escaped(o) + "\""), std::string::npos) << o;
         EXPECT_TRUE(t.response == "left" || t.response == "right") << t.response;
         // Two intervals of 0.5 s with 0.5 s between, then the model's answer.

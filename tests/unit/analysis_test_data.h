@@ -28,7 +28,7 @@ inline std::string stimulus_json(const protocols::Condition& c, const protocols:
     for (const p::Frame& fr : t.stimulus.frames)
         frames.push_back(Json{{"role", fr.role ? std::string(p::to_string(*fr.role)) : std::string("both")},
                               {"time_s", 0},
-                              {"overrides", fr.overrides}});
+                              {"overrides", fr.override_texts()}});
     Json views = Json::array();
     for (const p::StimulusView& v : t.stimulus.views)
         views.push_back(Json{{"frame", v.frame}, {"light", v.light}, {"role", p::to_string(v.role)}});

@@ -14,7 +14,7 @@
 #include "../store/store_test_support.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/display/calibration.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
@@ -394,7 +394,7 @@ TEST(CalibratePolicy, ProtocolDisplayNameAndMaximumAge) {
     EXPECT_EQ(named.display.name, "booth-2");
     EXPECT_EQ(named.display.max_calibration_age_days, 14.5);
     // Neither key becomes a scene override (the scene's [display] has no such keys).
-    for (const std::string& o : named.display_overrides()) EXPECT_EQ(o.find("name"), std::string::npos) << o;
+    for (const SceneOverride& o : named.display_overrides()) EXPECT_EQ(o.text().find("name"), std::string::npos) << o.text();
     auto error_key = [&](const std::string& keys) {
         try {
             protocols::parse_protocol(with_keys(keys), "p.toml");

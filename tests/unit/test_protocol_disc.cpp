@@ -52,16 +52,16 @@ TEST(ProtocolDisc, SideBySideMovesTheDiscAndSetsItsLuminance) {
     prop.test_on_left = true;
     Stimulus s = make_stimulus(p, c, prop);
     ASSERT_EQ(s.frames.size(), 1u);
-    EXPECT_TRUE(has(s.frames[0].overrides, "light.test.position_m=[-1, 0, -10]"));
-    EXPECT_TRUE(has(s.frames[0].overrides, "disc.plain.position_m=[1, 0, -10]"));
-    EXPECT_TRUE(has(s.frames[0].overrides, "disc.plain.luminance_cd_m2=10"));  // 10^1 cd/m²
+    EXPECT_TRUE(has(s.frames[0].override_texts(), "light.test.position_m=[-1, 0, -10]"));
+    EXPECT_TRUE(has(s.frames[0].override_texts(), "disc.plain.position_m=[1, 0, -10]"));
+    EXPECT_TRUE(has(s.frames[0].override_texts(), "disc.plain.luminance_cd_m2=10"));  // 10^1 cd/m²
     ASSERT_EQ(s.views.size(), 2u);
     EXPECT_EQ(s.views[0].light, "test");
     EXPECT_EQ(s.views[1].light, "plain");
     EXPECT_EQ(s.views[1].role, Role::Reference);
     prop.test_on_left = false;
     s = make_stimulus(p, c, prop);
-    EXPECT_TRUE(has(s.frames[0].overrides, "disc.plain.position_m=[-1, 0, -10]"));
+    EXPECT_TRUE(has(s.frames[0].override_texts(), "disc.plain.position_m=[-1, 0, -10]"));
     EXPECT_EQ(s.views[0].light, "plain");
 }
 

@@ -23,7 +23,7 @@
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/scene_file.h"
 
 namespace {
@@ -213,7 +213,7 @@ Rendered render_stimulus(const ToyScene& base, const Stimulus& stimulus, Task ta
     Rendered r;
     std::vector<ToyScene> scenes;
     for (const Frame& f : stimulus.frames) {
-        scenes.push_back(toy_with(base, f.overrides));
+        scenes.push_back(toy_with(base, f.override_texts()));
         r.images.push_back(toy_render(scenes.back()));
     }
     r.shown.task = task;
@@ -334,12 +334,12 @@ TEST(ProtocolExamples, TheSceneTakesEveryConditionsOverrides) {
                 for (const Frame& f : s.frames) {
                     try {
                         try {
-                            load(p.scene, f.overrides, true);
+                            load(p.scene, f.override_texts(), true);
                         } catch (const atonlab::InputError& e) {
                             const bool tonemap_not_yet = e.where() && e.where()->key.starts_with("tonemap") &&
                                                          e.message().find("not available yet") != std::string::npos;
                             if (!tonemap_not_yet) throw;
-                            load(p.scene, f.overrides, false);
+                            load(p.scene, f.override_texts(), false);
                         }
                     } catch (const atonlab::InputError& e) {
                         ADD_FAILURE() << e.what();
@@ -360,11 +360,11 @@ TEST(ProtocolExamples, StimuliFollowThePresentation) {
     EXPECT_EQ(s.frames[0].role, Role::Reference);
     EXPECT_EQ(s.frames[1].role, Role::Test);
     EXPECT_EQ(s.scene_value, 100.0);
-    const auto& ref = s.frames[0].overrides;
+    const auto& ref = s.frames[0].override_texts();
     EXPECT_EQ(ref.front(), "display.width_px=1920");
     EXPECT_EQ(ref.back(), "light.reference.intensity_cd=100");
     EXPECT_NE(std::find(ref.begin(), ref.end(), "eye.glare=\"none\""), ref.end());
-    const auto& test = s.frames[1].overrides;
+    const auto& test = s.frames[1].override_texts();
     EXPECT_NE(std::find(test.begin(), test.end(), "eye.glare=\"wave-optics\""), test.end());
     EXPECT_EQ(std::find(test.begin(), test.end(), "light.reference.intensity_cd=100"), test.end());
     ASSERT_EQ(s.views.size(), 2u);
@@ -555,7 +555,7 @@ procedure = { kind = "weighted-staircase", start = 2.0, target = 0.75, step_size
     Stimulus s = make_stimulus(p, c, prop);
     ASSERT_EQ(s.frames.size(), 1u);
     EXPECT_FALSE(s.frames[0].role.has_value());
-    const auto& o = s.frames[0].overrides;
+    const auto& o = s.frames[0].override_texts();
     EXPECT_NE(std::find(o.begin(), o.end(), "light.red.position_m=[-10, 3, -500]"), o.end());
     EXPECT_NE(std::find(o.begin(), o.end(), "light.white.position_m=[10, 3, -500]"), o.end());
     EXPECT_NE(std::find(o.begin(), o.end(), "light.white.intensity_cd=10"), o.end());
@@ -563,9 +563,8 @@ procedure = { kind = "weighted-staircase", start = 2.0, target = 0.75, step_size
     EXPECT_EQ(s.views[1].light, "white");
     prop.test_on_left = false;
     s = make_stimulus(p, c, prop);
-    EXPECT_NE(
-        std::find(s.frames[0].overrides.begin(), s.frames[0].overrides.end(), "light.red.position_m=[10, 3, -500]"),
-        s.frames[0].overrides.end());
+    const std::vector<std::string> swapped = s.frames[0].override_texts();
+    EXPECT_NE(std::find(swapped.begin(), swapped.end(), "light.red.position_m=[10, 3, -500]"), swapped.end());
     EXPECT_EQ(s.views[0].light, "white");
     EXPECT_EQ(make_track(c, 0, 1)->kind(), "2afc");
 }
@@ -704,7 +703,7 @@ TEST(ProtocolConflicts, SideBySideTestAndReferenceSetsMustAgree) {
     prop.level = 0.5;
     prop.test_on_left = true;
     const Stimulus stimulus = make_stimulus(p, c, prop);
-    const auto& o = stimulus.frames[0].overrides;
+    const auto& o = stimulus.frames[0].override_texts();
     EXPECT_NE(std::find(o.begin(), o.end(), "light.t.glare=\"wave-optics\""), o.end());
     EXPECT_NE(std::find(o.begin(), o.end(), "light.r.glare=\"none\""), o.end());
     // Equal values are not a conflict (numbers compare as numbers).
@@ -741,7 +740,7 @@ TEST(ProtocolConflicts, DefaultsAndRoleListsReplaceByDesign) {
         // The test's frame (the only frame side by side): the last pupil_mm is the block's in side-by-side; in a
         // two-interval test frame the role's list replaces `set` (the default's 3).
         std::string last;
-        for (const std::string& o : s.frames[0].overrides)
+        for (const std::string& o : s.frames[0].override_texts())
             if (o.starts_with("eye.pupil_mm=")) last = o;
         if (presentation == "side-by-side") {
             EXPECT_EQ(last, "eye.pupil_mm=5");
@@ -881,7 +880,7 @@ struct ToyCondition {
         prop.test_on_left = true;
         const Stimulus s = make_stimulus(protocol, condition, prop);
         for (const StimulusView& v : s.views)
-            if (v.role == role) return {toy_with(base, s.frames[v.frame].overrides), v.light};
+            if (v.role == role) return {toy_with(base, s.frames[v.frame].override_texts()), v.light};
         throw std::runtime_error("no view");
     }
     DisplayedImage image(double level, Role role) const { return toy_render(view(level, role).first); }
@@ -1142,7 +1141,8 @@ TEST(ConditionsFile, TheCsvExampleGivesTheSameScheduleAsItsTomlTwin) {
             EXPECT_EQ(ta->proposal.test_on_left, tb->proposal.test_on_left);
             ASSERT_EQ(ta->stimulus.frames.size(), tb->stimulus.frames.size());
             for (std::size_t f = 0; f < ta->stimulus.frames.size(); ++f) {
-                EXPECT_EQ(ta->stimulus.frames[f].overrides, tb->stimulus.frames[f].overrides) << "trial " << n;
+                EXPECT_EQ(ta->stimulus.frames[f].override_texts(), tb->stimulus.frames[f].override_texts())
+                    << "trial " << n;
             }
             EXPECT_EQ(a.state(), b.state());
             const Response r = random_response(ta->task, rng);
@@ -1205,6 +1205,85 @@ conditions_file = "c.csv"
         EXPECT_EQ(std::string(e.what()).rfind((dir / "c.csv").string() + ":1: column 2 'colour': not a column", 0), 0u)
             << e.what();
     }
+    fs::remove_all(dir);
+}
+
+// Every override of a frame carries where it was written (the scene loader
+// names a refused value there): a condition's own at its string's line and
+// column, the display at its [display] lines, the level and the side-by-side
+// positions (which the protocol makes) at the condition's line, and a
+// conditions file's at its row and column.
+TEST(ProtocolOverrides, EachFramesOverridesCarryWhereTheyWereWritten) {
+    const std::string body = R"(
+[[block]]
+name = "b"
+
+[[block.condition]]
+name = "glare"
+task = "2afc"
+presentation = "side-by-side"
+test_light = "t"
+reference_light = "r"
+left_position_m = [-1, 0, -10]
+right_position_m = [1, 0, -10]
+level_key = "light.r.intensity_cd"
+set = ["eye.glare=\"none\"", "eye.adaptation_cd_m2=0.01"]
+procedure = { kind = "staircase", start = 1.0, step_sizes = [0.1], step_type = "lin", n_reversals = 4 }
+)";
+    const std::string text = std::string(kHeader) + body;
+    const Protocol p = parse(body);
+    const Condition& c = p.blocks[0].conditions[0];
+    const Stimulus s = make_stimulus(p, c, Proposal{1.0, true});
+    ASSERT_EQ(s.frames.size(), 1u);
+    const auto line = [&](const std::string& needle) {
+        const auto at = text.find(needle);
+        EXPECT_NE(at, std::string::npos) << needle;
+        return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+    };
+    std::map<std::string, atonlab::SourceLocation> origin;
+    for (const Override& o : s.frames[0].overrides) origin[o.key] = o.origin;
+    for (const char* key : {"width_px", "height_px", "width_m", "viewing_distance_m"}) {
+        const atonlab::SourceLocation& w = origin["display." + std::string(key)];
+        EXPECT_EQ(w.file, "inline.toml") << key;
+        EXPECT_EQ(w.line, line(std::string(key) + " = ")) << key;
+    }
+    const atonlab::SourceLocation& glare = origin["eye.glare"];
+    EXPECT_EQ(glare.file, "inline.toml");
+    EXPECT_EQ(glare.line, line("set = [\"eye.glare"));
+    EXPECT_EQ(glare.column, static_cast<int>(std::string("set = [").size()) + 1);
+    EXPECT_EQ(glare.key, "block[0].condition[0].set[0]");
+    EXPECT_EQ(origin["eye.adaptation_cd_m2"].key, "block[0].condition[0].set[1]");
+    EXPECT_GT(origin["eye.adaptation_cd_m2"].column, glare.column);
+    for (const char* made : {"light.r.intensity_cd", "light.t.position_m", "light.r.position_m"}) {
+        EXPECT_EQ(origin[made].file, "inline.toml") << made;
+        EXPECT_EQ(origin[made].line, c.line) << made;
+        EXPECT_FALSE(origin[made].from_command_line()) << made;
+    }
+    EXPECT_EQ(c.line, line("[[block.condition]]"));
+
+    // A conditions file's override: its CSV row and column.
+    const fs::path dir = fs::temp_directory_path() / "atonlab-override-origin-test";
+    fs::create_directories(dir);
+    {
+        std::ofstream(dir / "scene.toml") << "";
+        std::ofstream(dir / "c.csv") << "name,eye.adaptation_cd_m2\n"
+                                        "a,0.1\n";
+        std::ofstream(dir / "p.toml") << std::string(kHeader) + R"(
+[defaults]
+task = "2afc"
+level_key = "light.r.intensity_cd"
+procedure = { kind = "staircase", start = 1.0, step_sizes = [0.1], step_type = "lin", n_reversals = 4 }
+
+[[block]]
+conditions_file = "c.csv"
+)";
+    }
+    const Protocol from_csv = load_protocol(dir / "p.toml");
+    const std::vector<Override>& set = from_csv.blocks.at(0).conditions.at(0).set;
+    ASSERT_EQ(set.size(), 1u);
+    EXPECT_EQ(set[0].origin.file, (dir / "c.csv").string());
+    EXPECT_EQ(set[0].origin.line, 2);
+    EXPECT_EQ(set[0].origin.column, 2);
     fs::remove_all(dir);
 }
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "atonlab/display/colour.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
 #include "atonlab/stimuli/scene_file.h"
@@ -838,6 +838,78 @@ TEST(SceneTemplate, EachInstantiationStartsFromTheFileAndKeepsItsLines) {
         EXPECT_EQ(e.where()->line, line_of(bad, "pupil_mm = -1")) << e.what();
         EXPECT_EQ(e.where()->key, "eye.pupil_mm") << e.what();
     }
+}
+
+// The template is parsed once and every scene is made from its one tree: the
+// overrides' changes (a value replaced, a key of an exclusive group erased, a
+// table made) are undone after each scene, made or refused, and the restored
+// values keep the file's lines.
+TEST(SceneTemplate, OverridesAreUndoneAndTheRestoredValuesKeepTheirLines) {
+    const SceneTemplate t = SceneTemplate::parse(kFullScene, kFile);
+    const Scene fresh = parse_scene(kFullScene, kFile);  // a second, independent parse
+
+    const Scene changed = t.instantiate(sets({"light.buoy.xy=[0.3, 0.3]",  // erases colour
+                                              "light[1].colour=\"green\"",  // erases xy
+                                              "profiles.vertical.extra.elevation_deg=[-90, 90]",  // new tables
+                                              "profiles.vertical.extra.relative=[1, 1]",
+                                              "light.buoy.vertical_profile=\"extra\"", "eye.pupil_mm=3"}));
+    EXPECT_NE(changed.lights[0].rgb_per_cd, fresh.lights[0].rgb_per_cd);
+    EXPECT_NE(changed.lights[1].rgb_per_cd, fresh.lights[1].rgb_per_cd);
+    EXPECT_EQ(changed.glare.pupil_mm, 3.0);
+
+    const Scene plain = t.instantiate();
+    ASSERT_EQ(plain.lights.size(), fresh.lights.size());
+    for (std::size_t i = 0; i < fresh.lights.size(); ++i) {
+        EXPECT_EQ(plain.lights[i].rgb_per_cd, fresh.lights[i].rgb_per_cd) << i;
+        EXPECT_EQ(plain.lights[i].vertical_profile, fresh.lights[i].vertical_profile) << i;
+    }
+    EXPECT_EQ(plain.profiles.vertical.size(), fresh.profiles.vertical.size());
+    EXPECT_FALSE(plain.glare.pupil_mm.has_value());
+
+    // The erased and restored values are the file's nodes, with their lines.
+    const auto replaced_at = [&](const char* set, const char* written) {
+        try {
+            (void)t.instantiate(sets({set}));
+            ADD_FAILURE() << "no InputError for " << set;
+        } catch (const InputError& e) {
+            const std::string at = std::string(kFile) + ":" + std::to_string(line_of(kFullScene, written));
+            EXPECT_NE(std::string(e.what()).find("like the value it replaces (" + at + ")"), std::string::npos)
+                << e.what();
+        }
+    };
+    replaced_at("light.buoy.colour=5", "colour = \"red\"");
+    replaced_at("light[1].xy=\"white\"", "xy = [0.3127, 0.3290]");
+
+    // A refused override list leaves the tree as the file has it too.
+    EXPECT_THROW((void)t.instantiate(sets({"profiles.vertical.more.relative=[1]", "light.buoy.vertical_profile=\"more\"",
+                                           "camera.nope=1"})),
+                 InputError);
+    const Scene after_error = t.instantiate();
+    EXPECT_EQ(after_error.profiles.vertical.size(), fresh.profiles.vertical.size());
+    EXPECT_EQ(after_error.lights[0].vertical_profile, fresh.lights[0].vertical_profile);
+}
+
+// An override carries where it was written: a value a protocol's line gave is
+// named at that line, whether the override itself is refused or the value it
+// gave is refused later by the schema. The command line's is "--set KEY".
+TEST(SceneOverrides, AnOverrideWrittenInAFileIsNamedAtItsLine) {
+    const atonlab::SourceLocation study{"study.toml", 12, 7, "block[0].condition[0].set[0]"};
+    const auto at_study = [&](const char* key, const char* value) { return SceneOverride{key, value, study}; };
+    for (const SceneOverride& o : {at_study("eye.glaer", "\"none\""), at_study("camera.fov_deg", "-5"),
+                                   at_study("camera.fov_deg", "\"wide\"")}) {
+        const InputError e = error_of(kMinimal, {o});
+        ASSERT_TRUE(e.where()) << e.what();
+        EXPECT_EQ(e.where()->file, "study.toml") << e.what();
+        EXPECT_EQ(e.where()->line, 12) << e.what();
+        EXPECT_EQ(e.where()->column, 7) << e.what();
+        EXPECT_EQ(e.where()->key, o.key) << e.what();
+        EXPECT_FALSE(e.where()->from_command_line()) << e.what();
+        EXPECT_EQ(std::string(e.what()).rfind("study.toml:12: key '" + o.key + "'", 0), 0u) << e.what();
+    }
+    const InputError cli = error_of(kMinimal, sets({"camera.fov_deg=-5"}));
+    ASSERT_TRUE(cli.where());
+    EXPECT_EQ(cli.where()->option, "--set");
+    EXPECT_EQ(cli.where()->key, "camera.fov_deg");
 }
 
 // Every unknown key of one table is reported in one run, not only the first.

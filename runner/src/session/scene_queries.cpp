@@ -31,9 +31,9 @@ const s::Disc* find_disc(const s::Scene& scene, std::string_view name) {
     return nullptr;
 }
 
-std::string judged_off_override(const s::Scene& scene, const std::string& name) {
-    if (find_disc(scene, name) && !find_light(scene, name)) return fmt::format("disc.{}.diameter_deg=0", name);
-    return fmt::format("light.{}.intensity_cd=0", name);
+SceneOverride judged_off_override(const s::Scene& scene, const std::string& name) {
+    if (find_disc(scene, name) && !find_light(scene, name)) return {fmt::format("disc.{}.diameter_deg", name), "0"};
+    return {fmt::format("light.{}.intensity_cd", name), "0"};
 }
 
 double brightest_moment_s(const s::Scene& scene, const std::vector<std::string>& lights, double interval_s) {

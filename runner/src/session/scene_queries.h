@@ -22,7 +22,7 @@ const stimuli::Disc* find_disc(const stimuli::Scene& scene, std::string_view nam
 
 /// The override that takes a judged light or disc out of a frame: a light dark,
 /// a disc of zero diameter (the background shows where it was).
-std::string judged_off_override(const stimuli::Scene& scene, const std::string& name);
+SceneOverride judged_off_override(const stimuli::Scene& scene, const std::string& name);
 
 /// The moment within [0, interval_s] at which the judged lights are brightest
 /// (their rhythms' summed level), so that a model observer looking at one

@@ -59,13 +59,11 @@ SessionInputs load_session_inputs(const RunOptions& o) {
     if (!o.script.empty()) in.script = p::ScriptedObserver::load(o.script);
     in.protocol_text = p::with_conditions_files(files::read_text(o.protocol, "protocol file"), o.protocol);
     in.protocol_sha = store::sha256_hex(in.protocol_text);
-    in.scene_file = in.protocol.scene;
-    in.scene_text = files::read_text(in.scene_file, "scene template");
-    // The template alone first: its own errors name its file and line.
-    std::vector<s::SceneOverride> display;
-    for (const std::string& d : in.protocol.display_overrides()) display.push_back(parsed_override(in.protocol, d));
-    in.display_scene = s::parse_scene(in.scene_text, in.scene_file.string(), display);
-    validate_conditions(in.protocol, in.scene_text, in.scene_file);
+    in.scene = s::SceneTemplate::parse(files::read_text(in.protocol.scene, "scene template"), in.protocol.scene.string());
+    // The template with the display first: its own errors name its file and
+    // line, the display's its [display] lines.
+    in.display_scene = in.scene->instantiate(in.protocol.display_overrides());
+    validate_conditions(in.protocol, *in.scene);
     return in;
 }
 

@@ -11,8 +11,9 @@
 #include "atonlab/common/input_text.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/scene.h"
+#include "atonlab/stimuli/scene_file.h"
 #include "commands.h"
 
 namespace atonlab::runner {
@@ -28,8 +29,9 @@ struct SessionInputs {
     /// comments: the study stores the whole design (protocol_file.h).
     std::string protocol_text;
     std::string protocol_sha;  ///< SHA-256 of protocol_text, hex
-    std::filesystem::path scene_file;
-    std::string scene_text;  ///< read once: a session renders the template as it was when it began
+    /// The scene file, read and parsed once: a session renders the template
+    /// as it was when it began.
+    std::optional<stimuli::SceneTemplate> scene;
     stimuli::Scene display_scene;  ///< the template with the protocol's [display]
 };
 

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <map>
 
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/display/tonemap.h"
@@ -24,10 +24,11 @@ namespace s = atonlab::stimuli;
 
 namespace {
 
-/// An override list as one cache key (each override ends in a newline).
-std::string overrides_key(const std::vector<std::string>& overrides) {
+/// An override list as one cache key (each "key=value" ends in a newline).
+/// Where an override was written does not change the scene it makes.
+std::string overrides_key(const std::vector<SceneOverride>& overrides) {
     std::string key;
-    for (const std::string& o : overrides) (key += o) += '\n';
+    for (const SceneOverride& o : overrides) (key += o.text()) += '\n';
     return key;
 }
 
@@ -86,10 +87,9 @@ void summarise_codes(const s::EncodedImage& codes, const s::EncodedImage* off, i
 
 }  // namespace
 
-StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
-                                   double interval_s, std::size_t cache_frames)
-    : scene_text_(std::move(scene_text)),
-      scene_file_(std::move(scene_file)),
+StimulusRenderer::StimulusRenderer(s::SceneTemplate scene_template, double window_radius_deg, double interval_s,
+                                   std::size_t cache_frames)
+    : template_(std::move(scene_template)),
       window_radius_deg_(window_radius_deg),
       interval_s_(interval_s),
       views_(cache_frames) {
@@ -98,13 +98,10 @@ StimulusRenderer::StimulusRenderer(std::string scene_text, std::filesystem::path
     pipeline_.set_frame_options(s::FrameOptions{});
 }
 
-std::shared_ptr<const s::Scene> StimulusRenderer::scene(const std::vector<std::string>& overrides) const {
+std::shared_ptr<const s::Scene> StimulusRenderer::scene(const std::vector<SceneOverride>& overrides) const {
     const std::string key = overrides_key(overrides);
     if (const auto* hit = scenes_.find(key)) return *hit;
-    std::vector<s::SceneOverride> parsed;
-    parsed.reserve(overrides.size());
-    for (const std::string& o : overrides) parsed.push_back(s::SceneOverride::parse(o));
-    s::Scene sc = s::parse_scene(scene_text_, scene_file_.string(), parsed);
+    s::Scene sc = template_.instantiate(overrides);
     if (display_model_) apply_display_model(sc, *display_model_);
     s::validate_output_settings(sc.output);
     ++parsed_;
@@ -166,17 +163,17 @@ void StimulusRenderer::present(int x, int y) const {
     pipeline_.present(x, y);
 }
 
-std::vector<std::string> StimulusRenderer::light_names(const std::vector<std::string>& overrides) const {
+std::vector<std::string> StimulusRenderer::light_names(const std::vector<SceneOverride>& overrides) const {
     std::vector<std::string> names;
     for (const s::Light& l : scene(overrides)->lights) names.push_back(l.name);
     return names;
 }
 
-std::vector<std::string> StimulusRenderer::all_off(const std::vector<std::string>& overrides) const {
+std::vector<SceneOverride> StimulusRenderer::all_off(const std::vector<SceneOverride>& overrides) const {
     const auto sc = scene(overrides);
-    std::vector<std::string> off;
-    for (const s::Light& l : sc->lights) off.push_back(fmt::format("light.{}.intensity_cd=0", l.name));
-    for (const s::Disc& d : sc->discs) off.push_back(fmt::format("disc.{}.diameter_deg=0", d.name));
+    std::vector<SceneOverride> off;
+    for (const s::Light& l : sc->lights) off.push_back(judged_off_override(*sc, l.name));
+    for (const s::Disc& d : sc->discs) off.push_back(judged_off_override(*sc, d.name));
     return off;
 }
 

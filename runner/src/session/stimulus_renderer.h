@@ -19,6 +19,7 @@
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/scene.h"
+#include "atonlab/stimuli/scene_file.h"
 #include "session/lru_cache.h"
 
 namespace atonlab::runner {
@@ -46,21 +47,20 @@ struct FrameViews {
 
 class StimulusRenderer {
 public:
-    /// scene_text: the scene template's text (read once: a session renders the
-    /// file as it was when it began); scene_file resolves its relative paths and
-    /// names it in errors. window_radius_deg: the radius (degrees of visual
+    /// scene_template: the scene file, read and parsed once (a session renders
+    /// the file as it was when it began). window_radius_deg: the radius (degrees of visual
     /// angle) around a light that the observer looks at; the windows kept are
     /// 2 × that (the yes-no annulus) plus a margin. interval_s: how long a frame
     /// is shown (a frame is rendered at the moment in it when its judged light
     /// is brightest). Needs a current GL 4.5 context.
-    StimulusRenderer(std::string scene_text, std::filesystem::path scene_file, double window_radius_deg,
-                     double interval_s, std::size_t cache_frames = 4096);
+    StimulusRenderer(stimuli::SceneTemplate scene_template, double window_radius_deg, double interval_s,
+                     std::size_t cache_frames = 4096);
 
     /// The scene a frame's overrides give. Throws InputError (the scene's own
-    /// errors, or "--set KEY" for an override). Each distinct override list is
-    /// parsed once (a small LRU of scenes): a trial asks for its scenes from
+    /// errors, or an override's at its origin). Each distinct override list is
+    /// applied to the template once (a small LRU of scenes): a trial asks for its scenes from
     /// views(), codes(), animated(), encode() and the backgrounds.
-    std::shared_ptr<const stimuli::Scene> scene(const std::vector<std::string>& overrides) const;
+    std::shared_ptr<const stimuli::Scene> scene(const std::vector<SceneOverride>& overrides) const;
 
     /// The frame seen around `lights` (scene light names; "" = the screen's
     /// centre), from the cache or rendered.
@@ -86,10 +86,10 @@ public:
     /// Draws the codes encode() made into the bound framebuffer, lower-left corner at (x, y).
     void present(int x, int y) const;
     /// The names of the scene's lights (the template with the display).
-    std::vector<std::string> light_names(const std::vector<std::string>& overrides) const;
+    std::vector<std::string> light_names(const std::vector<SceneOverride>& overrides) const;
     /// The overrides that take every light and disc of the scene out (lights
     /// dark, discs of zero diameter): what surrounds the stimuli.
-    std::vector<std::string> all_off(const std::vector<std::string>& overrides) const;
+    std::vector<SceneOverride> all_off(const std::vector<SceneOverride>& overrides) const;
 
     /// Encode every frame for this display model instead of the scene's (the
     /// display's measured calibration: calibration_policy.h). Set before the first frame.
@@ -100,7 +100,7 @@ public:
 
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
-    /// How many times the scene template was parsed with a frame's overrides.
+    /// How many times the scene template was instantiated with a frame's overrides.
     std::size_t scenes_parsed() const noexcept { return parsed_; }
     /// Wall-clock seconds spent rendering and reading frames back.
     double render_seconds() const noexcept { return render_s_; }
@@ -116,8 +116,7 @@ private:
     const stimuli::EncodedImage& background_codes(const protocols::Frame& frame, const std::vector<std::string>& lights,
                                                   double time_s);
 
-    std::string scene_text_;
-    std::filesystem::path scene_file_;
+    stimuli::SceneTemplate template_;
     std::optional<display::DisplayModel> display_model_;  ///< use_display_model()
     double window_radius_deg_;
     double interval_s_;

@@ -42,7 +42,7 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
         Json frame;
         frame["role"] = fr.role ? std::string(p::to_string(*fr.role)) : std::string("both");
         frame["time_s"] = f < frame_times.size() ? frame_times[f] : 0.0;
-        frame["overrides"] = fr.overrides;
+        frame["overrides"] = fr.override_texts();
         frames.push_back(std::move(frame));
     }
     j["frames"] = std::move(frames);

@@ -7,9 +7,10 @@
 // them, the schedule (protocol_schedule.h) runs them.
 //
 // A condition never touches the scene itself: it produces scene overrides
-// ("section.key=value", the value in TOML syntax, exactly what `atonlab render
-// --set` takes; docs/scene-file.md "Overrides with --set"), so this library
-// needs neither the stimuli library nor GL.
+// (common/scene_override.h: "section.key=value", the value in TOML syntax,
+// exactly what `atonlab render --set` takes, with the line that wrote it;
+// docs/scene-file.md "Overrides with --set"), so this library needs neither
+// the stimuli library nor GL.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "atonlab/common/input_error.h"  // bad input: InputError, as every library's
+#include "atonlab/common/scene_override.h"
 #include "atonlab/protocols/procedures.h"
 
 namespace atonlab::protocols {
@@ -65,15 +67,10 @@ enum class ProcedureKind : std::uint8_t { Staircase, WeightedStaircase, Quest, A
 std::string_view to_string(ProcedureKind k) noexcept;
 std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcept;
 
-/// One scene override, "key=value" with a TOML value, and where the protocol wrote it.
-struct Override {
-    std::string key;    ///< dotted scene key, e.g. "eye.glare", "light.reference.intensity_cd"
-    std::string value;  ///< TOML value text, e.g. "\"none\"", "120", "[0.0, 3.0, -500.0]"
-    int line = 0;       ///< line in the protocol file (0: made by the program)
-    int column = 0;
-    /// "key=value", as `atonlab render --set` and stimuli::SceneOverride::parse take it.
-    std::string text() const { return key + "=" + value; }
-};
+/// One scene override, "key=value" with a TOML value, and where the protocol
+/// wrote it (origin: the file, line and key path "block[0].condition[1].set[0]",
+/// or a conditions file's row and column).
+using Override = ::atonlab::SceneOverride;
 
 /// A procedure and its parameters, 1:1 the procedures' parameter structs.
 using ProcedureParams =
@@ -183,7 +180,8 @@ struct Display {
     std::optional<double> max_calibration_age_days;
     /// The line of each key in the protocol file ("viewing_distance_m" -> 9),
     /// so that a limit the scene derives from them (a glare billboard too wide
-    /// for the display) names the protocol's lines.
+    /// for the display) names the protocol's lines; a key without a line was
+    /// given on the command line (`atonlab check --set`).
     std::map<std::string, int> lines;
 };
 
@@ -268,8 +266,10 @@ struct Protocol {
 
     /// The condition called `name`, or nullptr.
     const Condition* find_condition(std::string_view name) const;
-    /// The display as scene overrides ("display.width_px=1920", ...).
-    std::vector<std::string> display_overrides() const;
+    /// The display as scene overrides ("display.width_px=1920", ...), each at
+    /// its [display] line: a limit the scene derives from the display (a glare
+    /// billboard too wide for it) names the protocol's line.
+    std::vector<Override> display_overrides() const;
 };
 
 /// Track `track` of a condition's procedure: the procedure built from its
@@ -284,10 +284,14 @@ std::unique_ptr<Procedure> make_track(const Condition& condition, std::size_t tr
 /// seeds) but interleaves all the tracks of a block together.
 std::unique_ptr<Procedure> make_procedure(const Condition& condition, std::uint64_t seed);
 
-/// One frame to render: the scene overrides in the order they apply.
+/// One frame to render: the scene overrides in the order they apply, each
+/// with where it was written (the level and the side-by-side positions: the
+/// condition's line).
 struct Frame {
     std::optional<Role> role;  ///< whose frame it is; nullopt: side-by-side (both)
-    std::vector<std::string> overrides;
+    std::vector<Override> overrides;
+    /// The overrides as "key=value" text, in order (what the study file stores).
+    std::vector<std::string> override_texts() const;
 };
 
 /// One light the observer judges: in which frame and which scene light.

@@ -6,30 +6,22 @@
 #include <string_view>
 #include <vector>
 
-#include "atonlab/stimuli/error.h"
+#include "atonlab/common/input_error.h"
+#include "atonlab/common/scene_override.h"
 #include "atonlab/stimuli/scene.h"
 
 namespace atonlab::stimuli {
 
-/// A command-line override "section.key=value" (value in TOML syntax: 250,
-/// 1.5, "red", [0, 2, -100], true). Keys inside the [[light]] array are named
-/// "light.NAME.key" (by the light's name) or "light[INDEX].key".
-struct SceneOverride {
-    std::string key;
-    std::string value;
-    /// Where the value was written when it comes from a file (a protocol's
-    /// [display] key): errors about the value then name that file and line.
-    /// Empty file: the command line, and errors name "--set KEY".
-    SourceLocation origin;
-    /// Parses "key=value"; throws InputError for a missing '=' or an empty key.
-    static SceneOverride parse(std::string_view text);
-};
+/// An override "section.key=value" (value in TOML syntax: 250, 1.5, "red",
+/// [0, 2, -100], true) and where it was written (common/scene_override.h).
+/// Keys inside the [[light]] array are named "light.NAME.key" (by the light's
+/// name) or "light[INDEX].key"; [[disc]] likewise.
+using SceneOverride = ::atonlab::SceneOverride;
 
-/// A scene file read once (its TOML syntax checked), from which scenes are
-/// made with different overrides: a protocol's conditions change a few keys of
-/// one template per frame. Copies share the text, which never changes. (Each
-/// instantiate() still parses the text: toml++ drops source lines when a tree
-/// is copied, and errors must name the file's lines.)
+/// A scene file read and parsed once, from which scenes are made with
+/// different overrides: a protocol's conditions change a few keys of one
+/// template per frame. Copies share the parsed file; instantiate() may be
+/// called from several threads (one at a time makes its scene).
 class SceneTemplate {
 public:
     /// Parses `toml_text` (file_label names it in errors). Throws InputError
