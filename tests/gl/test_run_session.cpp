@@ -324,7 +324,9 @@ TEST_F(run, KilledTwentyTimesEachResumeContinuesTheUninterruptedSequence) {
 
 TEST_F(run, SigtermQuitsBetweenTrialsAndTheSessionContinues) {
     const pid_t pid = spawn(db(), {"--progress-every", "1"}, out(), err());
-    for (int i = 0; i < 600 && last_reported(out()) < 3; ++i)
+    // Up to 60 s for the third trial: an ASan build on 2 busy cores takes
+    // over 6 s to begin (the load-time checks render every condition).
+    for (int i = 0; i < 6000 && last_reported(out()) < 3; ++i)
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     kill(pid, SIGTERM);
     const int code = wait_for(pid);
