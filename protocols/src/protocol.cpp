@@ -161,7 +161,7 @@ std::span<const Action> task_actions(Task t) noexcept {
 
 ResponseMap ResponseMap::defaults() {
     ResponseMap m;
-    auto set = [&m](Action a, std::vector<std::string> keys) { m.keys[static_cast<std::size_t>(a)] = std::move(keys); };
+    auto set = [&m](Action a, std::vector<std::string> names) { m.keys[static_cast<std::size_t>(a)] = std::move(names); };
     set(Action::Left, {"left"});
     set(Action::Right, {"right"});
     set(Action::Yes, {"y"});
@@ -303,9 +303,10 @@ std::vector<Override> Protocol::display_overrides() const {
     const auto at_line = [&](const std::string& key, std::string value) {
         const std::string scene_key = "display." + key;
         const auto it = display.lines.find(key);
-        return Override{scene_key, std::move(value),
-                        it == display.lines.end() ? SourceLocation::command_line("--set", scene_key)
-                                                  : SourceLocation{file, it->second, 0, scene_key}};
+        SourceLocation origin = it == display.lines.end()
+                                    ? SourceLocation::command_line(std::string(Override::kSetOption), scene_key)
+                                    : SourceLocation{file, it->second, 0, scene_key};
+        return Override{scene_key, std::move(value), std::move(origin)};
     };
     return {at_line("width_px", fmt::format("{}", display.width_px)),
             at_line("height_px", fmt::format("{}", display.height_px)),
@@ -368,7 +369,8 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
     s.scene_value = condition.scene_value(proposal.level);
     // The values the protocol makes for the condition stand at its line.
     const auto made = [&](std::string key, std::string value, std::string_view from) {
-        return Override{std::move(key), std::move(value), SourceLocation{protocol.file, condition.line, 0, std::string(from)}};
+        return Override{std::move(key), std::move(value),
+                        SourceLocation{protocol.file, condition.line, 0, std::string(from)}};
     };
     const Override level_override = made(condition.level_key, number_text(s.scene_value), "level_key");
     const bool test_first = proposal.test_on_left.value_or(true);
@@ -414,8 +416,9 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
                                        position_text(test_first ? left : right), test_first ? left_key : right_key));
             // A reference disc moves like a light (scene.h Disc: its centre's direction).
             const char* reference_table = condition.reference_disc.empty() ? "light" : "disc";
-            f.overrides.push_back(made(fmt::format("{}.{}.position_m", reference_table, condition.judged(Role::Reference)),
-                                       position_text(test_first ? right : left), test_first ? right_key : left_key));
+            f.overrides.push_back(
+                made(fmt::format("{}.{}.position_m", reference_table, condition.judged(Role::Reference)),
+                     position_text(test_first ? right : left), test_first ? right_key : left_key));
             s.frames.push_back(std::move(f));
             const Role left_role = test_first ? Role::Test : Role::Reference;
             const Role right_role = test_first ? Role::Reference : Role::Test;

@@ -881,8 +881,8 @@ TEST(SceneTemplate, OverridesAreUndoneAndTheRestoredValuesKeepTheirLines) {
     replaced_at("light[1].xy=\"white\"", "xy = [0.3127, 0.3290]");
 
     // A refused override list leaves the tree as the file has it too.
-    EXPECT_THROW((void)t.instantiate(sets({"profiles.vertical.more.relative=[1]", "light.buoy.vertical_profile=\"more\"",
-                                           "camera.nope=1"})),
+    EXPECT_THROW((void)t.instantiate(sets({"profiles.vertical.more.relative=[1]",
+                                           "light.buoy.vertical_profile=\"more\"", "camera.nope=1"})),
                  InputError);
     const Scene after_error = t.instantiate();
     EXPECT_EQ(after_error.profiles.vertical.size(), fresh.profiles.vertical.size());
