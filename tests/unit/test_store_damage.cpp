@@ -170,22 +170,20 @@ TEST(StoreDamage, AFileShorterThanItsHeaderWithTheRestInItsWalOpens) {
     // the header's are left from before the -wal last restarted.
     const std::string wal = file_bytes(path.string() + "-wal");
     ASSERT_GT(wal.size(), 32u);
-    const auto be32 = [&](std::size_t at) {
-        return (std::uint32_t{static_cast<unsigned char>(wal[at])} << 24) |
-               (std::uint32_t{static_cast<unsigned char>(wal[at + 1])} << 16) |
-               (std::uint32_t{static_cast<unsigned char>(wal[at + 2])} << 8) |
-               std::uint32_t{static_cast<unsigned char>(wal[at + 3])};
+    const auto be32_of = [](const std::string& bytes, std::size_t at) {
+        return (std::uint32_t{static_cast<unsigned char>(bytes[at])} << 24) |
+               (std::uint32_t{static_cast<unsigned char>(bytes[at + 1])} << 16) |
+               (std::uint32_t{static_cast<unsigned char>(bytes[at + 2])} << 8) |
+               std::uint32_t{static_cast<unsigned char>(bytes[at + 3])};
     };
+    const auto be32 = [&](std::size_t at) { return be32_of(wal, at); };
     const std::size_t page = be32(8);
     std::string page1;
     for (std::size_t at = 32; at + 24 + page <= wal.size(); at += 24 + page)
         if (be32(at) == 1 && be32(at + 8) == be32(16) && be32(at + 12) == be32(20)) page1 = wal.substr(at + 24, page);
     ASSERT_EQ(page1.size(), page) << "the -wal holds no page 1";
     write_bytes(path, 0, page1);
-    const std::uint32_t header_pages = (std::uint32_t{static_cast<unsigned char>(page1[28])} << 24) |
-                                       (std::uint32_t{static_cast<unsigned char>(page1[29])} << 16) |
-                                       (std::uint32_t{static_cast<unsigned char>(page1[30])} << 8) |
-                                       std::uint32_t{static_cast<unsigned char>(page1[31])};
+    const std::uint32_t header_pages = be32_of(page1, 28);
     ASSERT_LT(fs::file_size(path), std::uintmax_t{header_pages} * page) << "the file should be shorter than its header";
 
     { Store reopened = Store::open_existing(path); }  // not refused; SQLite completes the checkpoint

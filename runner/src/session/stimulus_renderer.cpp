@@ -172,8 +172,8 @@ std::vector<std::string> StimulusRenderer::light_names(const std::vector<SceneOv
 std::vector<SceneOverride> StimulusRenderer::all_off(const std::vector<SceneOverride>& overrides) const {
     const auto sc = scene(overrides);
     std::vector<SceneOverride> off;
-    for (const s::Light& l : sc->lights) off.push_back(judged_off_override(*sc, l.name));
-    for (const s::Disc& d : sc->discs) off.push_back(judged_off_override(*sc, d.name));
+    for (const s::Light& l : sc->lights) off.push_back({fmt::format("light.{}.intensity_cd", l.name), "0"});
+    for (const s::Disc& d : sc->discs) off.push_back({fmt::format("disc.{}.diameter_deg", d.name), "0"});
     return off;
 }
 
