@@ -19,9 +19,23 @@
 //    Kannampuzha/LED-Acid_Fly_Research, CIE_std_illum_D65.csv. Its 5 nm values were cross-checked
 //    against the 5 nm D65 table in google/filament tools/specular-color/src/main.cpp (all 107 agree).
 //
-// The checks that a transcription error would fail live in tests/unit/test_colour.cpp (suite CieTables):
+// 3. CIE 1951 scotopic spectral luminous efficiency V'(lambda), 380..780 nm in 1 nm steps, 1 at 507 nm
+//    (and at 506 and 508 nm, to the table's 3 decimals). Defined by CIE 1951 (Compte Rendu, 12th Session,
+//    Stockholm) on Wald (1945) and Crawford (1949); the 1 nm table is the one ISO 23539:2005/CIE S 010/E:2004
+//    gives and CVRL (cvrl.ioo.ucl.ac.uk, file "scvle_1") publishes.
+//    Transcribed from colour-science/colour, colour/colorimetry/datasets/lefs.py, DATA_LEFS_SCOTOPIC
+//    ("CIE 1951 Scotopic Standard Observer", cited there to CVRL), commit
+//    9d743142ed97a5cfae347b559aca14c43464eb70, by a script that read the file and wrote the rows below
+//    (values unchanged, reprinted in shortest form). Its 81 values at the 5 nm nodes were cross-checked value
+//    by value against CVRL's 5 nm "scvle.csv" as rrogge/meade-4000-filter stores it (commit
+//    2efd170f3a6abf8cb37731fbf7adb8e9f2b58d0b) and luxpy's CVRL copy (ksmet1977/luxpy,
+//    luxpy/data/cmfs/ciexyz_1951_20_scotopic.dat, commit d84a1e075ec5208f702954310d3fbb151219002a): all 81
+//    agree exactly.
+//
+// The checks that a transcription error would fail live in tests/display/test_colour.cpp (suite CieTables):
 // y-bar(555) = 1, D65(560) = 100, the 1 nm sums of x-bar, y-bar, z-bar (equal-energy white), D65's
-// linear-interpolation structure, spectral-locus chromaticities and the xy of D65.
+// linear-interpolation structure, spectral-locus chromaticities and the xy of D65; and, for V'(lambda), in
+// tests/display/test_mesopic.cpp (suite ScotopicTable): its peak, CIE's 5 nm values and its 1 nm sum.
 #include "cie_tables.h"
 
 #include <algorithm>
@@ -30,6 +44,7 @@
 #include <cstddef>
 
 #include "atonlab/display/colour.h"
+#include "atonlab/display/mesopic.h"
 
 namespace atonlab::display {
 namespace cie {
@@ -568,6 +583,51 @@ constexpr std::array<double, kD65Count> kCieD65 = {
     57.4406, 57.7278, 58.015, 58.3022, 58.5894, 58.8765, 59.1637, 59.4509, 59.7381, 60.0253,        // 820 nm
     60.3125,                                                                                        // 830 nm
 };
+
+// CIE 1951 V'(lambda); row starts at the commented wavelength, 10 values (1 nm apart) per row.
+constexpr std::array<double, kScotopicCount> kCie1951Scotopic = {
+    5.89e-4, 6.65e-4, 7.52e-4, 8.54e-4, 9.72e-4, 0.001108, 0.001268, 0.001453, 0.001668, 0.001918,   // 380 nm
+    0.002209, 0.002547, 0.002939, 0.003394, 0.003921, 0.00453, 0.00524, 0.00605, 0.00698, 0.00806,   // 390 nm
+    0.00929, 0.0107, 0.01231, 0.01413, 0.01619, 0.01852, 0.02113, 0.02405, 0.0273, 0.03089,          // 400 nm
+    0.03484, 0.03916, 0.0439, 0.049, 0.0545, 0.0604, 0.0668, 0.0736, 0.0808, 0.0885,                 // 410 nm
+    0.0966, 0.1052, 0.1141, 0.1235, 0.1334, 0.1436, 0.1541, 0.1651, 0.1764, 0.1879,                  // 420 nm
+    0.1998, 0.2119, 0.2243, 0.2369, 0.2496, 0.2625, 0.2755, 0.2886, 0.3017, 0.3149,                  // 430 nm
+    0.3281, 0.3412, 0.3543, 0.3673, 0.3803, 0.3931, 0.406, 0.418, 0.431, 0.443,                      // 440 nm
+    0.455, 0.467, 0.479, 0.49, 0.502, 0.513, 0.524, 0.535, 0.546, 0.557,                             // 450 nm
+    0.567, 0.578, 0.588, 0.599, 0.61, 0.62, 0.631, 0.642, 0.653, 0.664,                              // 460 nm
+    0.676, 0.687, 0.699, 0.71, 0.722, 0.734, 0.745, 0.757, 0.769, 0.781,                             // 470 nm
+    0.793, 0.805, 0.817, 0.828, 0.84, 0.851, 0.862, 0.873, 0.884, 0.894,                             // 480 nm
+    0.904, 0.914, 0.923, 0.932, 0.941, 0.949, 0.957, 0.964, 0.97, 0.976,                             // 490 nm
+    0.982, 0.986, 0.99, 0.994, 0.997, 0.998, 1, 1, 1, 0.998,                                         // 500 nm
+    0.997, 0.994, 0.99, 0.986, 0.981, 0.975, 0.968, 0.961, 0.953, 0.944,                             // 510 nm
+    0.935, 0.925, 0.915, 0.904, 0.892, 0.88, 0.867, 0.854, 0.84, 0.826,                              // 520 nm
+    0.811, 0.796, 0.781, 0.765, 0.749, 0.733, 0.717, 0.7, 0.683, 0.667,                              // 530 nm
+    0.65, 0.633, 0.616, 0.599, 0.581, 0.564, 0.548, 0.531, 0.514, 0.497,                             // 540 nm
+    0.481, 0.465, 0.448, 0.433, 0.417, 0.402, 0.3864, 0.3715, 0.3569, 0.3427,                        // 550 nm
+    0.3288, 0.3151, 0.3018, 0.2888, 0.2762, 0.2639, 0.2519, 0.2403, 0.2291, 0.2182,                  // 560 nm
+    0.2076, 0.1974, 0.1876, 0.1782, 0.169, 0.1602, 0.1517, 0.1436, 0.1358, 0.1284,                   // 570 nm
+    0.1212, 0.1143, 0.1078, 0.1015, 0.0956, 0.0899, 0.0845, 0.0793, 0.0745, 0.0699,                  // 580 nm
+    0.0655, 0.0613, 0.0574, 0.0537, 0.0502, 0.0469, 0.0438, 0.0409, 0.03816, 0.03558,                // 590 nm
+    0.03315, 0.03087, 0.02874, 0.02674, 0.02487, 0.02312, 0.02147, 0.01994, 0.01851, 0.01718,        // 600 nm
+    0.01593, 0.01477, 0.01369, 0.01269, 0.01175, 0.01088, 0.01007, 0.00932, 0.00862, 0.00797,        // 610 nm
+    0.00737, 0.00682, 0.0063, 0.00582, 0.00538, 0.00497, 0.00459, 0.00424, 0.003913, 0.003613,       // 620 nm
+    0.003335, 0.003079, 0.002842, 0.002623, 0.002421, 0.002235, 0.002062, 0.001903, 0.001757, 0.001621, // 630 nm
+    0.001497, 0.001382, 0.001276, 0.001178, 0.001088, 0.001005, 9.28e-4, 8.57e-4, 7.92e-4, 7.32e-4,  // 640 nm
+    6.77e-4, 6.26e-4, 5.79e-4, 5.36e-4, 4.96e-4, 4.59e-4, 4.25e-4, 3.935e-4, 3.645e-4, 3.377e-4,     // 650 nm
+    3.129e-4, 2.901e-4, 2.689e-4, 2.493e-4, 2.313e-4, 2.146e-4, 1.991e-4, 1.848e-4, 1.716e-4, 1.593e-4, // 660 nm
+    1.48e-4, 1.375e-4, 1.277e-4, 1.187e-4, 1.104e-4, 1.026e-4, 9.54e-5, 8.88e-5, 8.26e-5, 7.69e-5,   // 670 nm
+    7.15e-5, 6.66e-5, 6.2e-5, 5.78e-5, 5.38e-5, 5.01e-5, 4.67e-5, 4.36e-5, 4.06e-5, 3.789e-5,        // 680 nm
+    3.533e-5, 3.295e-5, 3.075e-5, 2.87e-5, 2.679e-5, 2.501e-5, 2.336e-5, 2.182e-5, 2.038e-5, 1.905e-5, // 690 nm
+    1.78e-5, 1.664e-5, 1.556e-5, 1.454e-5, 1.36e-5, 1.273e-5, 1.191e-5, 1.114e-5, 1.043e-5, 9.76e-6, // 700 nm
+    9.14e-6, 8.56e-6, 8.02e-6, 7.51e-6, 7.04e-6, 6.6e-6, 6.18e-6, 5.8e-6, 5.44e-6, 5.1e-6,           // 710 nm
+    4.78e-6, 4.49e-6, 4.21e-6, 3.951e-6, 3.709e-6, 3.482e-6, 3.27e-6, 3.07e-6, 2.884e-6, 2.71e-6,    // 720 nm
+    2.546e-6, 2.393e-6, 2.25e-6, 2.115e-6, 1.989e-6, 1.87e-6, 1.759e-6, 1.655e-6, 1.557e-6, 1.466e-6, // 730 nm
+    1.379e-6, 1.299e-6, 1.223e-6, 1.151e-6, 1.084e-6, 1.022e-6, 9.62e-7, 9.07e-7, 8.55e-7, 8.06e-7,  // 740 nm
+    7.6e-7, 7.16e-7, 6.75e-7, 6.37e-7, 6.01e-7, 5.67e-7, 5.35e-7, 5.05e-7, 4.77e-7, 4.5e-7,          // 750 nm
+    4.25e-7, 4.01e-7, 3.79e-7, 3.58e-7, 3.382e-7, 3.196e-7, 3.021e-7, 2.855e-7, 2.699e-7, 2.552e-7,  // 760 nm
+    2.413e-7, 2.282e-7, 2.159e-7, 2.042e-7, 1.932e-7, 1.829e-7, 1.731e-7, 1.638e-7, 1.551e-7, 1.468e-7, // 770 nm
+    1.39e-7,                                                                                         // 780 nm
+};
 // clang-format on
 
 // Where wavelength_nm falls in a table sampled every 1 nm from first_nm: the lower row and the
@@ -585,6 +645,13 @@ bool locate(double wavelength_nm, double first_nm, std::size_t count, std::size_
 std::span<const double> d65_table() { return kCieD65; }
 
 }  // namespace cie
+
+double cie1951_scotopic_efficiency(double wavelength_nm) {
+    std::size_t i = 0;
+    double f = 0.0;
+    if (!cie::locate(wavelength_nm, cie::kScotopicFirstNm, cie::kScotopicCount, i, f)) return 0.0;
+    return cie::kCie1951Scotopic[i] * (1.0 - f) + cie::kCie1951Scotopic[i + 1] * f;
+}
 
 Vec3 cie1931_cmf(double wavelength_nm) {
     std::size_t i = 0;
