@@ -224,6 +224,17 @@ Vec3 xyz_to_linear_rgb(Vec3 xyz) { return rec709_xyz_to_rgb() * xyz; }
 
 Vec3 linear_rgb_to_xyz(Vec3 rgb) { return rec709_rgb_to_xyz() * rgb; }
 
+Vec3 fit_to_gamut_keeping_luminance(Vec3 rgb, Vec3 w) {
+    for (int c = 0; c < 3; ++c) rgb[c] = rgb[c] > 0.0 ? rgb[c] : 0.0;  // NaN and negatives: black
+    const double y = glm::dot(w, rgb);
+    if (!(y < 1.0)) return Vec3(1.0);  // at or beyond white (or +inf)
+    const double m = std::max(rgb.r, std::max(rgb.g, rgb.b));
+    if (m <= 1.0) return rgb;
+    // m > 1 > y >= 0, so 0 <= t < 1; every channel stays >= y (1 - t) >= 0 and the largest is 1.
+    const double t = (1.0 - y) / (m - y);
+    return Vec3(y) + t * (rgb - Vec3(y));
+}
+
 double luminance_of_linear_rgb(Vec3 rgb) {
     // The Y row of eq 3.11 (glm is column-major: m[column][row]).
     const Mat3& m = rec709_rgb_to_xyz();

@@ -484,15 +484,22 @@ double dither_threshold(glm::ivec2 pixel, std::uint32_t frame, int channel, std:
     return static_cast<double>(phase >> 8) * 0x1p-24;
 }
 
+glm::dvec3 channel_weights(const DisplayModel& display) {
+    glm::dvec3 w(0.0);
+    for (int c = 0; c < 3; ++c) w[c] = display.channels[static_cast<std::size_t>(c)].max_cd_m2();
+    return w / (w.r + w.g + w.b);
+}
+
 glm::ivec3 encode_pixel(const DisplayModel& display, glm::dvec3 relative_rgb, glm::ivec2 pixel, std::uint32_t frame,
                         const EncodeSettings& settings) {
     check_bits(settings.bits);
     const int max_code = (1 << settings.bits) - 1;
+    // Luminance wins over chroma (docs/tone-mapping.md "Adding light never darkens").
+    const glm::dvec3 shown = fit_to_gamut_keeping_luminance(relative_rgb, channel_weights(display));
     glm::ivec3 code(0);
     for (int c = 0; c < 3; ++c) {
         const auto& ch = display.channels[static_cast<std::size_t>(c)];
-        double d = relative_rgb[c];
-        if (std::isnan(d)) d = 0.0;  // NaN is black (documented); negatives clip to black in drive_for
+        const double d = shown[c];
         const double v = ch.drive_for(d * ch.max_cd_m2());
         const double u = settings.dither == Dither::none ? 0.5 : dither_threshold(pixel, frame, c, settings.seed);
         const double q = std::floor(v * static_cast<double>(max_code) + u);

@@ -21,10 +21,6 @@ constexpr std::array<std::string_view, 6> kOperatorNames = {"empirical", "percep
                                                             "kakimoto",  "linear",     "clamp"};
 constexpr std::array<std::string_view, 3> kHueNames = {"none", "xyY", "rgb"};
 
-double max_component(glm::dvec3 v) {
-    return std::max(v.r, std::max(v.g, v.b));
-}
-
 // Rows of the Rec.709 RGB -> XYZ matrix (glm is column-major: m[col][row]).
 glm::dvec3 xyz_row(int row) {
     const Mat3& m = rec709_rgb_to_xyz();
@@ -194,6 +190,17 @@ double scotopic_luminance(glm::dvec3 xyz) {
     return std::max(y * (1.33 * (1.0 + ratio) - 1.68), 0.0);
 }
 
+glm::dvec3 scotopic_weights_rgb() {
+    // K2012 eq 4.25 at each Rec.709 primary (a column of the RGB -> XYZ matrix):
+    // (0.0844, 1.9690, 0.5188), summing to 2.5722 for D65 white (the formula itself gives 2.5728).
+    const Mat3& m = rec709_rgb_to_xyz();
+    return {scotopic_luminance(m[0]), scotopic_luminance(m[1]), scotopic_luminance(m[2])};
+}
+
+double scotopic_luminance_rgb(glm::dvec3 rgb) {
+    return glm::dot(scotopic_weights_rgb(), glm::max(rgb, glm::dvec3(0.0)));
+}
+
 double krawczyk_key(double adaptation_cd_m2) {
     // K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1). Written as
     // 0.002 + δ/(2 + δ), δ = log10(1 + L) — algebraically 1.002 - 2/(2 + δ) — so that the
@@ -299,7 +306,7 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     const double lw = y_w * sum;
     double v = 0.0;
     if (s.tone_operator == ToneOperator::perceptual) {
-        v = scotopic_luminance(glm::dvec3(glm::dot(xyz_row(0), rgb), lw, glm::dot(xyz_row(2), rgb)));
+        v = scotopic_luminance_rgb(rgb);  // linear: adding light never lowers V
     }
     const double ld = tone_curve(lw, v, lwa, s);
 
@@ -307,19 +314,8 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     // equations' σ(L_w)) or from the adaptation luminance; the cone weight is L/(σ₀ + L)
     // rather than 1 - σ, which fp32 would lose in the dark.
     const bool per_pixel = s.blueshift_luminance == BlueshiftLuminance::pixel;
-    // The largest channel per unit luminance either end of the mix can have: no
-    // channel of the mix exceeds ld times it (a channel of a mix is at most the
-    // larger of its ends; eq 4.30 below).
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
-    const double largest_per_unit = std::max(max_component(c) / y_w, max_component(b));
-    double l_sigma = per_pixel ? std::min(lw, kMaxInputCdM2) : lwa;
-    if (per_pixel && s.tone_operator == ToneOperator::clamp && ld * largest_per_unit > 1.0) {
-        // clamp clips each channel. Once a channel can clip (ld · largest > 1) the
-        // colour is frozen at that luminance, lw / (ld · largest) = L_white / largest:
-        // a mix still moving towards a saturated colour would clip more and more of
-        // it, and the output luminance would fall as the light brightens.
-        l_sigma = std::min(l_sigma, lw / (ld * largest_per_unit));
-    }
+    const double l_sigma = per_pixel ? std::min(lw, kMaxInputCdM2) : lwa;
     const double rod = s.blueshift ? rod_sensitivity(l_sigma) : 0.0;
     const double cone = s.blueshift ? l_sigma / (kRodSigmaCdM2 + l_sigma) : 1.0;
 
@@ -341,20 +337,20 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
             // K2012 eq 4.29: RGB_w · L_d/L_w · (1-σ) + b · L_d · σ, with RGB_w/L_w = c / y_w.
             out = ld * (cone / y_w * c + rod * b);
             if (s.hue_preservation == HuePreservation::rgb) {
-                // K2012 eq 4.30: divided by max(1, largest channel). With σ of the pixel's
-                // own luminance the mix, and so its largest channel per unit luminance,
-                // changes with L_w: dividing by it would make a saturated light's output
-                // luminance fall as it brightens. So that case divides by ld times the
-                // largest channel either end of the mix can have (a channel of the mix
-                // is at most the larger of its ends), which keeps every channel <= 1,
-                // the ratios, and the output monotonic in L_w.
-                const double largest = per_pixel && s.blueshift ? ld * largest_per_unit : max_component(out);
-                out /= std::max(1.0, largest);
+                // K2012 eq 4.30 divides by max(1, largest channel): no channel exceeds 1 and
+                // the ratios stay, but luminance is lost, and more of it the more saturated
+                // the pixel, so adding a red light to a grey pixel would darken it. Here
+                // luminance wins instead: the colour moves towards the grey of its own
+                // luminance until no channel exceeds 1 (docs/tone-mapping.md).
+                out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
             }
             break;
         }
     }
-    if (s.tone_operator == ToneOperator::clamp) out = glm::clamp(out, 0.0, 1.0);
+    // clamp clips at the display's white: luminance first, then chroma (as for eq 4.30 above).
+    // Clipping each channel instead would darken a pixel whose chroma turns towards a
+    // saturated colour as light is added (a red light on a grey sky).
+    if (s.tone_operator == ToneOperator::clamp) out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
     return glm::max(out, glm::dvec3(0.0));
 }
 
@@ -373,7 +369,7 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     const double lda = display_adaptation_cd_m2(s);
     p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
-    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(max_component(b)), 0.0f};
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), 0.0f, 0.0f};
     p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
     const glm::dvec2 bxy = s.blueshift_xy;
     const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));
@@ -381,6 +377,8 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     p.rgb_to_x = row(0);
     p.rgb_to_y = row(1);
     p.rgb_to_z = row(2);
+    const glm::dvec3 w = scotopic_weights_rgb();
+    p.scotopic = {f(w.r), f(w.g), f(w.b), 0.0f};
     return p;
 }
 

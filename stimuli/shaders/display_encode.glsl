@@ -190,14 +190,30 @@ double display_drive_for(DisplayChannel c, double L) {
 }
 
 // ---------------------------------------------------------------------------
+// Twin of fit_to_gamut_keeping_luminance() (colour.cpp): NaN and negatives are black; a
+// colour with a channel above 1 moves towards the grey of its luminance (the display's
+// channel weights), one at or above white luminance is white.
+dvec3 display_fit_to_gamut(vec3 relative_rgb, DisplayParams p) {
+    dvec3 rgb;
+    for (int c = 0; c < 3; ++c) rgb[c] = relative_rgb[c] > 0.0 ? double(relative_rgb[c]) : 0.0LF;
+    dvec3 w = dvec3(p.channel[0].white_cd_m2, p.channel[1].white_cd_m2, p.channel[2].white_cd_m2);
+    w /= w.r + w.g + w.b;
+    double y = dot(w, rgb);
+    if (!(y < 1.0LF)) return dvec3(1.0LF);
+    double m = max(rgb.r, max(rgb.g, rgb.b));
+    if (m <= 1.0LF) return rgb;
+    double t = (1.0LF - y) / (m - y);
+    return dvec3(y) + t * (rgb - dvec3(y));
+}
+
 // The encoder: relative_rgb is linear Rec.709 relative to the display's white
-// (1 = full drive); NaN and negatives give black, values above 1 clip to full drive.
+// (1 = full drive), brought into the gamut keeping its luminance (display_fit_to_gamut).
 uvec3 encode_pixel(vec3 relative_rgb, ivec2 pixel, uint frame, DisplayParams p) {
     double max_code = double((1 << p.bits) - 1);
+    dvec3 shown = display_fit_to_gamut(relative_rgb, p);
     uvec3 code;
     for (int c = 0; c < 3; ++c) {
-        float d = relative_rgb[c];
-        double dd = isnan(d) ? 0.0LF : double(d);
+        double dd = shown[c];
         double v = display_drive_for(p.channel[c], dd * p.channel[c].white_cd_m2);
         double u = p.dither == DISPLAY_DITHER_NONE ? 0.5LF : display_dither_threshold(pixel, frame, c, p.seed);
         code[c] = uint(clamp(floor(v * max_code + u), 0.0LF, max_code));

@@ -38,12 +38,13 @@ struct ToneMapParams {
     uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift (BLUE_*), w: white_cd_m2 given 0/1
     vec4 curve;          // x: 1/L_white² (empirical), y: Reinhard key, z: 1/L_white² (Reinhard), w: Kakimoto g
     vec4 display;        // x: Kakimoto k, y: white_cd_m2, z: L_dmax (cd/m²), w: L_da (cd/m²)
-    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), z: largest channel of blue_rgb
+    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), zw: 0
     vec4 blue_rgb;       // xyz: blueshift RGB at Y = 1 (eq 4.29); w: blueshift y
     vec4 blue_per_sum;   // xyz: blueshift RGB per unit X+Y+Z (eq 4.28 path)
     vec4 rgb_to_x;       // rows of the Rec.709 RGB -> XYZ matrix
     vec4 rgb_to_y;
     vec4 rgb_to_z;
+    vec4 scotopic;       // xyz: scotopic luminance per unit R, G, B (scotopic_weights_rgb(), eq 4.25 at the primaries)
 };
 
 // ln(1 + x) for x >= 0. Below 0.1 by its series (to x⁷: relative error < 2e-8), because
@@ -74,12 +75,15 @@ float log10_tvi_cone(float l) {
     return pow(max(0.249 * l + 0.65, 0.0), 2.7) - 0.72;
 }
 
-// K2012 eq 4.25 after Larson, Rushmeier & Piatko 1997: V = Y (1.33 (1 + (Y+Z)/X) - 1.68).
-float scotopic_luminance(vec3 xyz) {
-    vec3 c = max(xyz, vec3(0.0));
-    if (!(c.y > 0.0)) return 0.0;
-    float ratio = c.x > 0.0 ? min((c.y + c.z) / c.x, TM_MAX_SCOTOPIC_RATIO) : TM_MAX_SCOTOPIC_RATIO;
-    return max(c.y * (1.33 * (1.0 + ratio) - 1.68), 0.0);
+// Twin of fit_to_gamut_keeping_luminance() (colour.cpp) at Rec.709's weights w: the colour
+// moves towards the grey of its own luminance until no channel exceeds 1; white beyond it.
+vec3 tm_fit_to_gamut(vec3 rgb, vec3 w) {
+    rgb = max(rgb, vec3(0.0));
+    float y = dot(w, rgb);
+    if (!(y < 1.0)) return vec3(1.0);
+    float m = max(rgb.r, max(rgb.g, rgb.b));
+    if (m <= 1.0) return rgb;
+    return vec3(y) + ((1.0 - y) / (m - y)) * (rgb - vec3(y));
 }
 
 // K2012 eq 4.19 with Krawczyk et al. 2005's log10(L + 1), as 0.002 + δ/(2 + δ).
@@ -138,7 +142,7 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     float lw = y_w * sum;
     float v = 0.0;
     if (p.mode.x == TONE_PERCEPTUAL) {
-        v = scotopic_luminance(vec3(dot(p.rgb_to_x.xyz, rgb), lw, dot(p.rgb_to_z.xyz, rgb)));
+        v = dot(p.scotopic.xyz, rgb);  // scotopic_luminance_rgb(): linear, so adding light never lowers V
     }
     float ld = tone_curve(lw, v, lwa, p);
 
@@ -147,12 +151,7 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     bool blue = p.mode.z != BLUE_OFF;
     bool per_pixel = p.mode.z == BLUE_PIXEL;
     float sigma0 = p.tvi.y;
-    // The largest channel per unit luminance either end of the mix can have (tonemap.cpp).
-    float largest_per_unit = max(max(c.r, max(c.g, c.b)) / y_w, p.tvi.z);
     float l_sigma = per_pixel ? lw : lwa;
-    if (per_pixel && p.mode.x == TONE_CLAMP && ld * largest_per_unit > 1.0) {
-        l_sigma = min(l_sigma, lw / (ld * largest_per_unit));  // colour frozen once a channel can clip
-    }
     float rod = blue ? sigma0 / (sigma0 + l_sigma) : 0.0;
     float cone = blue ? l_sigma / (sigma0 + l_sigma) : 1.0;
 
@@ -165,12 +164,11 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
         // eq 4.29; eq 4.30 for HUE_RGB.
         outc = ld * ((cone / y_w) * c + rod * p.blue_rgb.xyz);
         if (p.mode.y == HUE_RGB) {
-            // eq 4.30; per pixel, the bound over the mix's ends keeps L monotonic (tonemap.cpp).
-            float largest = per_pixel ? ld * largest_per_unit : max(outc.r, max(outc.g, outc.b));
-            outc /= max(1.0, largest);
+            // eq 4.30 with luminance kept instead of the division (tonemap.cpp).
+            outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);
         }
     }
-    if (p.mode.x == TONE_CLAMP) outc = clamp(outc, vec3(0.0), vec3(1.0));
+    if (p.mode.x == TONE_CLAMP) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);  // luminance first (tonemap.cpp)
     return max(outc, vec3(0.0));
 }
 

@@ -85,6 +85,17 @@ Vec3 xyz_to_linear_rgb(Vec3 xyz);
 Vec3 linear_rgb_to_xyz(Vec3 rgb);
 double luminance_of_linear_rgb(Vec3 rgb);  ///< Y = 0.2126 R + 0.7152 G + 0.0722 B (derived coefficients)
 
+/// Brings linear RGB (relative to the display's white, 1 = full drive of a channel) into the
+/// display's gamut [0, 1]³ keeping its luminance and giving up chroma: negatives and NaN are
+/// black, and a colour with a channel above 1 is moved along the line to the grey of equal
+/// luminance, Y + t (RGB - Y), with the largest t that keeps every channel <= 1. Luminance is
+/// Y = w · RGB with the display's channel weights w (each channel's white luminance over the
+/// white's; they sum to 1; Rec.709's for an sRGB display). A colour brighter than white
+/// (Y >= 1) becomes white. So the luminance shown is min(1, Y) and never falls when Y rises,
+/// whatever happens to chroma: a brightness match measures luminance (docs/tone-mapping.md
+/// "Adding light never darkens").
+Vec3 fit_to_gamut_keeping_luminance(Vec3 rgb, Vec3 channel_weights);
+
 /// xyY <-> XYZ (K2012 eq 3.9, 3.10). xyz_to_xyY of black returns the D65 xy with Y = 0.
 Vec3 xyY_to_xyz(Vec3 xyY);
 Vec3 xyz_to_xyY(Vec3 xyz);

@@ -124,11 +124,18 @@ struct EncodeSettings {
 };
 
 /// Encodes one pixel. relative_rgb is linear Rec.709 relative to the display's
-/// white: channel c should emit relative_rgb[c] · channel c's L(1). The target is
-/// clipped to [L(0), L(1)], inverted through the channel's transfer function and
-/// quantised to `bits` with the dither offset. NaN is taken as 0 (black), as are
-/// negative values; +inf and values above 1 clip to full drive. Codes are always
-/// in [0, 2^bits − 1]. Throws InputError for bits outside 1..16.
+/// white: channel c should emit relative_rgb[c] · channel c's L(1). A colour the
+/// display cannot show first gives up chroma and keeps its luminance
+/// (fit_to_gamut_keeping_luminance with channel_weights(display)): NaN and negative
+/// channels are black, a colour with a channel above 1 moves towards the grey of
+/// its luminance, and one at or above white luminance is white. Each channel's
+/// target is then clipped to [L(0), L(1)], inverted through its transfer function
+/// and quantised to `bits` with the dither offset. Codes are always in
+/// [0, 2^bits − 1]. Throws InputError for bits outside 1..16.
+/// The display's channel weights: each channel's white luminance L(1) over the sum of
+/// the three (they sum to 1). Rec.709's (0.2126, 0.7152, 0.0722) for srgb() and pq().
+glm::dvec3 channel_weights(const DisplayModel& display);
+
 glm::ivec3 encode_pixel(const DisplayModel& display, glm::dvec3 relative_rgb, glm::ivec2 pixel, std::uint32_t frame,
                         const EncodeSettings& settings);
 

@@ -165,6 +165,16 @@ double log10_tvi_cone(double log10_adaptation_cd_m2);
 /// V = 2.573 Y.
 double scotopic_luminance(glm::dvec3 xyz);
 
+/// The scotopic luminance the perceptual operator uses (cd/m² of scotopic light, on eq 4.25's
+/// scale), linear in linear Rec.709 RGB (cd/m²): V = w · RGB, w = eq 4.25 evaluated at each
+/// primary, (0.0844, 1.9690, 0.5188). Scotopic luminance is an integral of the spectrum
+/// (CIE 1951 V'(λ)), so it adds; eq 4.25 of a pixel's XYZ does not (adding red light to a
+/// D65 pixel lowers its (Y + Z)/X and can lower V), which made a red light darken a night
+/// sky. This form equals eq 4.25 at every primary and is within 0.03 % of it for D65
+/// white; negative components count as 0.
+double scotopic_luminance_rgb(glm::dvec3 rgb_cd_m2);
+glm::dvec3 scotopic_weights_rgb();  ///< the weights w above
+
 /// K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1): the scene key
 /// α(L_wa) = 1.002 - 2 / (2 + log10(L_wa + 1)). The thesis drops the "+ 1", which makes
 /// α singular at L_wa = 0.01 cd/m² and negative below it; with it, α runs from 0.002 in
@@ -220,14 +230,15 @@ struct ToneMapGpuParams {
         mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
     std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
     std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), largest channel of the blueshift RGB at Y = 1, 0
+    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), 0, 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)
     std::array<float, 4> rgb_to_y{};
     std::array<float, 4> rgb_to_z{};
+    std::array<float, 4> scotopic{};  ///< scotopic_weights_rgb() (w: 0)
 };
-static_assert(sizeof(ToneMapGpuParams) == 9 * 16, "must match ToneMapParams in tonemap.glsl");
+static_assert(sizeof(ToneMapGpuParams) == 10 * 16, "must match ToneMapParams in tonemap.glsl");
 
 /// Validates the settings and fills the GPU parameters (constants precomputed in double).
 ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s);

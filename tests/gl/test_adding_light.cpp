@@ -1,0 +1,166 @@
+// Adding light never darkens, on the GPU path (docs/tone-mapping.md "Adding light never
+// darkens"; the CPU reference's sweep is tests/display/test_adding_light.cpp): a red, a
+// green and a white light 500 m away over a uniform night-to-day sky, rendered by the
+// FrameRenderer with no glare and with the default eye's glare, then tone-mapped and
+// encoded by the DisplayPipeline for every operator × blueshift reading × hue mode on an
+// 8-bit display. Against the same frame without the light (same dither frame), every
+// pixel of the 41 × 41 window around the light shows at least its displayed luminance
+// (decoded through the display model), to within one code step of each channel (a channel
+// whose drive falls as the chroma turns may round down alone: see the CPU test), the
+// window's sum is at least the sky's, and the sum does not fall as the light brightens.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "atonlab/display/display_model.h"
+#include "atonlab/stimuli/display_pipeline.h"
+#include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/scene_file.h"
+#include "gl_test_support.h"
+
+namespace atonlab::test {
+namespace {
+
+using namespace atonlab::stimuli;
+using namespace atonlab::display;
+
+constexpr int kHalf = 20;  // the window: 41 × 41 px around the light's centre
+
+// 160 × 90 px on 0.05 m at 0.9 m: 50 px/deg. The light sits at the centre.
+std::string scene_text(const std::string& glare, double adaptation, double sky, const std::string& colour,
+                       double intensity_cd) {
+    std::string s = R"(
+[display]
+width_px = 160
+height_px = 90
+width_m = 0.05
+viewing_distance_m = 0.9
+
+[camera]
+position_m = [0.0, 2.0, 0.0]
+
+[environment]
+background = "uniform"
+)";
+    s += "luminance_cd_m2 = " + std::to_string(sky) + "\n\n[eye]\nadaptation = \"fixed\"\n";
+    s += "adaptation_cd_m2 = " + std::to_string(adaptation) + "\nglare = \"" + glare + "\"\n\n[glare]\npsf_size = 256\n";
+    if (intensity_cd > 0.0) {
+        s += "\n[[light]]\nname = \"light\"\nposition_m = [0.0, 2.0, -500.0]\ncolour = \"" + colour + "\"\n";
+        s += "intensity_cd = " + std::to_string(intensity_cd) + "\n";
+    }
+    return s;
+}
+
+struct Window {
+    std::vector<double> pixel_cd_m2, step_cd_m2;
+    double sum_cd_m2 = 0.0;
+};
+
+Window window_of(const EncodedImage& codes, const DisplayModel& d) {
+    Window w;
+    const int max_code = (1 << codes.bits) - 1;
+    for (int y = codes.height / 2 - kHalf; y <= codes.height / 2 + kHalf; ++y) {
+        for (int x = codes.width / 2 - kHalf; x <= codes.width / 2 + kHalf; ++x) {
+            const std::size_t i = (static_cast<std::size_t>(y) * codes.width + x) * 3;
+            const glm::ivec3 c(codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]);
+            const double l = displayed_luminance_cd_m2(d, c, codes.bits);
+            double step = 0.0;
+            for (int k = 0; k < 3; ++k)
+                step += d.channel_luminance_cd_m2(k, std::min(c[k] + 1, max_code) / double(max_code)) -
+                        d.channel_luminance_cd_m2(k, c[k] / double(max_code));
+            w.pixel_cd_m2.push_back(l);
+            w.step_cd_m2.push_back(step);
+            w.sum_cd_m2 += l;
+        }
+    }
+    return w;
+}
+
+std::vector<ToneMapSettings> every_setting() {
+    std::vector<ToneMapSettings> out;
+    for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual, ToneOperator::reinhard,
+                                  ToneOperator::kakimoto, ToneOperator::linear, ToneOperator::clamp}) {
+        for (const HuePreservation hue : {HuePreservation::none, HuePreservation::xyY, HuePreservation::rgb}) {
+            for (int blue = 0; blue < 3; ++blue) {
+                ToneMapSettings s;
+                s.tone_operator = op;
+                s.hue_preservation = hue;
+                s.blueshift = blue != 0;
+                s.blueshift_luminance = blue == 2 ? BlueshiftLuminance::adaptation : BlueshiftLuminance::pixel;
+                out.push_back(s);
+            }
+        }
+    }
+    return out;
+}
+
+using AddingLight = GLTest;
+
+TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
+    FrameRenderer frame;
+    DisplayPipeline display;
+    const std::vector<ToneMapSettings> settings = every_setting();
+    long checks = 0, failures = 0;
+    for (const std::string glare : {"none", "wave-optics"}) {
+        for (const double adaptation : {0.001, 0.1, 10.0, 1000.0}) {
+            for (const double sky_factor : {0.0, 1.0, 10.0}) {
+                const double sky = sky_factor * adaptation;
+                // Codes of every setting for one scene, dither frame 0.
+                auto codes_of = [&](const std::string& text) {
+                    const Scene scene = parse_scene(text, "adding-light.toml", {});
+                    frame.render(scene, 0.0);
+                    std::vector<Window> out;
+                    for (const ToneMapSettings& s : settings) {
+                        OutputSettings o = scene.output;
+                        o.tonemap.tone_operator = s.tone_operator;
+                        o.tonemap.hue_preservation = s.hue_preservation;
+                        o.tonemap.blueshift = s.blueshift;
+                        o.tonemap.blueshift_luminance = s.blueshift_luminance;
+                        display.process(frame.hdr_texture(), o, 0.0, 0, frame.pre_exposure());
+                        out.push_back(window_of(display.read_codes(), scene.output.display));
+                    }
+                    return out;
+                };
+                const std::vector<Window> without = codes_of(scene_text(glare, adaptation, sky, "white", 0.0));
+                for (const std::string colour : {"red", "green", "white"}) {
+                    // The core pixel's luminance is about 0.03 cd/m² per cd at 500 m and
+                    // 50 px/deg: intensities put it at 0.1, 10 and 1000 times the adaptation.
+                    std::vector<Window> previous = without;
+                    for (const double core_factor : {0.1, 10.0, 1000.0}) {
+                        const double intensity = core_factor * adaptation / 0.0305;
+                        const std::vector<Window> with = codes_of(scene_text(glare, adaptation, sky, colour, intensity));
+                        for (std::size_t k = 0; k < settings.size(); ++k) {
+                            const ToneMapSettings& s = settings[k];
+                            for (const Window* reference : {&without[k], static_cast<const Window*>(&previous[k])}) {
+                                ++checks;
+                                bool ok = with[k].sum_cd_m2 >= reference->sum_cd_m2 * (1.0 - 1e-9);
+                                for (std::size_t i = 0; i < with[k].pixel_cd_m2.size(); ++i) {
+                                    const double step = std::max(with[k].step_cd_m2[i], reference->step_cd_m2[i]);
+                                    ok = ok && reference->pixel_cd_m2[i] - with[k].pixel_cd_m2[i] <= step * (1.0 + 1e-9);
+                                }
+                                if (!ok && failures++ < 8) {
+                                    ADD_FAILURE() << colour << " light, glare " << glare << ", L_wa " << adaptation
+                                                  << ", sky " << sky << ", core x" << core_factor << ", "
+                                                  << tone_operator_name(s.tone_operator) << " hue "
+                                                  << hue_preservation_name(s.hue_preservation) << " blueshift "
+                                                  << s.blueshift << "/" << blueshift_luminance_name(s.blueshift_luminance)
+                                                  << ": window " << with[k].sum_cd_m2 << " against "
+                                                  << reference->sum_cd_m2 << " cd/m2 (summed)";
+                                }
+                            }
+                        }
+                        previous = with;
+                    }
+                }
+            }
+        }
+    }
+    std::printf("%ld window comparisons, %ld failures\n", checks, failures);
+    EXPECT_EQ(failures, 0);
+}
+
+}  // namespace
+}  // namespace atonlab::test
