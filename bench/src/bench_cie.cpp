@@ -1,6 +1,7 @@
 // The `cie` glare model on the default display (veiling_glare.h): one light on
 // the optical axis, its veil L/E at the angles the frame holds against the CIE
-// 146:2002 General Disability Glare equation, and the frame convolution's time.
+// glare spread function it convolves with (CIE 135/1-1999, cie_glare.h), and the
+// frame convolution's time.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -21,7 +22,7 @@ void bench_cie_veil(Bench& b) {
     const DisplayGeometry d = b.quick() ? DisplayGeometry{480, 270, 0.598 / 4, 0.9} : default_display();
     const int w = d.width_px, h = d.height_px;
     const double f = d.focal_px();
-    const CieObserver observer{25.0, 0.5};  // CIE 146's reference observer, brown eyes
+    const CieObserver observer{25.0, 0.5};  // the CIE's young reference observer, brown eyes
     // One light of 1 lx on the pixel (w/2, h/2), whose centre is (0.5, 0.5) px off the axis.
     const int ci = w / 2, cj = h / 2;
     const double e_lux = 1.0;
@@ -54,18 +55,18 @@ void bench_cie_veil(Bench& b) {
         Row r;
         r.bench = "cie_veil";
         r.setting = fmt::format("θ = {}°", want_deg);
-        r.metric = "|L/E ÷ CIE 146 − 1| at the pixel nearest θ to the right of the light (age 25, p = 0.5)";
+        r.metric = "|L/E ÷ CIE GSF − 1| at the pixel nearest θ to the right of the light (age 25, p = 0.5)";
         r.time = t;
         const glm::dvec3 pixel(i + 0.5 - 0.5 * w, source.y, f);
         const double theta =
             std::acos(glm::dot(pixel, source) / (glm::length(pixel) * glm::length(source))) * 180.0 / std::numbers::pi;
         const double l = frame[(static_cast<std::size_t>(cj) * w + i) * 4 + 1];
-        const double ratio = l / e_lux / cie146_veil_per_lux(theta, observer);
+        const double ratio = l / e_lux / cie_gsf_veil_per_lux(theta, observer);
         r.error = std::abs(ratio - 1.0);
         r.note = fmt::format(
-            "θ = {:.3f}°: L/E = {:.5g} sr⁻¹, equation {:.5g} sr⁻¹; {}×{} px frame (reaching {:.1f}° to the right), "
+            "θ = {:.3f}°: L/E = {:.5g} sr⁻¹, CIE GSF {:.5g} sr⁻¹; {}×{} px frame (reaching {:.1f}° to the right), "
             "{:.1f}% of the light outside it; first frame {:.0f} ms (kernel built once per display and observer)",
-            theta, l / e_lux, cie146_veil_per_lux(theta, observer), w, h, half_width_deg, 100.0 * outside.g, first_ms);
+            theta, l / e_lux, cie_gsf_veil_per_lux(theta, observer), w, h, half_width_deg, 100.0 * outside.g, first_ms);
         b.add(r);
     }
 }

@@ -1,8 +1,10 @@
 // The default eye's PSF against optics and the CIE (docs/glare.md,
 // "Validation"): for pupils of 3, 5 and 7 mm, the core's FWHM against the
 // diffraction limit, the encircled energy at 0.1°, 0.5° and 1°, the PSF per
-// steradian at 1° … 20° against the CIE 146:2002 general disability glare
-// equation of a 25-year-old, and the lenticular halo's radius and colour order.
+// steradian at 1° … 20° against both CIE equations of a 25-year-old (the CIE
+// glare spread function of CIE 135/1-1999, which the `cie` model uses, and the
+// CIE 146:2002 General Disability Glare equation), and the lenticular halo's
+// radius and colour order.
 // Written as eye_validation.md next to bench.md; one row per pupil in bench.csv
 // with the time the PSF took.
 #include <fmt/format.h>
@@ -14,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/psf.h"
 #include "bench_common.h"
 
@@ -27,17 +30,9 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kRadPerDeg = kPi / 180.0;
 
-/// CIE 146:2002 general disability glare equation (Vos & van den Berg; Vos
-/// 2003, Clin Exp Optom 86:363): L_veil / E_glare in sr⁻¹ (cd/m² per lx) at
-/// θ degrees from a point source, age A years, pigmentation p (0 very dark,
-/// 0.5 brown, 1 blue-green, 1.2 very light), valid 0.1° ≤ θ ≤ 100°.
-double cie146_per_sr(double theta_deg, double age_years, double pigmentation) {
-    const double t = theta_deg;
-    return 10 / (t * t * t) + (5 / (t * t) + 0.1 * pigmentation / t) * (1 + std::pow(age_years / 62.5, 4)) +
-           0.0025 * pigmentation;
-}
-constexpr double kAge = 25.0;
-constexpr double kPigmentation = 0.5;
+// The CIE observer both equations are evaluated for (cie_glare.h): 25 years,
+// brown eyes.
+constexpr CieObserver kObserver{25.0, 0.5};
 
 /// |F(θ)|² of a pupil-plane field (n×n over width_mm) at angle θ (rad) along
 /// x (axis 0) or y (axis 1), by the direct sum over the field's projection on
@@ -137,22 +132,29 @@ void bench_eye_validation(Bench& b) {
     const SpectralSamples samples = spectral_samples(d65_spectrum(), 30);
 
     std::string md = fmt::format(
-        "# Eye validation: the default eye against optics and CIE 146:2002\n\n"
+        "# Eye validation: the default eye against optics and the CIE glare equations\n\n"
         "`atonlab bench --only eye_validation`. The default eye (two scales, in focus, gratings and particles, "
         "halo at 4°), N = {} (the default; per-steradian values at N = {} to reach the far angles), λ0 = 575 nm "
         "for the monochromatic columns. The halo columns: the same eye with its particles off (their scatter is "
-        "brighter than the halo at 4°), D65 with 30 samples, the largest azimuthal mean beyond 2°. CIE: the general "
-        "disability glare "
-        "equation for age {} and pigmentation {} (sr⁻¹).\n\n",
-        n, n_far, kAge, kPigmentation);
+        "brighter than the halo at 4°), D65 with 30 samples, the largest azimuthal mean beyond 2°. CIE (sr⁻¹, age "
+        "{} years, pigmentation {}): GSF, the CIE glare spread function of Vos & van den Berg (CIE 135/1-1999), "
+        "the `cie` model's equation; General, the CIE 146:2002 General Disability Glare equation (valid 0.1° … "
+        "100°).\n\n",
+        n, n_far, kObserver.age_years, kObserver.pigmentation);
     md +=
         "| pupil | core FWHM (arcmin) | diffraction limit 1.029 λ/D | ratio | core share | EE 0.1° | EE 0.5° | "
         "EE 1° | halo peak (luminance, gratings) | red / blue peak | colour order "
         "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    // The two CIE equations at the angles (they do not depend on the pupil).
+    std::string cie = "| θ | GSF (CIE 135/1) | General (CIE 146) | GSF / General |\n|---|---|---|---|\n";
+    for (double a : angles) {
+        const double g = cie_gsf_veil_per_lux(a, kObserver), c = cie146_general_veil_per_lux(a, kObserver);
+        cie += fmt::format("| {}° | {:.4g} | {:.4g} | {:.3f} |\n", a, g, c, g / c);
+    }
     std::string sr = "| pupil | N |";
     std::string sr_rule = "|---|---|";
     for (double a : angles) {
-        sr += fmt::format(" PSF/sr at {0}° | CIE at {0}° | ratio |", a);
+        sr += fmt::format(" PSF/sr at {0}° | ÷ GSF | ÷ General |", a);
         sr_rule += "---|---|---|";
     }
     sr += "\n" + sr_rule + "\n";
@@ -195,8 +197,9 @@ void bench_eye_validation(Bench& b) {
             const MonoPsf far = size == n ? mono : mono_psf_reference(eye, size, kReferenceWavelengthNm);
             sr += fmt::format("| {} mm | {} |", p, size);
             for (double a : angles) {
-                const double v = per_sr(far, a), c = cie146_per_sr(a, kAge, kPigmentation);
-                sr += fmt::format(" {} | {:.4g} | {} |", cell(v, "{:.4g}"), c, cell(v / c, "{:.3g}"));
+                const double v = per_sr(far, a);
+                const double g = cie_gsf_veil_per_lux(a, kObserver), c = cie146_general_veil_per_lux(a, kObserver);
+                sr += fmt::format(" {} | {} | {} |", cell(v, "{:.4g}"), cell(v / g, "{:.3g}"), cell(v / c, "{:.3g}"));
             }
             sr += "\n";
         }
@@ -213,10 +216,10 @@ void bench_eye_validation(Bench& b) {
         b.add(r);
         if (b.options.verbose) std::printf("eye_validation: %.0f mm done\n", p);
     }
-    md +=
-        "\nPSF per steradian (λ0, azimuthal mean over ±5% of the angle) against the CIE equation; — where the "
-        "angle lies beyond the PSF's grid (the glare beyond it is not drawn by the billboard).\n\n" +
-        sr;
+    md += "\nThe two CIE equations at the angles of the comparison:\n\n" + cie +
+          "\nPSF per steradian (λ0, azimuthal mean over ±5% of the angle) divided by each CIE equation; — where "
+          "the angle lies beyond the PSF's grid (the glare beyond it is not drawn by the billboard).\n\n" +
+          sr;
     b.documents.emplace_back("eye_validation.md", md);
 }
 

@@ -110,7 +110,7 @@ std::string ViewControls::press(ViewKey key, double adapted_cd_m2) {
             std::vector<stimuli::GlareModel> models = {
                 stimuli::GlareModel::wave_optics, stimuli::GlareModel::gaussian_bloom, stimuli::GlareModel::spencer};
             if (!s.glare.aperture_image.empty()) models.push_back(stimuli::GlareModel::aperture);
-            models.push_back(stimuli::GlareModel::cie);  // CIE 146 veil over the whole frame (docs/glare.md)
+            models.push_back(stimuli::GlareModel::cie);  // CIE veil over the whole frame (docs/glare.md)
             const auto it = std::find(models.begin(), models.end(), s.glare.model);
             s.glare.model = it == models.end() || it + 1 == models.end() ? models.front() : *(it + 1);
             last_glare_ = s.glare.model;

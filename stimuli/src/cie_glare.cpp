@@ -1,5 +1,6 @@
-// The CIE 146:2002 General Disability Glare equation and its energy-conserving
-// glare spread function (cie_glare.h has the equation and the definition).
+// The CIE glare spread function (Vos & van den Berg, CIE 135/1-1999) and its
+// energy-conserving form, and the CIE 146:2002 General Disability Glare equation
+// that the eye validation compares with (cie_glare.h has both and the definition).
 #include "atonlab/stimuli/cie_glare.h"
 
 #include <fmt/format.h>
@@ -43,8 +44,8 @@ double ring_integral(const Density& density, double theta0_deg, double theta1_de
 
 }  // namespace
 
-double cie146_veil_per_lux(double theta_deg, const CieObserver& o) {
-    // CIE 146:2002, General Disability Glare equation (θ in degrees, A in years, p pigmentation).
+double cie_gsf_veil_per_lux(double theta_deg, const CieObserver& o) {
+    // CIE 135/1-1999 glare spread function (Vos & van den Berg; θ in degrees, A in years, p pigmentation).
     const double t = std::abs(theta_deg);
     const double age4 = std::pow(o.age_years / 70.0, 4);
     const double p = o.pigmentation;
@@ -55,14 +56,21 @@ double cie146_veil_per_lux(double theta_deg, const CieObserver& o) {
     return (1.0 - 0.08 * age4) * core + (1.0 + 1.6 * age4) * wide + 2.5e-3 * p;
 }
 
+double cie146_general_veil_per_lux(double theta_deg, const CieObserver& o) {
+    // CIE 146:2002, General Disability Glare equation (valid 0.1° ≤ θ ≤ 100°).
+    const double t = std::abs(theta_deg);
+    const double p = o.pigmentation;
+    return 10.0 / (t * t * t) + (5.0 / (t * t) + 0.1 * p / t) * (1.0 + std::pow(o.age_years / 62.5, 4)) + 0.0025 * p;
+}
+
 double CieGlareSpread::density_sr(double theta_deg) const {
-    const double f = cie146_veil_per_lux(theta_deg, observer);
+    const double f = cie_gsf_veil_per_lux(theta_deg, observer);
     if (std::abs(theta_deg) >= kCieInnerDeg) return f;
     return at_inner_sr + (1.0 - kappa) * (f - at_inner_sr);
 }
 
-double cie146_energy_between(const CieObserver& observer, double theta0_deg, double theta1_deg) {
-    return ring_integral([&](double t) { return cie146_veil_per_lux(t, observer); }, theta0_deg, theta1_deg);
+double cie_gsf_energy_between(const CieObserver& observer, double theta0_deg, double theta1_deg) {
+    return ring_integral([&](double t) { return cie_gsf_veil_per_lux(t, observer); }, theta0_deg, theta1_deg);
 }
 
 double cie_energy_between(const CieGlareSpread& gsf, double theta0_deg, double theta1_deg) {
@@ -78,29 +86,29 @@ double cie_energy_between(const CieGlareSpread& gsf, double theta0_deg, double t
 CieGlareSpread cie_glare_spread(const CieObserver& observer) {
     if (!(observer.age_years >= 0.0 && observer.age_years <= 100.0))
         throw InputError(SourceLocation{"", 0, 0, "cie_age_years"},
-                         fmt::format("cie_age_years must be an age from 0 to 100 years (the CIE 146 equation's "
-                                     "observers), got {}.",
+                         fmt::format("cie_age_years must be an age from 0 to 100 years (the CIE glare "
+                                     "equations' observers), got {}.",
                                      observer.age_years));
     if (!(observer.pigmentation >= 0.0 && observer.pigmentation <= 1.2))
         throw InputError(SourceLocation{"", 0, 0, "cie_pigmentation"},
                          fmt::format("cie_pigmentation must be from 0 (very dark eyes) to 1.2 (very light blue "
-                                     "eyes), as CIE 146 defines it, got {}.",
+                                     "eyes), as the CIE defines it, got {}.",
                                      observer.pigmentation));
     CieGlareSpread g;
     g.observer = observer;
-    g.at_inner_sr = cie146_veil_per_lux(kCieInnerDeg, observer);
+    g.at_inner_sr = cie_gsf_veil_per_lux(kCieInnerDeg, observer);
     // Energy of the equation outside 0.1°, and of its excess over f(0.1°) inside.
-    const double outside = cie146_energy_between(observer, kCieInnerDeg, 180.0);
-    const double inner_total = cie146_energy_between(observer, 0.0, kCieInnerDeg);
+    const double outside = cie_gsf_energy_between(observer, kCieInnerDeg, 180.0);
+    const double inner_total = cie_gsf_energy_between(observer, 0.0, kCieInnerDeg);
     const double inner_floor = g.at_inner_sr * 2.0 * std::numbers::pi * (1.0 - std::cos(kCieInnerDeg * kDegToRad));
     const double inner_excess = inner_total - inner_floor;
     // Σ = outside + inner_floor + (1 − κ) inner_excess = 1.
     g.kappa = 1.0 - (1.0 - outside - inner_floor) / inner_excess;
     if (!(g.kappa <= 1.0))
         throw InputError(SourceLocation{"", 0, 0, "cie_age_years"},
-                         fmt::format("the CIE 146 equation for age {} and pigmentation {} scatters {:.3f} of the "
-                                     "light beyond 0.1°, more than all of it, so no glare spread function can "
-                                     "conserve energy; choose a younger age or a lower pigmentation.",
+                         fmt::format("the CIE glare spread function for age {} and pigmentation {} scatters {:.3f} "
+                                     "of the light beyond 0.1°, more than all of it, so no glare spread function "
+                                     "can conserve energy; choose a younger age or a lower pigmentation.",
                                      observer.age_years, observer.pigmentation, outside + inner_floor));
     return g;
 }

@@ -275,7 +275,7 @@ void FrameRenderer::Impl::upload_light_tables(const Scene& scene, const GpuLight
 }
 
 // The `cie` veil: the veil lights' direct images (already drawn into the glare
-// buffer, cd/m²) convolved with the CIE 146 GSF; the result is the glare buffer
+// buffer, cd/m²) convolved with the CIE GSF; the result is the glare buffer
 // of the LDR path, or is added to the HDR frame.
 void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjection& P, bool ldr) {
     const auto pre = static_cast<float>(pre_exposure);
@@ -438,7 +438,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
         }
         if (any_veil) {
             // `cie`: the direct images of its lights alone (cd/m²) convolved over
-            // the whole frame with the CIE 146 GSF (veiling_glare.h), which
+            // the whole frame with the CIE GSF (veiling_glare.h), which
             // replaces them in the HDR frame, or is the glare buffer of the LDR
             // path. Lights with another model are not in the convolution.
             const auto veil_started = Clock::now();

@@ -126,7 +126,7 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         s.within("pupil_mm", *p, 0.5, 12.0);
         glare.pupil_mm = *p;
     }
-    // CIE 146:2002 observer of the `cie` model (cie_glare.h).
+    // The CIE observer (age, pigmentation) of the `cie` model (cie_glare.h).
     if (auto a = s.number("cie_age_years")) {
         s.within("cie_age_years", *a, 0.0, 100.0);
         glare.cie.age_years = *a;

@@ -1,5 +1,5 @@
-// The `cie` glare model over a whole frame: the CIE 146:2002 glare spread
-// function integrated over each pixel's solid angle, and the frame-sized linear
+// The `cie` glare model over a whole frame: the CIE glare spread
+// function (CIE 135/1-1999) integrated over each pixel's solid angle, and the frame-sized linear
 // convolution by FFTW (veiling_glare.h).
 #include "atonlab/stimuli/veiling_glare.h"
 

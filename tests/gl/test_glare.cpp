@@ -312,11 +312,11 @@ TEST_F(GlareFrames, LdrPathTakesTheGlareOfTheGlareLightsOnly) {
     EXPECT_NEAR(glare_lux / e_a, 1.0, 1e-3);
 }
 
-TEST_F(GlareFrames, CieVeilOfOneLightIsTheCie146EquationAndKeepsItsEnergy) {
+TEST_F(GlareFrames, CieVeilOfOneLightIsTheCieGlareSpreadFunctionAndKeepsItsEnergy) {
     // 261×121 px at 12 px per degree (±10.9° × ±5°); a 10⁴ cd light 1 km straight
     // ahead (E = 0.01 lx) lands in the centre pixel. L/E at 1°, 3° and 10° to the
-    // right is the CIE 146:2002 General Disability Glare equation (age 25, p = 0.5)
-    // written out here from Vos 2003.
+    // right is the CIE glare spread function of Vos & van den Berg (CIE 135/1-1999;
+    // age 25, p = 0.5), written out here independently of cie_glare.cpp.
     const double kDeg = std::numbers::pi / 180.0;
     const double f = 12.0 / kDeg;
     Scene scene = black_scene(GlareModel::cie);

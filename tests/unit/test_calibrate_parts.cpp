@@ -442,7 +442,7 @@ TEST(ViewKeys, NamesMoveTurnAndToggle) {
     EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::gaussian_bloom);
     v.press(ViewKey::glare_cycle, 0.0);
     v.press(ViewKey::glare_cycle, 0.0);
-    EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::cie);  // spencer, then the CIE 146 veil
+    EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::cie);  // spencer, then the CIE veil
     v.press(ViewKey::glare_cycle, 0.0);
     EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::wave_optics);
 

@@ -476,7 +476,7 @@ TEST(SceneFileGlare, CieModelAndObserverAreRead) {
     EXPECT_EQ(scene.glare.model, GlareModel::cie);
     EXPECT_EQ(scene.glare.cie.age_years, 62.0);
     EXPECT_EQ(scene.glare.cie.pigmentation, 1.0);
-    // Defaults: CIE 146's 25-year-old, brown eyes (p = 0.5); and --set reaches both keys.
+    // Defaults: the CIE's 25-year-old, brown eyes (p = 0.5); and --set reaches both keys.
     const Scene plain = parse_scene(std::string(kMinimal), "cie.toml");
     EXPECT_EQ(plain.glare.cie.age_years, 25.0);
     EXPECT_EQ(plain.glare.cie.pigmentation, 0.5);

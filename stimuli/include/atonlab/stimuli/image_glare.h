@@ -24,7 +24,7 @@ namespace atonlab::stimuli {
 /// adaptation_cd_m2 (the pupil by K2012 eq 3.15 unless glare.pupil_mm is set,
 /// Spencer's vision class): wave-optics (the CPU spectral path, `anchored` or
 /// `exact`; `rescaled` runs on the GPU and is taken as `anchored`), gaussian-bloom,
-/// spencer, and cie (the CIE 146:2002 GSF as a radial kernel, radius_deg or by
+/// spencer, and cie (the CIE glare spread function as a radial kernel, radius_deg or by
 /// default 20°). The spectrum is D65. Throws InputError (key "model") for none
 /// and aperture, and the kernel builders' errors (radius, size).
 GlareKernel image_glare_kernel(const GlareSettings& glare, double adaptation_cd_m2, double degrees_per_pixel);

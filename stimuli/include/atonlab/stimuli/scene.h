@@ -97,7 +97,7 @@ enum class GlareModel : std::uint8_t {
     gaussian_bloom,  ///< a monochromatic Gaussian blur (K2012 §3.4.1, [Kaw05]/[KMS05])
     spencer,         ///< the analytic PSF of Spencer et al. 1995
     aperture,        ///< the FFT of an obstacle image (Kakimoto et al. 2005)
-    cie,             ///< CIE 146:2002 veiling glare over the whole frame (veiling_glare.h), not a billboard
+    cie,             ///< the CIE glare spread function's veiling glare over the whole frame (veiling_glare.h), not a billboard
 };
 std::string_view glare_model_name(GlareModel m);
 std::optional<GlareModel> glare_model_from_name(std::string_view name);

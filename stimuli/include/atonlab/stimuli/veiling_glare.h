@@ -1,6 +1,6 @@
 #pragma once
 // Wide-angle veiling glare over a whole frame (the `cie` glare model): the
-// lights' direct images convolved with the CIE 146:2002 glare spread function
+// lights' direct images convolved with the CIE glare spread function (CIE 135/1-1999)
 // (cie_glare.h) by a frame-sized FFT convolution, in double precision (FFTW).
 //
 // Energy: each pixel's light is its illuminance e = L·Ω (lux; L in cd/m², Ω the
