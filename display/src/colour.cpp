@@ -48,11 +48,25 @@ struct NarrowBandLed {
     double peak_nm;
     double fwhm_nm;
 };
-constexpr std::array<NarrowBandLed, 4> kNarrowBandLeds = {{
+//
+// The IALA colours' glare spectra (iala_colour_spectrum_name): typical ATON LED dies, each tuned so its
+// CIE 1931 xy lies inside its colour's signal-light area (COLREGs 1972 Annex I §7 for red, green and
+// yellow; ICAO Annex 14 Vol I Appendix 1, after CIE S 004, for blue), with the FWHM of such dies:
+//   iala-red     625 nm, 20 nm  -> (0.6945, 0.3054)  AlInGaP red (the led-red die)
+//   iala-green   505 nm, 30 nm  -> (0.0477, 0.5977)  InGaN "signal green" (a 525 nm die, led-green,
+//                                                    lies at y = 0.776, above the green area's yellow edge)
+//   iala-blue    465 nm, 25 nm  -> (0.1353, 0.0471)  InGaN blue (the led-blue die)
+//   iala-yellow  592 nm, 15 nm  -> (0.5835, 0.4159)  AlInGaP amber (a 590 nm, 20 nm die, led-yellow, lies
+//                                                    at x = 0.570, left of the yellow area's x = 0.575 edge)
+constexpr std::array<NarrowBandLed, 8> kNarrowBandLeds = {{
     {"led-red", 625.0, 20.0},
     {"led-green", 525.0, 30.0},
     {"led-blue", 465.0, 25.0},
     {"led-yellow", 590.0, 20.0},
+    {"iala-red", 625.0, 20.0},
+    {"iala-green", 505.0, 30.0},
+    {"iala-blue", 465.0, 25.0},
+    {"iala-yellow", 592.0, 15.0},
 }};
 
 // IALA light colours as K2012 table 4.1 maps them into the Rec.709 gamut. The thesis prints xy to two
@@ -74,17 +88,22 @@ constexpr std::array<NarrowBandLed, 4> kNarrowBandLeds = {{
 // K2012 eq 3.12. Eq 3.11, by contrast, is the matrix derived from the specified white (0.3127, 0.3290).
 // We derive both matrices from the specified white (Rec.709, docs/architecture.md), which moves the table's values
 // by at most 2.4e-4 relative (red 4.7028, blue 13.8519): inside the 1e-3 the tests hold it to.
+//
+// `spectrum` is the named spectrum its glare is integrated over (docs/glare.md "The light's spectrum"):
+// white keeps D65, whose xy lies 0.0027 inside the white area's blue edge (x = 0.310); red-optimum
+// shares red's die (IALA's narrower "optimum" red area was not at hand; the die lies in the red area).
 struct IalaColour {
     const char* name;
     glm::dvec2 xy;
+    const char* spectrum;
 };
 constexpr std::array<IalaColour, 6> kIalaColours = {{
-    {"white", kD65WhiteXy},
-    {"red", kRec709Red},
-    {"red-optimum", {0.62, 0.32}},
-    {"green", {0.28, 0.52}},
-    {"blue", kRec709Blue},
-    {"yellow", {0.5396, 0.4097}},
+    {"white", kD65WhiteXy, "d65"},
+    {"red", kRec709Red, "iala-red"},
+    {"red-optimum", {0.62, 0.32}, "iala-red"},
+    {"green", {0.28, 0.52}, "iala-green"},
+    {"blue", kRec709Blue, "iala-blue"},
+    {"yellow", {0.5396, 0.4097}, "iala-yellow"},
 }};
 
 // Chart abbreviations (IALA / INT 1 light characters): "Bu" is blue; a bare "B" is not a colour on
@@ -314,6 +333,13 @@ std::optional<Vec3> iala_colour_rgb(std::string_view name) {
     if (!xy) return std::nullopt;
     // All table 4.1 colours are inside the gamut or on its edge; clipping only guards rounding.
     return normalised_rgb_from_xy(*xy, true);
+}
+
+std::optional<std::string> iala_colour_spectrum_name(std::string_view name) {
+    for (const auto& c : kIalaColours) {
+        if (name == c.name) return std::string(c.spectrum);
+    }
+    return std::nullopt;
 }
 
 std::vector<std::string> iala_colour_names() {

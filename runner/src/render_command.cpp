@@ -89,6 +89,11 @@ int run_render(const RenderOptions& o) {
                 own += fmt::format("{}{}={}", own.empty() ? "" : " ", l.name,
                                    stimuli::glare_model_name(stimuli::light_glare_model(scene, l)));
         if (!own.empty()) meta.strings["glare_lights"] = own;
+        // Every light's glare spectrum (docs/glare.md "The light's spectrum"): its spd, or its colour's.
+        std::string spectra;
+        for (const auto& l : scene.lights)
+            spectra += fmt::format("{}{}={}", spectra.empty() ? "" : " ", l.name, l.spd.empty() ? "d65" : l.spd);
+        if (!spectra.empty()) meta.strings["spd_lights"] = spectra;
     }
     const double adapted = pipeline.display().adaptation_cd_m2();
     meta.strings["tonemap"] = fmt::format(
@@ -163,6 +168,8 @@ int run_render(const RenderOptions& o) {
     const auto st = renderer.stats();
     std::printf("%s: %dx%d, %d of %d lights drawn, %.4f deg/px -> %s%s%s\n", o.scene.c_str(), hdr.width, hdr.height,
                 st.drawn, st.lights, meta.degrees_per_pixel, o.exr.c_str(), o.png.empty() ? "" : ", ", o.png.c_str());
+    if (auto it = meta.strings.find("spd_lights"); it != meta.strings.end())
+        std::printf("  light spectra: %s\n", it->second.c_str());
     std::fputs(glare_note.c_str(), stdout);
     std::printf("  %s\n", meta.strings["tonemap"].c_str());
     return 0;

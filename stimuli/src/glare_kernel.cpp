@@ -43,6 +43,10 @@ double glare_kernel_width_px(double pixels_per_degree, double radius_deg) {
 namespace {
 
 // Applies the window at R, reports the cut against `total`, renormalises each channel.
+// A channel the spectrum has (next to) no light in (its RGB clipped at 0: a red LED has
+// no green or blue in Rec.709, but for a few aliased texels far out) takes the
+// luminance's distribution, so a light whose displayed colour has some of that channel
+// (red-optimum's blue, docs/glare.md "The light's spectrum") still spreads all of it.
 void window_and_normalise(GlareKernel& k, const std::vector<glm::dvec3>& energy, glm::dvec3 total, GlareWindow window) {
     const int m = k.size, h = k.half();
     glm::dvec3 kept{0.0};
@@ -55,11 +59,19 @@ void window_and_normalise(GlareKernel& k, const std::vector<glm::dvec3>& energy,
             kept += windowed[idx];
         }
     k.rgba.assign(energy.size(), glm::vec4(0.0f));
+    const double kept_luminance = display::luminance_of_linear_rgb(kept);
     for (int c = 0; c < 3; ++c) {
         k.window_cut[c] = total[c] > 0 ? std::clamp(1.0 - kept[c] / total[c], 0.0, 1.0) : 0.0;
-        if (!(kept[c] > 0)) continue;
-        for (std::size_t idx = 0; idx < windowed.size(); ++idx)
-            k.rgba[idx][c] = static_cast<float>(windowed[idx][c] / kept[c]);
+        glm::dvec3 unit(0.0);
+        unit[c] = 1.0;
+        // Its share of the kernel's luminance: under 1e-6, the channel's shape is noise.
+        if (kept[c] > 0 && display::luminance_of_linear_rgb(unit * kept[c]) > 1e-6 * kept_luminance) {
+            for (std::size_t idx = 0; idx < windowed.size(); ++idx)
+                k.rgba[idx][c] = static_cast<float>(windowed[idx][c] / kept[c]);
+        } else if (kept_luminance > 0) {
+            for (std::size_t idx = 0; idx < windowed.size(); ++idx)
+                k.rgba[idx][c] = static_cast<float>(display::luminance_of_linear_rgb(windowed[idx]) / kept_luminance);
+        }
     }
 }
 

@@ -154,7 +154,7 @@ double glare_psf_degrees_per_texel(const GlareSettings& glare) {
 namespace {
 
 display::Spectrum spd_for(const std::string& name) {
-    if (name.empty()) return display::d65_spectrum();
+    if (name.empty() || name == "d65") return display::d65_spectrum();
     if (auto s = display::named_spectrum(name)) return *s;
     throw InputError(SourceLocation{"", 0, 0, "spd"}, fmt::format("unknown spectrum \"{}\".", name));
 }
@@ -227,7 +227,7 @@ struct GlareStage::Impl {
         GlareGroupReport report;
         std::vector<float> envelope;  // billboard crop table (see envelope_buffer())
     };
-    std::map<std::string, Group> groups;  // by model and SPD name ("wave-optics|D65"), kept between frames
+    std::map<std::string, Group> groups;  // by model and SPD name ("wave-optics|d65"), kept between frames
     std::vector<std::string> order;       // this frame's groups, index = group id
     std::vector<GlareGroupReport> reports;
     std::vector<unsigned> light_groups;
@@ -381,7 +381,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const GlareModel model = light_glare_model(scene, scene.lights[i]);
         if (glare_path(model) != GlarePath::billboard) continue;
-        const std::string& spd = scene.lights[i].spd;
+        // "" is D65 (scene.h Light::spd): one group with the lights that name it.
+        const std::string spd = scene.lights[i].spd.empty() ? "d65" : scene.lights[i].spd;
         const std::string name = fmt::format("{}|{}", glare_model_name(model), spd);
         auto it = std::find(m.order.begin(), m.order.end(), name);
         if (it == m.order.end()) {

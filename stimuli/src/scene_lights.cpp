@@ -32,6 +32,15 @@ glm::dvec3 read_colour(const Section& s) {
     return *iala_colour_rgb("white");
 }
 
+/// The named spectrum a light's glare is integrated over (docs/glare.md "The light's spectrum"): its
+/// `spd`, else its IALA colour's representative spectrum (white's when no colour key is given), else
+/// D65 for an `xy`, which names no spectrum.
+std::string glare_spectrum(const Section& s) {
+    if (auto spd = s.string("spd")) return *spd;
+    if (s.has("xy")) return "d65";
+    return iala_colour_spectrum_name(s.string("colour").value_or("white")).value_or("d65");
+}
+
 struct SceneBuilder {
     const Document& doc;
     Scene& scene;
@@ -99,7 +108,7 @@ struct SceneBuilder {
             s.fail(s.get(given[1]), given[1],
                    fmt::format("give only one of colour, xy and spd; this light has {}.", join(given)));
         light.rgb_per_cd = read_colour(s);
-        light.spd = s.string("spd").value_or("");
+        light.spd = glare_spectrum(s);
         light.glare = read_glare_model(s);
 
         light.orientation = orientation_from_yaw_pitch_roll(s.number_or("yaw_deg", 0.0), s.number_or("pitch_deg", 0.0),
@@ -149,7 +158,10 @@ struct SceneBuilder {
         const toml::node* name_node = s.has("name") ? s.get("name") : &s.table();
         if (rhythm.channels.size() == 1) {
             const RhythmChannel& channel = rhythm.channels.front();
-            if (!channel.colour.empty()) light.rgb_per_cd = chart_letter_rgb(s, channel.colour, rhythm_text);
+            if (!channel.colour.empty()) {
+                light.rgb_per_cd = chart_letter_rgb(s, channel.colour, rhythm_text);
+                light.spd = chart_letter_spectrum(channel.colour);
+            }
             light.rhythm = channel.knots;
             claim_name(s, light.name);
             scene.lights.push_back(std::move(light));
@@ -161,6 +173,7 @@ struct SceneBuilder {
             Light l = light;
             l.name = fmt::format("{}/{}", light.name, channel.colour);
             l.rgb_per_cd = chart_letter_rgb(s, channel.colour, rhythm_text);
+            l.spd = chart_letter_spectrum(channel.colour);
             l.rhythm = channel.knots;
             if (auto it = names.find(l.name); it != names.end())
                 s.fail(name_node, "name",
@@ -205,6 +218,12 @@ struct SceneBuilder {
                                text::echo(disc.name), it->second));
         names.emplace(disc.name, path);
         scene.discs.push_back(std::move(disc));
+    }
+
+    /// The glare spectrum of a chart letter's colour (chart_letter_rgb has checked the letter).
+    static std::string chart_letter_spectrum(const std::string& letter) {
+        const auto name = iala_colour_from_chart_letter(letter);
+        return iala_colour_spectrum_name(name.value_or("white")).value_or("d65");
     }
 
     glm::dvec3 chart_letter_rgb(const Section& s, const std::string& letter, const std::string& rhythm_text) {

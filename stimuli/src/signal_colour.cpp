@@ -12,11 +12,16 @@ namespace {
 
 // COLREGs 1972 Annex I §7, "Colour specification of lights": the corner
 // coordinates of each colour's area in the CIE 1931 diagram, in the order the
-// Annex lists them (which walks the boundary).
+// Annex lists them (which walks the boundary), except red: the Annex lists
+// (0.680, 0.320), (0.660, 0.320), (0.735, 0.265), (0.721, 0.259), and joined in
+// that order its edges cross (a bow tie, which the even-odd rule below counts
+// wrongly). Walked, the last two swap: (0.660, 0.320)-(0.721, 0.259) is the
+// purple boundary y = 0.980 - x and (0.735, 0.265)-(0.680, 0.320) runs along
+// the spectrum locus.
 const std::vector<glm::dvec2> kWhite = {{0.525, 0.382}, {0.525, 0.440}, {0.452, 0.440},
                                         {0.310, 0.348}, {0.310, 0.283}, {0.443, 0.382}};
 const std::vector<glm::dvec2> kGreen = {{0.028, 0.385}, {0.009, 0.723}, {0.300, 0.511}, {0.203, 0.356}};
-const std::vector<glm::dvec2> kRed = {{0.680, 0.320}, {0.660, 0.320}, {0.735, 0.265}, {0.721, 0.259}};
+const std::vector<glm::dvec2> kRed = {{0.680, 0.320}, {0.660, 0.320}, {0.721, 0.259}, {0.735, 0.265}};
 const std::vector<glm::dvec2> kYellow = {{0.612, 0.382}, {0.618, 0.382}, {0.575, 0.425}, {0.575, 0.406}};
 
 double cross(glm::dvec2 a, glm::dvec2 b) {

@@ -54,7 +54,9 @@ Spectrum gaussian_spectrum(double peak_nm, double fwhm_nm);
 Spectrum white_led_spectrum();
 
 /// Named SPDs: "d65", "led-white", "led-red", "led-green", "led-blue",
-/// "led-yellow" (narrow-band coloured LEDs, peaks and widths documented).
+/// "led-yellow" (narrow-band coloured LEDs, peaks and widths documented), and
+/// "iala-red", "iala-green", "iala-blue", "iala-yellow": the LED dies whose
+/// chromaticities lie in those colours' signal-light areas (iala_colour_spectrum_name).
 /// Returns nullopt for an unknown name.
 std::optional<Spectrum> named_spectrum(std::string_view name);
 
@@ -125,6 +127,12 @@ std::optional<glm::dvec2> iala_colour_xy(std::string_view name);
 /// The same as normalised linear RGB (table 4.1 reproduced).
 std::optional<Vec3> iala_colour_rgb(std::string_view name);
 std::vector<std::string> iala_colour_names();
+/// The named_spectrum() a light of this IALA colour integrates its glare over
+/// when it names no `spd`: one whose CIE 1931 chromaticity lies in the colour's
+/// signal-light area ("d65" for white, "iala-red" for red and red-optimum,
+/// "iala-green", "iala-blue", "iala-yellow"; colour.cpp gives each die). The
+/// displayed colour stays iala_colour_rgb(). nullopt for an unknown name.
+std::optional<std::string> iala_colour_spectrum_name(std::string_view name);
 
 /// Chart letters -> IALA colour name: "W" white, "R" red, "G" green, "Bu" blue,
 /// "Y" yellow (used by Al. rhythms such as "Al.WR").

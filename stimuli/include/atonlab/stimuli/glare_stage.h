@@ -20,7 +20,7 @@ struct CameraProjection;
 /// What the glare stage used for one SPD group in the last frame.
 struct GlareGroupReport {
     GlareModel model = GlareModel::none;  ///< the group's model (the eye's, or its lights' own)
-    std::string spd;               ///< "" = D65
+    std::string spd;               ///< the named spectrum ("d65" for lights that name none)
     double pupil_mm = 0;           ///< the pupil the PSF was computed for (wave-optics)
     double degrees_per_texel = 0;  ///< the PSF's angular texel (wave-optics, aperture)
     int kernel_size_px = 0;

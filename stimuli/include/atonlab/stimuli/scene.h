@@ -65,8 +65,10 @@ struct Light {
     std::vector<RhythmKnot> rhythm{{0.0, 1.0}};  ///< B(t) knots of this light's colour channel
     double rhythm_period_s = 0.0;                ///< 0 = fixed
     double rhythm_phase_s = 0.0;                 ///< added to the time before the rhythm lookup
-    /// The SPD its glare is integrated with (a named_spectrum()); empty: D65,
-    /// for lights given by an IALA colour or xy (K2012 §4.2.4, eq 4.10).
+    /// The SPD its glare is integrated with (a named_spectrum(); K2012 §4.2.4,
+    /// eq 4.10). The scene file sets it for every light: its `spd`, else its IALA
+    /// colour's spectrum (display::iala_colour_spectrum_name), else "d65" for an
+    /// `xy`. Empty (a Light built in code): D65.
     std::string spd;
     /// Its own glare model ([[light]] glare); nullopt: the eye's ([eye] glare).
     /// The models' settings ([glare], the eye's PSF) are shared by all lights.
