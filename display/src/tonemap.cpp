@@ -13,6 +13,7 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/colour.h"
+#include "atonlab/display/mesopic.h"
 
 namespace atonlab::display {
 namespace {
@@ -191,10 +192,19 @@ double scotopic_luminance(glm::dvec3 xyz) {
 }
 
 glm::dvec3 scotopic_weights_rgb() {
-    // K2012 eq 4.25 at each Rec.709 primary (a column of the RGB -> XYZ matrix):
-    // (0.0844, 1.9690, 0.5188), summing to 2.5722 for D65 white (the formula itself gives 2.5728).
-    const Mat3& m = rec709_rgb_to_xyz();
-    return {scotopic_luminance(m[0]), scotopic_luminance(m[1]), scotopic_luminance(m[2])};
+    // Scotopic cd/m² per unit of each channel (docs/tone-mapping.md "Scotopic weights"). The IALA
+    // red and blue lights are drawn in the red and the blue primary alone (K2012 table 4.1), so
+    // those channels carry their representative spectra's S/P (CIE S 010 V', V), times the
+    // primary's luminance; green makes up D65 white's S/P. All three are positive.
+    static const glm::dvec3 w = [] {
+        const auto sp_of = [](std::string_view colour) {
+            return scotopic_to_photopic_ratio(*named_spectrum(*iala_colour_spectrum_name(colour)));
+        };
+        const Mat3& m = rec709_rgb_to_xyz();  // m[c][1]: the luminance of primary c at unit drive
+        const double r = m[0][1] * sp_of("red"), b = m[2][1] * sp_of("blue");
+        return glm::dvec3(r, sp_of("white") - r - b, b);
+    }();
+    return w;
 }
 
 double scotopic_luminance_rgb(glm::dvec3 rgb) {

@@ -126,11 +126,12 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                 };
                 const std::vector<Window> without = codes_of(scene_text(glare, adaptation, sky, "white", 0.0));
                 for (const std::string colour : {"red", "green", "white"}) {
-                    // The core pixel's luminance is about 0.03 cd/m² per cd at 500 m and
-                    // 50 px/deg: intensities put it at 0.1, 10 and 1000 times the adaptation.
+                    // 1 cd at 500 m puts 4e-6 lx into a pixel of (1/50)° squared, 1.22e-7 sr:
+                    // 32.8 cd/m². Intensities put the core at about 0.1, 10 and 1000 times the
+                    // adaptation (less where the light's footprint spreads it).
                     std::vector<Window> previous = without;
                     for (const double core_factor : {0.1, 10.0, 1000.0}) {
-                        const double intensity = core_factor * adaptation / 0.0305;
+                        const double intensity = core_factor * adaptation / 32.8;
                         const std::vector<Window> with = codes_of(scene_text(glare, adaptation, sky, colour, intensity));
                         for (std::size_t k = 0; k < settings.size(); ++k) {
                             const ToneMapSettings& s = settings[k];

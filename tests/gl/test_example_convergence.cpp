@@ -221,5 +221,8 @@ TEST(ExampleConvergence, Suzuki2019GlareMatching) { expect_convergence("suzuki20
 // Issue 14: a glare test light beside a no-glare reference in one frame, at
 // 0.001, 0.03 and 1 cd/m² (each light its own glare model).
 TEST(ExampleConvergence, GlareSideBySide) { expect_convergence("glare_side_by_side.toml"); }
+// Issue 24: red (with glare) and green lights matched against white at 0.001, 0.1 and
+// 10 cd/m², side by side, with the perceptual operator's rod pathway.
+TEST(ExampleConvergence, ColourNightMatching) { expect_convergence("colour_night_matching.toml"); }
 
 }  // namespace

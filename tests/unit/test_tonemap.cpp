@@ -344,11 +344,17 @@ TEST(ToneCurves, LinearAndClampExposure) {
     EXPECT_NEAR(tone_curve(3.0, 0.0, 3.0, s), 0.5, 1e-15);
     s.white_cd_m2 = 300.0;
     EXPECT_NEAR(tone_curve(150.0, 0.0, 1e-3, s), 0.5, 1e-15);
+    // clamp limits luminance at white first and gives up chroma (docs/tone-mapping.md "Adding
+    // light never darkens"): (600, 150, 30)/300 = (2, 0.5, 0.1) has Y = 0.790 (hand), kept, with
+    // the red channel at 1 and the others on the line to grey; Y above 1 is white.
     s.tone_operator = ToneOperator::clamp;
-    const glm::dvec3 out = tonemap_pixel({900.0, 150.0, 30.0}, 1.0, s);
-    EXPECT_NEAR(out.r, 1.0, 1e-15);
-    EXPECT_NEAR(out.g, 0.5, 1e-15);
-    EXPECT_NEAR(out.b, 0.1, 1e-15);
+    const glm::dvec3 out = tonemap_pixel({600.0, 150.0, 30.0}, 1.0, s);
+    const double y = 0.2126 * 2.0 + 0.7152 * 0.5 + 0.0722 * 0.1, t = (1.0 - y) / (2.0 - y);
+    EXPECT_NEAR(out.r, 1.0, 1e-12);
+    EXPECT_NEAR(out.g, y + t * (0.5 - y), 1e-4);  // the weights rounded to 4 digits here
+    EXPECT_NEAR(out.b, y + t * (0.1 - y), 1e-4);
+    EXPECT_NEAR(luminance_of_linear_rgb(out), luminance_of_linear_rgb(glm::dvec3(2.0, 0.5, 0.1)), 1e-14);
+    EXPECT_EQ(tonemap_pixel({900.0, 150.0, 30.0}, 1.0, s), glm::dvec3(1.0));  // Y = 1.0026
 }
 
 TEST(HuePreservation, NoneScalesRgbByLdOverLw) {
@@ -380,14 +386,20 @@ TEST(HuePreservation, Eq428IsMinOfOneNotMax) {
     EXPECT_GT(out.r, 1.0);  // eq 4.28 limits Y, not the channels
 }
 
-TEST(HuePreservation, Eq430DividesByTheLargestChannel) {
+TEST(HuePreservation, Eq430KeepsTheLuminanceInsteadOfDividingByTheLargestChannel) {
+    // K2012 eq 4.30 divides (2, 0.2, 0.01) by 2: (1, 0.1, 0.005), Y = 0.2841 of the 0.5689
+    // asked for. Luminance wins here: Y stays 0.5689, red at 1, chroma given up towards grey.
     ToneMapSettings s = plain(ToneOperator::linear);
     s.hue_preservation = HuePreservation::rgb;
     s.white_cd_m2 = 100.0;
-    const glm::dvec3 out = tonemap_pixel({800.0, 200.0, 10.0}, 1.0, s);
-    EXPECT_NEAR(out.r, 1.0, 1e-15);
-    EXPECT_NEAR(out.g, 0.25, 1e-15);
-    EXPECT_NEAR(out.b, 0.0125, 1e-15);
+    const glm::dvec3 out = tonemap_pixel({200.0, 20.0, 1.0}, 1.0, s);
+    const double y = luminance_of_linear_rgb(glm::dvec3(2.0, 0.2, 0.01));
+    EXPECT_NEAR(y, 0.2126 * 2.0 + 0.7152 * 0.2 + 0.0722 * 0.01, 1e-4);  // 0.5689
+    EXPECT_NEAR(out.r, 1.0, 1e-12);
+    EXPECT_NEAR(luminance_of_linear_rgb(out), y, 1e-14);
+    EXPECT_GT(luminance_of_linear_rgb(out), 2.0 * luminance_of_linear_rgb(glm::dvec3(1.0, 0.1, 0.005)));
+    EXPECT_LE(std::max(out.g, out.b), 1.0);
+    EXPECT_EQ(tonemap_pixel({800.0, 200.0, 10.0}, 1.0, s), glm::dvec3(1.0));  // Y = 3.14: white
     const glm::dvec3 dim = tonemap_pixel({80.0, 20.0, 1.0}, 1.0, s);  // max < 1: untouched
     EXPECT_NEAR(dim.r, 0.8, 1e-15);
 }
@@ -419,8 +431,8 @@ TEST(Blueshift, DarkAdaptationTurnsEveryColourTowardsTheBlueshiftHue) {
         // σ(1e-6) = 0.999975: the red light's own chromaticity has weight 2.5e-5.
         const glm::dvec3 dark = tonemap_pixel({5e-6, 0.0, 0.0}, 1e-6, s);
         EXPECT_NEAR(glm::length(xy_of_rgb(dark) - glm::dvec2(0.3, 0.3)), 0.0, 2e-4) << hue_preservation_name(h);
-        // Daylight: σ(1e4) = 4e-6, colour kept.
-        const glm::dvec3 rgb(5e4, 1e3, 0.0);
+        // Daylight: σ(1e4) = 4e-6, colour kept (dim enough that no channel exceeds 1).
+        const glm::dvec3 rgb(5e3, 1e2, 0.0);
         const glm::dvec3 day = tonemap_pixel(rgb, 1e4, s);
         EXPECT_NEAR(glm::length(xy_of_rgb(day) - xy_of_rgb(rgb)), 0.0, 1e-4) << hue_preservation_name(h);
     }

@@ -165,15 +165,15 @@ double log10_tvi_cone(double log10_adaptation_cd_m2);
 /// V = 2.573 Y.
 double scotopic_luminance(glm::dvec3 xyz);
 
-/// The scotopic luminance the perceptual operator uses (cd/m² of scotopic light, on eq 4.25's
-/// scale), linear in linear Rec.709 RGB (cd/m²): V = w · RGB, w = eq 4.25 evaluated at each
-/// primary, (0.0844, 1.9690, 0.5188). Scotopic luminance is an integral of the spectrum
-/// (CIE 1951 V'(λ)), so it adds; eq 4.25 of a pixel's XYZ does not (adding red light to a
-/// D65 pixel lowers its (Y + Z)/X and can lower V), which made a red light darken a night
-/// sky. This form equals eq 4.25 at every primary and is within 0.03 % of it for D65
-/// white; negative components count as 0.
+/// The scotopic luminance the perceptual operator uses, in scotopic cd/m², linear in linear
+/// Rec.709 RGB (cd/m²): V = w · RGB with non-negative weights, negative components counted as 0.
+/// Scotopic luminance is an integral of the spectrum against CIE 1951 V'(λ), so it adds; eq 4.25
+/// of a pixel's XYZ does not (adding red light to a D65 pixel lowers its (Y + Z)/X and can lower
+/// V), which made a red light darken a night sky. w (scotopic_weights_rgb) gives the IALA red and
+/// blue lights (drawn in the red and blue primary alone) their representative spectra's S/P
+/// ratios and D65 white its S/P (2.4645); docs/tone-mapping.md "Scotopic weights".
 double scotopic_luminance_rgb(glm::dvec3 rgb_cd_m2);
-glm::dvec3 scotopic_weights_rgb();  ///< the weights w above
+glm::dvec3 scotopic_weights_rgb();  ///< the weights w above, scotopic cd/m² per cd/m² of each channel
 
 /// K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1): the scene key
 /// α(L_wa) = 1.002 - 2 / (2 + log10(L_wa + 1)). The thesis drops the "+ 1", which makes
