@@ -19,8 +19,7 @@ namespace {
 
 /// Every judged light of the condition's stimulus at `level` (the test first
 /// in 2AFC: the order does not change what each light looks like).
-LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c, double level,
-                    double window_radius_deg) {
+LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, const p::Condition& c, double level) {
     p::Proposal proposal;
     proposal.level = level;
     if (c.task == p::Task::TwoAfc) proposal.test_on_left = true;
@@ -42,10 +41,13 @@ LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, con
         s.role = v.role;
         s.light = v.light;
         s.peak_code = w.peak_code;
-        s.background_code = w.background_code;
-        s.rise_codes = w.rise_codes;
         s.clipped = w.clipped;
-        s.light_lux = p::window_light_lux(w.image, w.light_px, window_radius_deg);
+        s.background_code = w.background_code;
+        s.background_cd_m2 = w.background_cd_m2;
+        // What the model observer sums (observer.h window_light_lux), signed:
+        // Σ (L − L_off) · Ω over its window.
+        s.added_lux = p::increment_illuminance_lux(w.image, w.light_px, renderer.window_radius_deg());
+        s.resolution_lux = w.code_step_cd_m2 * w.image.pixel_sr();
         end.lights.push_back(std::move(s));
     }
     return end;
@@ -61,51 +63,125 @@ std::string role_text(const ShownLight& s) {
     return fmt::format("{} light \"{}\"", p::to_string(s.role), s.light);
 }
 
-/// R1-R3 of displayability.h for one condition.
-std::vector<std::string> problems_of(const p::Condition& c, const LevelEnd& low, const LevelEnd& high, int white) {
-    std::vector<std::string> out;
+/// The level where the level stimulus would add `target` lux, from the two
+/// ends (R4): log10 of the light linear in the level on a log10 level scale
+/// (a light's intensity is 10^level), the light itself on a linear one.
+/// nullopt where the ends do not give it.
+std::optional<double> interpolate_level(const p::Condition& c, double lo_level, double lo_lux, double hi_level,
+                                        double hi_lux, double target_lux) {
+    const bool log_scale = c.level_scale == p::LevelScale::Log10;
+    if (log_scale && !(lo_lux > 0 && hi_lux > 0 && target_lux > 0)) return std::nullopt;
+    const auto f = [&](double e) { return log_scale ? std::log10(e) : e; };
+    if (!(f(hi_lux) != f(lo_lux))) return std::nullopt;
+    const double level = lo_level + (hi_level - lo_level) * (f(target_lux) - f(lo_lux)) / (f(hi_lux) - f(lo_lux));
+    return std::isfinite(level) ? std::optional<double>(level) : std::nullopt;
+}
+
+/// The name of the bound at the low or high end of a condition's range.
+std::string bound_name(const p::Condition& c, bool high) {
+    if (c.procedure.kind == p::ProcedureKind::ConstantStimuli)
+        return high ? "the highest of its levels" : "the lowest of its levels";
+    return high ? "max_level" : "min_level";
+}
+
+/// R1 for one light: it adds less than the display's resolution.
+std::string invisible(const ShownLight& s, const std::string& where, bool level_light, const std::string& raise) {
+    const std::string adds =
+        s.added_lux > 0
+            ? fmt::format("adds {:.3g} lx, less than one code step at its brightest pixel ({:.3g} lx)", s.added_lux,
+                          s.resolution_lux)
+            : fmt::format("adds no light ({:.3g} lx; one code step there is {:.3g} lx)", s.added_lux, s.resolution_lux);
+    return fmt::format(
+        "the {} {} within the observer's window {} over a background of {:.3g} cd/m² (codes {},{},{}): it cannot be "
+        "seen; {}",
+        role_text(s), adds, where, s.background_cd_m2, s.background_code.r, s.background_code.g, s.background_code.b,
+        level_light ? raise : "raise its intensity_cd (give it headroom: docs/protocol-file.md, \"Displayability\")");
+}
+
+/// R1-R4 of displayability.h for one condition; sets cd.equal_level.
+void judge(const p::Condition& c, ConditionDisplayability& cd, int white) {
+    std::vector<std::string>& out = cd.problems;
     const bool matching = c.task != p::Task::YesNo;
-    const std::string top = fmt::format("{:.4g}", high.level);
-    // R1: each judged light, at the top of the range, where it is brightest.
-    for (const ShownLight& s : high.lights) {
-        if (s.rise_codes >= kMinRiseCodes) continue;
-        const bool level_light = s.role == c.level_on;
-        out.push_back(fmt::format(
-            "the {} rises {} code value{} above the background (code {}) at the top of the level range ({}), "
-            "fewer than {}: it cannot be seen; {}",
-            role_text(s), s.rise_codes, s.rise_codes == 1 ? "" : "s", s.background_code, top, kMinRiseCodes,
-            level_light ? "raise max_level (or the intensity the level scales)"
-                        : "raise its intensity_cd (give it headroom: docs/protocol-file.md, \"Displayability\")"));
+    const p::Role other_role = c.level_on == p::Role::Test ? p::Role::Reference : p::Role::Test;
+    const ShownLight* lo = find_role(cd.low, c.level_on);
+    const ShownLight* hi = find_role(cd.high, c.level_on);
+    // Where the level stimulus adds most: the top of the range unless the
+    // level dims it (a level key that darkens).
+    const bool rising = !(lo && hi && lo->added_lux > hi->added_lux);
+    const LevelEnd& bright = rising ? cd.high : cd.low;
+    const LevelEnd& dim = rising ? cd.low : cd.high;
+    const std::string bright_at = fmt::format("at {} ({:.4g})", bound_name(c, rising), bright.level);
+    // R1: every judged light where it adds most (the other stimulus is the same at both ends).
+    bool seen = true;
+    for (const ShownLight& s : bright.lights) {
+        if (s.added_lux > 0 && s.added_lux >= s.resolution_lux) continue;
+        seen = false;
+        out.push_back(invisible(s, bright_at, s.role == c.level_on,
+                                fmt::format("{} {} (or raise the intensity the level scales)",
+                                            rising ? "raise" : "lower", bound_name(c, rising))));
     }
-    const ShownLight* lo = find_role(low, c.level_on);
-    const ShownLight* hi = find_role(high, c.level_on);
-    if (!lo || !hi) return out;
+    if (!lo || !hi || !seen) return;
+    const ShownLight& level_bright = rising ? *hi : *lo;
+    const ShownLight& level_dim = rising ? *lo : *hi;
     // R2: the level changes nothing on the screen.
-    if (!(hi->light_lux > lo->light_lux) && hi->rise_codes >= kMinRiseCodes)
+    if (const double change = std::abs(hi->added_lux - lo->added_lux);
+        change == 0 || change < level_bright.resolution_lux) {
         out.push_back(fmt::format(
-            "the {} shows the same at both ends of the level range ({:.4g} and {}){}: the level changes nothing on "
-            "this display; lower the range (min_level, max_level) below where it clips",
-            role_text(*hi), low.level, top, hi->clipped ? fmt::format(", clipped at the display's white (code {})", white)
-                                                       : std::string()));
-    // R3: clipped, and still less light than the other stimulus.
-    if (matching && hi->clipped) {
-        const p::Role other_role = c.level_on == p::Role::Test ? p::Role::Reference : p::Role::Test;
-        // 1% below: two lights clipped alike are equal, not one dimmer (the sums differ in the last digits).
-        if (const ShownLight* other = find_role(high, other_role); other && hi->light_lux < 0.99 * other->light_lux)
-            out.push_back(fmt::format(
-                "at the top of the level range ({}) the {} is clipped at the display's white (code {}) and still "
-                "puts less light into the eye ({:.3g} lx) than the {} ({:.3g} lx): no level can make it the brighter; "
-                "lower the {}'s intensity, or show the lights on larger pixels (a smaller display.width_px, or a "
-                "longer viewing distance in pixels per degree) or an HDR display",
-                top, role_text(*hi), white, hi->light_lux, role_text(*other), other->light_lux,
-                p::to_string(other_role)));
+            "the {} adds the same light at both ends of the level range ({:.4g} and {:.4g}: {:.3g} and {:.3g} lx, "
+            "less apart than one code step, {:.3g} lx){}: the level changes nothing on this display; lower the range "
+            "(min_level, max_level) below where it clips",
+            role_text(*hi), cd.low.level, cd.high.level, lo->added_lux, hi->added_lux, level_bright.resolution_lux,
+            hi->clipped ? fmt::format(", clipped at the display's white (code {})", white) : std::string()));
+        return;
     }
-    return out;
+    if (!matching) return;
+    const ShownLight* other = find_role(bright, other_role);
+    if (!other) return;
+    cd.equal_level = interpolate_level(c, cd.low.level, lo->added_lux, cd.high.level, hi->added_lux, other->added_lux);
+    const double span = std::abs(cd.high.level - cd.low.level);
+    // R3: clipped where brightest, and still less light than the other stimulus.
+    // 1% below: two lights clipped alike are equal, not one dimmer (the sums differ in the last digits).
+    if (level_bright.clipped && level_bright.added_lux < 0.99 * other->added_lux) {
+        out.push_back(fmt::format(
+            "{} the {} is clipped at the display's white (code {}) and still adds less light ({:.3g} lx) than the "
+            "{} ({:.3g} lx): no level can make it the brighter; lower the {}'s intensity, or show the lights on "
+            "larger pixels (a smaller display.width_px, or a longer viewing distance in pixels per degree) or an HDR "
+            "display",
+            bright_at, role_text(level_bright), white, level_bright.added_lux, role_text(*other), other->added_lux,
+            p::to_string(other_role)));
+        return;
+    }
+    // R4: the range straddles the other stimulus. A quarter of the range's
+    // width beyond the estimated equal level leaves the procedure room to bracket it.
+    const auto move_to = [&](bool high_bound) {
+        const double sign = high_bound ? 1.0 : -1.0;
+        return cd.equal_level ? fmt::format(
+                                    "; {} {} to about {:.3g} (the two would add equal light near level "
+                                    "{:.3g}, interpolated between the ends)",
+                                    high_bound ? "raise" : "lower", bound_name(c, high_bound),
+                                    *cd.equal_level + sign * 0.25 * span, *cd.equal_level)
+                              : fmt::format("; {} {}", high_bound ? "raise" : "lower", bound_name(c, high_bound));
+    };
+    if (level_dim.added_lux >= other->added_lux) {
+        out.push_back(fmt::format(
+            "the level range does not reach below the {}: at {} ({:.4g}), where it is dimmest, the {} already adds "
+            "{:.3g} lx, at least the {}'s {:.3g} lx, so no level in the range makes it the dimmer{}",
+            role_text(*other), bound_name(c, !rising), dim.level, role_text(level_dim), level_dim.added_lux,
+            p::to_string(other_role), other->added_lux, move_to(!rising)));
+    } else if (!level_bright.clipped && level_bright.added_lux <= other->added_lux) {
+        out.push_back(fmt::format(
+            "the level range does not reach above the {}: {}, where it is brightest, the {} adds only {:.3g} lx, no "
+            "more than the {}'s {:.3g} lx, so no level in the range makes it the brighter{}",
+            role_text(*other), bright_at, role_text(level_bright), level_bright.added_lux, p::to_string(other_role),
+            other->added_lux, move_to(rising)));
+    }
 }
 
 std::string light_cell(const ShownLight& s, int white) {
-    return fmt::format("{} {:>4} (bg {:>3}, +{:<3}{}) {:.2e} lx", p::to_string(s.role), s.peak_code, s.background_code,
-                       s.rise_codes, s.peak_code >= white && s.clipped ? " WHITE" : "", s.light_lux);
+    return fmt::format("{} {:+.2e} lx ({:>7.3g} steps of {:.1e} lx) peak {:>4}{} bg {},{},{} {:.2e} cd/m²",
+                       p::to_string(s.role), s.added_lux, s.resolution_lux > 0 ? s.added_lux / s.resolution_lux : 0.0,
+                       s.resolution_lux, s.peak_code, s.peak_code >= white && s.clipped ? " WHITE" : "",
+                       s.background_code.r, s.background_code.g, s.background_code.b, s.background_cd_m2);
 }
 
 }  // namespace
@@ -116,13 +192,13 @@ bool Displayability::displayable() const noexcept {
 }
 
 Displayability check_displayability(StimulusRenderer& renderer, const p::Protocol& protocol) {
-    const p::ModelObserverParams params{};  // the observer's window: the light each stimulus adds
     Displayability d;
     d.width_px = protocol.display.width_px;
     d.height_px = protocol.display.height_px;
     d.width_m = protocol.display.width_m;
     d.viewing_distance_m = protocol.display.viewing_distance_m;
     // Degrees per pixel at the centre (a flat screen; the same pinhole as the camera's).
+    d.window_radius_deg = renderer.window_radius_deg();
     d.deg_per_px = 2.0 * std::atan(0.5 * d.width_m / d.width_px / d.viewing_distance_m) * 180.0 / M_PI;
     for (const p::Block& b : protocol.blocks)
         for (const p::Condition& c : b.conditions) {
@@ -130,11 +206,11 @@ Displayability check_displayability(StimulusRenderer& renderer, const p::Protoco
             ConditionDisplayability cd;
             cd.name = c.name;
             cd.line = c.line;
-            cd.low = render_end(renderer, protocol, c, lo, params.window_radius_deg);
-            cd.high = render_end(renderer, protocol, c, hi, params.window_radius_deg);
+            cd.low = render_end(renderer, protocol, c, lo);
+            cd.high = render_end(renderer, protocol, c, hi);
             // The codes' depth (white = 2^bits − 1), as every window of the frames knows it.
             d.bits = static_cast<int>(std::lround(std::log2(static_cast<double>(cd.high.white_code) + 1.0)));
-            cd.problems = problems_of(c, cd.low, cd.high, (1 << d.bits) - 1);
+            judge(c, cd, (1 << d.bits) - 1);
             d.conditions.push_back(std::move(cd));
         }
     return d;
@@ -143,16 +219,21 @@ Displayability check_displayability(StimulusRenderer& renderer, const p::Protoco
 std::string displayability_table(const Displayability& d) {
     const int white = (1 << d.bits) - 1;
     std::string t = fmt::format(
-        "displayability on {}×{} px, {:.3g} m wide at {:.3g} m ({:.4f}°/px), {}-bit codes (white {}): peak code "
-        "(background, rise), light into the eye:\n",
-        d.width_px, d.height_px, d.width_m, d.viewing_distance_m, d.deg_per_px, d.bits, white);
+        "displayability on {}×{} px, {:.3g} m wide at {:.3g} m ({:.4f}°/px), {}-bit codes (white {}): per judged "
+        "light, the light it adds to the eye within the observer's {:.3g}° window (Σ (L − L_off)·Ω, lx, L decoded "
+        "through the display model), that in code steps at its brightest pixel (one step's light, lx), its peak "
+        "code, and the background there with the judged lights off (codes R,G,B; cd/m²):\n",
+        d.width_px, d.height_px, d.width_m, d.viewing_distance_m, d.deg_per_px, d.bits, white, d.window_radius_deg);
     for (const ConditionDisplayability& c : d.conditions) {
         for (const LevelEnd* end : {&c.low, &c.high}) {
-            std::string row = fmt::format("  {:<24} level {:>8.4g} ", end == &c.low ? c.name : std::string(),
-                                          end->level);
+            std::string row =
+                fmt::format("  {:<24} level {:>8.4g} ", end == &c.low ? c.name : std::string(), end->level);
             for (const ShownLight& s : end->lights) row += " | " + light_cell(s, white);
             t += row + "\n";
         }
+        if (c.equal_level)
+            t += fmt::format("  {:<24} level stimulus equals the other near level {:.3g} (interpolated)\n", "",
+                             *c.equal_level);
         t += c.displayable() ? "" : fmt::format("  {:<24} NOT DISPLAYABLE\n", "");
     }
     return t;
@@ -178,17 +259,22 @@ std::string displayability_json(const Displayability& d, bool allowed) {
         for (const LevelEnd* end : {&c.low, &c.high}) {
             Json lights = Json::array();
             for (const ShownLight& s : end->lights)
-                lights.push_back(Json{{"role", p::to_string(s.role)},
-                                      {"light", s.light},
-                                      {"peak_code", s.peak_code},
-                                      {"background_code", s.background_code},
-                                      {"rise_codes", s.rise_codes},
-                                      {"clipped", s.clipped},
-                                      {"light_lux", s.light_lux}});
+                lights.push_back(Json{
+                    {"role", p::to_string(s.role)},
+                    {"light", s.light},
+                    {"added_lux", s.added_lux},
+                    {"resolution_lux", s.resolution_lux},
+                    {"peak_code", s.peak_code},
+                    {"clipped", s.clipped},
+                    {"background_code", Json::array({s.background_code.r, s.background_code.g, s.background_code.b})},
+                    {"background_cd_m2", s.background_cd_m2}});
             ends.push_back(Json{{"level", end->level}, {"lights", std::move(lights)}});
         }
-        conditions.push_back(Json{
-            {"name", c.name}, {"displayable", c.displayable()}, {"problems", c.problems}, {"ends", std::move(ends)}});
+        conditions.push_back(Json{{"name", c.name},
+                                  {"displayable", c.displayable()},
+                                  {"problems", c.problems},
+                                  {"equal_level", c.equal_level ? Json(*c.equal_level) : Json(nullptr)},
+                                  {"ends", std::move(ends)}});
     }
     const Json j{{"display",
                   {{"width_px", d.width_px},
@@ -198,7 +284,7 @@ std::string displayability_json(const Displayability& d, bool allowed) {
                    {"deg_per_px", d.deg_per_px},
                    {"bits", d.bits},
                    {"white_code", (1 << d.bits) - 1}}},
-                 {"min_rise_codes", kMinRiseCodes},
+                 {"window_radius_deg", d.window_radius_deg},
                  {"displayable", d.displayable()},
                  {"allowed_undisplayable", allowed},
                  {"conditions", std::move(conditions)}};

@@ -1,25 +1,40 @@
 #pragma once
-// Displayability: what a protocol's stimuli look like on its display before
-// the first trial (docs/running.md, "Displayability"). For every condition, at
-// both ends of its level range, each judged light is rendered at the display's
-// geometry and calibration (the StimulusRenderer of the session) and
-// summarised in code values: the peak code, the background's, how far the
-// light rises above the background, whether it clips at the display's white,
-// and the light it puts into the eye (lux).
+// Displayability: what a protocol's stimuli give the observer on its display
+// before the first trial (docs/running.md, "Displayability"). For every
+// condition, at both ends of its level range, each judged light is rendered at
+// the display's geometry and calibration (the StimulusRenderer of the session)
+// together with the same frame without the judged lights (the same moment and
+// dither frame), both decoded through the display model to displayed
+// luminance (cd/m²). A light's contribution is what it adds to the eye's
+// illuminance over the model observer's window (radius 0.5°, observer.h):
+// E = Σ (L − L_off) · Ω_px, lux; the display's resolution for it is one code
+// step at the pixel where it adds most: the displayed luminance of raising the
+// channels it raises there by one code over the lights-off codes, times Ω_px
+// (lux): the least light the display can add there.
 //
 // A condition "cannot produce a match" (or a threshold) on this display when
-//  R1  a judged light rises fewer than kMinRiseCodes code values above the
-//      background at the top of the level range (it cannot be seen there, and
-//      the top is where it is brightest);
-//  R2  the level stimulus puts no more light into the eye at the top of the
-//      range than at the bottom (the display clips or hides it over the whole
-//      range: the level changes nothing on the screen);
-//  R3  (2AFC and adjust) at the top of the range the level stimulus is clipped
-//      at the display's white and still puts less light into the eye than the
-//      other stimulus (by more than 1%): no level in the range can make it the
-//      brighter of the two.
-// `atonlab run` refuses such a protocol (exit 2) unless --allow-undisplayable;
-// `atonlab check` prints the same table and exits 0 or 2.
+//  R1  a judged light adds nothing, or less than the display's resolution, at
+//      the end of the level range where it adds most (the level stimulus) or
+//      at the top (the other stimulus): it cannot be seen;
+//  R2  the level stimulus adds the same light at both ends of the range
+//      (within the display's resolution: the display clips or hides it over
+//      the whole range; the level changes nothing on the screen);
+//  R3  (2AFC and adjust) at the end where the level stimulus is brightest it
+//      is clipped at the display's white and still adds less light than the
+//      other stimulus (by more than 1 %): no level in the range can make it
+//      the brighter of the two;
+//  R4  (2AFC and adjust) the range does not straddle the other stimulus: at
+//      the end where the level stimulus is dimmest it already adds at least
+//      the other's light, or at its brightest end (not clipped) no more; the
+//      sentence names the bound to move and about where (the level where the
+//      two would be equal, interpolated between the ends: log10 of the light
+//      linear in the level on a log10 level scale, the light itself on a
+//      linear one).
+// `atonlab run` refuses such a protocol (exit 2, before the study file is
+// created) unless --allow-undisplayable; `atonlab check` prints the same table
+// and exits 0 or 2.
+#include <glm/vec3.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,18 +43,22 @@
 
 namespace atonlab::runner {
 
-/// R1's limit: a light must rise at least this many code values above the background.
-inline constexpr int kMinRiseCodes = 2;
-
 /// One judged light at one level.
 struct ShownLight {
     protocols::Role role = protocols::Role::Test;
-    std::string light;         ///< the scene light's name
-    int peak_code = 0;         ///< the highest code of any channel in its window
-    int background_code = 0;   ///< the same with the judged lights off
-    int rise_codes = 0;        ///< the most a pixel's channel lies above the lights-off frame
-    bool clipped = false;      ///< a channel at the display's white
-    double light_lux = 0.0;    ///< what it adds to the eye's illuminance within the observer's window, lx
+    std::string light;     ///< the scene light's name
+    int peak_code = 0;     ///< the highest code of any channel in its window
+    bool clipped = false;  ///< a channel at the display's white where the lights-off frame is not
+    /// The lights-off codes (R, G, B) and displayed luminance (cd/m²) at the
+    /// pixel where the light adds most (under its centre where it adds none).
+    glm::ivec3 background_code{0};
+    double background_cd_m2 = 0.0;
+    /// E: the light it adds to the eye's illuminance within the observer's
+    /// window, Σ (L − L_off) · Ω_px, lx; negative where it takes light away.
+    double added_lux = 0.0;
+    /// The display's resolution there: one code step of the channels it
+    /// raises at that pixel, over the lights-off codes, times Ω_px, lx.
+    double resolution_lux = 0.0;
 };
 
 /// A condition's stimulus at one end of its level range.
@@ -51,9 +70,13 @@ struct LevelEnd {
 
 struct ConditionDisplayability {
     std::string name;
-    int line = 0;         ///< the condition's line in the protocol
-    LevelEnd low, high;   ///< the bottom and top of the level range
-    /// Why the condition cannot produce a match on this display (R1-R3, with
+    int line = 0;        ///< the condition's line in the protocol
+    LevelEnd low, high;  ///< the bottom and top of the level range
+    /// 2AFC and adjust: the level where the level stimulus would add as much
+    /// light as the other, interpolated between the ends (R4); nullopt where
+    /// the ends do not give one (a light adds none, or the same at both ends).
+    std::optional<double> equal_level;
+    /// Why the condition cannot produce a match on this display (R1-R4, with
     /// what to change), one clause each; empty when it can.
     std::vector<std::string> problems;
     bool displayable() const noexcept { return problems.empty(); }
@@ -62,8 +85,9 @@ struct ConditionDisplayability {
 struct Displayability {
     int width_px = 0, height_px = 0;
     double width_m = 0.0, viewing_distance_m = 0.0;
-    double deg_per_px = 0.0;  ///< at the screen's centre
-    int bits = 8;             ///< bits per channel of the codes
+    double deg_per_px = 0.0;         ///< at the screen's centre
+    double window_radius_deg = 0.5;  ///< the observer's window the light is summed over, degrees
+    int bits = 8;                    ///< bits per channel of the codes
     std::vector<ConditionDisplayability> conditions;
     bool displayable() const noexcept;
 };
@@ -71,7 +95,7 @@ struct Displayability {
 /// Renders every condition at both ends of its level range (min_level and
 /// max_level, or the constant-stimuli levels' extremes; else the procedure's
 /// search range) on `renderer` (set up as the session's: display model and
-/// window radius) and applies R1-R3. Throws InputError (a scene refused).
+/// window radius) and applies R1-R4. Throws InputError (a scene refused).
 Displayability check_displayability(StimulusRenderer& renderer, const protocols::Protocol& protocol);
 
 /// The table printed in the run header and by `atonlab check`: one line per

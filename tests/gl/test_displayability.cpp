@@ -5,23 +5,37 @@
 //    each at the protocol's viewing distance (issue 14 item 6);
 //  - a light far too dim for its display (1e-7 cd at 500 m on 320 × 180 px:
 //    3e-6 cd/m² over one pixel, 0.3 % of the 0.001 cd/m² background, less than
-//    one 8-bit step at any code) is reported fewer than 2 code values above it;
-//  - `atonlab run` refuses a protocol whose test light cannot rise 2 code
-//    values above the background (exit 2, one sentence naming the condition's
-//    line) before any trial, and creates no study file; with
+//    one 8-bit step at any code) changes no code of its frame, so it adds
+//    exactly 0 lx over the lights-off frame of the same dither: R1 refuses it,
+//    and the display's resolution there (one code step over the background's
+//    codes, times the pixel's solid angle) is the sRGB decoding's, worked out
+//    here independently;
+//  - a white reference whose lowest level already puts more light into the eye
+//    than the (white, same place) test is refused under R4, saying to lower
+//    min_level; the level where the two are equal, interpolated between the
+//    ends, lies near log10 of the test's intensity (the analytic match); with
+//    the bound moved as said, the condition passes;
+//  - a good condition passes, its interpolated equal level near the same;
+//  - `atonlab run` refuses a protocol whose test light adds nothing, or whose
+//    range does not straddle the test (exit 2, one sentence naming the
+//    condition's line) before any trial, and creates no study file; with
 //    --allow-undisplayable it runs and records the flag in the session
 //    (sessions.displayability_json), and `atonlab analyze` says so;
 //  - `atonlab check` prints the table and exits 0 or 2, writing nothing.
 // The binary's tests skip where it finds no GL 4.5 context (exit status 3).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <ostream>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../store/store_test_support.h"
@@ -65,10 +79,37 @@ Displayability check(const fs::path& file, int width_px, int height_px, double w
     protocol.display.height_px = height_px;
     protocol.display.width_m = width_m;
     const p::ModelObserverParams params{};
-    runner::StimulusRenderer renderer(stimuli::SceneTemplate::parse(file_bytes(protocol.scene), protocol.scene.string()), params.window_radius_deg,
-                                      protocol.timing.stimulus_s);
+    runner::StimulusRenderer renderer(
+        stimuli::SceneTemplate::parse(file_bytes(protocol.scene), protocol.scene.string()), params.window_radius_deg,
+        protocol.timing.stimulus_s);
     return runner::check_displayability(renderer, protocol);
 }
+
+/// A copy of `from` in `dir` named `name`, each `replace` pair's first text
+/// (which must be there) replaced by its second, and its scene named by its
+/// absolute path (the copy is not beside the scene).
+fs::path variant(const fs::path& dir, const std::string& name, const fs::path& from,
+                 const std::vector<std::pair<std::string, std::string>>& replace) {
+    std::string text = file_bytes(from);
+    const std::string scene = "scene = \"small.scene.toml\"";
+    std::vector<std::pair<std::string, std::string>> all = replace;
+    all.emplace_back(scene, "scene = \"" + (kSource / "tests/data/run/small.scene.toml").string() + "\"");
+    for (const auto& [a, b] : all) {
+        const std::size_t at = text.find(a);
+        if (at == std::string::npos) throw std::runtime_error("variant: no \"" + a + "\" in " + from.string());
+        text.replace(at, a.size(), b);
+    }
+    const fs::path out = dir / name;
+    std::FILE* f = std::fopen(out.c_str(), "wb");
+    if (!f) throw std::runtime_error("cannot write " + out.string());
+    std::fwrite(text.data(), 1, text.size(), f);
+    std::fclose(f);
+    return out;
+}
+
+/// Protocol-file values the tests below change in undisplayable_2afc.toml.
+const std::string kTestIntensity = "light.test.intensity_cd=1e-7";
+const std::string kMinLevel = "min_level = -4.0";
 
 struct DisplayCase {
     const char* name;
@@ -100,7 +141,9 @@ std::vector<ExampleAtDisplay> examples_at_displays() {
 
 class Examples : public ::testing::TestWithParam<ExampleAtDisplay> {};
 
-TEST(Displayability, ThereAreExamples) { EXPECT_GE(example_protocols().size(), 4u); }
+TEST(Displayability, ThereAreExamples) {
+    EXPECT_GE(example_protocols().size(), 4u);
+}
 
 // The long form (docs/running.md, "Displayability"): every example at three
 // displays renders hundreds of full frames, 1–13 min per case on llvmpipe, so
@@ -142,20 +185,138 @@ bool contains(const std::string& s, const std::string& part) {
     return s.find(part) != std::string::npos;
 }
 
+/// IEC 61966-2-1 (sRGB) decoding of a drive level V in [0, 1]: the scene's
+/// default display (docs/scene-file.md: transfer "srgb", peak 100 cd/m², black
+/// 0.1 cd/m², each channel its Rec.709 share), in double precision.
+double srgb_decode(double v) {
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+/// What the default display emits for 8-bit codes (R, G, B), cd/m².
+double default_display_cd_m2(const glm::ivec3& code) {
+    const double share[3] = {0.2126, 0.7152, 0.0722};
+    double l = 0.0;
+    for (int c = 0; c < 3; ++c) l += share[c] * (0.1 + (100.0 - 0.1) * srgb_decode(code[c] / 255.0));
+    return l;
+}
+
+/// The solid angle (sr) of a pixel at the centre of a display width_px wide
+/// over width_m, seen from distance_m.
+double pixel_sr(int width_px, double width_m, double distance_m) {
+    const double pitch_rad = 2.0 * std::atan(0.5 * width_m / width_px / distance_m);
+    return pitch_rad * pitch_rad;
+}
+
+// A test light far too dim to change any code (the file's header): it adds
+// exactly nothing over the lights-off frame of the same dither, so R1 refuses
+// it; what the check calls the display's resolution there is one code step of
+// all three channels (the light raises none) over the background's codes.
+TEST(Displayability, TooDimTestLightAddsNothingAndIsRefused) {
+    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    const Displayability d = check(kUndisplayable, 320, 180, 0.1);
+    ASSERT_EQ(d.conditions.size(), 1u);
+    const runner::ConditionDisplayability& c = d.conditions[0];
+    EXPECT_FALSE(c.displayable());
+    ASSERT_EQ(c.high.lights.size(), 2u);
+    const runner::ShownLight& test = c.high.lights[0];
+    ASSERT_EQ(test.role, p::Role::Test);
+    // Not a hair of dither noise: the same frame index in both renders.
+    EXPECT_EQ(test.added_lux, 0.0);
+    // The 0.001 cd/m² sky is shown above the display's black: its codes are
+    // what the screen shows (not 0), and their luminance is the display's.
+    EXPECT_GT(test.background_code.r + test.background_code.g + test.background_code.b, 0);
+    EXPECT_NEAR(test.background_cd_m2, default_display_cd_m2(test.background_code), 1e-6)
+        << "background decoded through the display model";
+    const double step_cd_m2 =
+        default_display_cd_m2(test.background_code + glm::ivec3(1)) - default_display_cd_m2(test.background_code);
+    // 0.5 %: the check's pixel is the camera's at the screen's centre (its own
+    // pinhole), this one the display's pitch over the distance; they agree to ~1e-6.
+    EXPECT_NEAR(test.resolution_lux, step_cd_m2 * pixel_sr(320, 0.1, 0.9), 5e-3 * test.resolution_lux);
+    ASSERT_FALSE(c.problems.empty());
+    EXPECT_TRUE(contains(c.problems[0], "the test light \"test\" adds no light")) << c.problems[0];
+    // The reference, which the level raises, is seen at the top of its range.
+    EXPECT_GT(c.high.lights[1].added_lux, c.high.lights[1].resolution_lux);
+}
+
+// A white reference whose lowest level already puts more light into the eye
+// than the white test at the same place: the range does not straddle the
+// test, and the refusal says to lower min_level, to about where. Both lights
+// are the same pixel of the same colour, so they are equal exactly where
+// their intensities are (the analytic match): level log10(1e-4 cd) = −4.
+TEST(Displayability, ReferenceBrighterAtItsLowestLevelIsRefusedWithTheBoundToMove) {
+    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    TempDir dir;
+    const fs::path too_bright = variant(dir.path(), "too-bright.toml", kUndisplayable,
+                                        {{kTestIntensity, "light.test.intensity_cd=1e-4"},
+                                         {kMinLevel, "min_level = -3.6"},
+                                         {"max_level = -2.0", "max_level = -3.0"}});
+    const Displayability d = check(too_bright, 320, 180, 0.1);
+    ASSERT_EQ(d.conditions.size(), 1u);
+    const runner::ConditionDisplayability& c = d.conditions[0];
+    std::printf("%s", runner::displayability_table(d).c_str());
+    EXPECT_FALSE(c.displayable());
+    ASSERT_EQ(c.problems.size(), 1u);
+    const std::string& why = c.problems[0];
+    EXPECT_TRUE(contains(why, "does not reach below the test light \"test\"")) << why;
+    EXPECT_TRUE(contains(why, "at min_level (-3.6)")) << why;
+    // The reference at its lowest level against the test.
+    ASSERT_EQ(c.low.lights[1].role, p::Role::Reference);
+    EXPECT_GE(c.low.lights[1].added_lux, c.low.lights[0].added_lux);
+    ASSERT_TRUE(c.equal_level.has_value());
+    // 0.25 log10: the level is extrapolated 0.4 below the range, along the
+    // slope the tone curve gives between its ends (it compresses: the estimate
+    // falls below the match, on the side that leaves the procedure room).
+    EXPECT_NEAR(*c.equal_level, -4.0, 0.25) << why;
+    const std::string say = "lower min_level to about ";
+    const std::size_t at = why.find(say);
+    ASSERT_NE(at, std::string::npos) << why;
+    const double suggested = std::stod(why.substr(at + say.size()));
+    EXPECT_LT(suggested, *c.equal_level);
+    // With min_level moved as said, the condition can produce a match.
+    const fs::path moved = variant(dir.path(), "moved.toml", kUndisplayable,
+                                   {{kTestIntensity, "light.test.intensity_cd=1e-4"},
+                                    {kMinLevel, fmt::format("min_level = {}", suggested)},
+                                    {"max_level = -2.0", "max_level = -3.0"}});
+    const Displayability after = check(moved, 320, 180, 0.1);
+    EXPECT_TRUE(after.displayable()) << runner::displayability_refusal(after, moved.string());
+}
+
+// A condition whose test is well shown and whose range brackets it passes, its
+// equal level near the analytic match (log10 of the test's intensity).
+TEST(Displayability, GoodConditionPasses) {
+    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    TempDir dir;
+    const fs::path good =
+        variant(dir.path(), "good.toml", kUndisplayable, {{kTestIntensity, "light.test.intensity_cd=1e-3"}});
+    const Displayability d = check(good, 320, 180, 0.1);
+    std::printf("%s", runner::displayability_table(d).c_str());
+    ASSERT_EQ(d.conditions.size(), 1u);
+    const runner::ConditionDisplayability& c = d.conditions[0];
+    EXPECT_TRUE(c.displayable()) << runner::displayability_refusal(d, good.string());
+    const runner::ShownLight& test = c.high.lights[0];
+    EXPECT_GT(test.added_lux, 10.0 * test.resolution_lux);
+    // The reference below the test at the bottom of its range, above it at the top.
+    EXPECT_LT(c.low.lights[1].added_lux, c.low.lights[0].added_lux);
+    EXPECT_GT(c.high.lights[1].added_lux, c.high.lights[0].added_lux);
+    ASSERT_TRUE(c.equal_level.has_value());
+    // 0.5 log10: interpolated across the range's two decades, along which the
+    // tone curve compresses (a straight line in log through two points).
+    EXPECT_NEAR(*c.equal_level, -3.0, 0.5);
+}
+
 TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
     TempDir dir;
     const fs::path db = dir / "study.db";
-    const Result refused =
-        atonlab({"run", kUndisplayable.string(), "--db", db.string(), "--headless", "--model-observer"}, dir.path(),
-                "refused");
+    const Result refused = atonlab(
+        {"run", kUndisplayable.string(), "--db", db.string(), "--headless", "--model-observer"}, dir.path(), "refused");
     if (refused.code == 3) GTEST_SKIP() << "no GL: " << refused.err;
     EXPECT_EQ(refused.code, 2) << refused.err;
     EXPECT_FALSE(fs::exists(db)) << "a refused session must not create the study file";
     // One sentence for the condition, naming the file and its line, what is not displayable and what to change.
     EXPECT_TRUE(contains(refused.err, kUndisplayable.string() + ":52: condition \"too-dim\" cannot produce a match"))
         << refused.err;
-    EXPECT_TRUE(contains(refused.err, "test light \"test\" rises ")) << refused.err;
-    EXPECT_TRUE(contains(refused.err, "fewer than 2: it cannot be seen; raise its intensity_cd")) << refused.err;
+    EXPECT_TRUE(contains(refused.err, "test light \"test\" adds no light")) << refused.err;
+    EXPECT_TRUE(contains(refused.err, "it cannot be seen; raise its intensity_cd")) << refused.err;
     EXPECT_TRUE(contains(refused.err, "--allow-undisplayable")) << refused.err;
     // The header's table was printed before the refusal.
     EXPECT_TRUE(contains(refused.out, "displayability on 320×180 px")) << refused.out;
@@ -176,9 +337,11 @@ TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
         EXPECT_EQ(store::string_at(j, "/conditions/0/name"), "too-dim");
         EXPECT_EQ(store::number_at(j, "/display/width_px"), 320.0);
         EXPECT_EQ(store::number_at(j, "/display/white_code"), 255.0);
-        // The test light is the first of a 2AFC stimulus; at 1e-7 cd it adds (almost) nothing.
+        // The test light is the first of a 2AFC stimulus; at 1e-7 cd it adds nothing.
         EXPECT_EQ(store::string_at(j, "/conditions/0/ends/1/lights/0/role"), "test");
-        EXPECT_LE(store::number_at(j, "/conditions/0/ends/1/lights/0/rise_codes").value_or(99.0), 1.0);
+        EXPECT_EQ(store::number_at(j, "/conditions/0/ends/1/lights/0/added_lux").value_or(99.0), 0.0);
+        EXPECT_GT(store::number_at(j, "/conditions/0/ends/1/lights/0/resolution_lux").value_or(0.0), 0.0);
+        EXPECT_EQ(store::number_at(j, "/window_radius_deg"), 0.5);
     }
     const Result analyzed =
         atonlab({"analyze", db.string(), "--out", (dir / "report").string(), "--bootstrap", "20"}, dir.path(), "an");
@@ -186,6 +349,25 @@ TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
     EXPECT_TRUE(contains(analyzed.out, "ran with --allow-undisplayable: too-dim")) << analyzed.out;
     const nlohmann::json summary = store::parse_json(file_bytes(dir / "report/summary.json"), "summary.json");
     EXPECT_EQ(store::boolean_at(summary, "/sessions/0/allowed_undisplayable"), true);
+}
+
+// R4 refuses a session the same way: exit 2 before the study file exists.
+TEST(Displayability, RunRefusesARangeThatDoesNotStraddleTheTest) {
+    TempDir dir;
+    const fs::path too_bright = variant(dir.path(), "too-bright.toml", kUndisplayable,
+                                        {{kTestIntensity, "light.test.intensity_cd=1e-4"},
+                                         {kMinLevel, "min_level = -3.6"},
+                                         {"max_level = -2.0", "max_level = -3.0"}});
+    const fs::path db = dir / "study.db";
+    const Result refused = atonlab({"run", too_bright.string(), "--db", db.string(), "--headless", "--model-observer"},
+                                   dir.path(), "refused");
+    if (refused.code == 3) GTEST_SKIP() << "no GL: " << refused.err;
+    EXPECT_EQ(refused.code, 2) << refused.err;
+    EXPECT_FALSE(fs::exists(db)) << "a refused session must not create the study file";
+    EXPECT_TRUE(contains(refused.err, too_bright.string() + ":52: condition \"too-dim\" cannot produce a match"))
+        << refused.err;
+    EXPECT_TRUE(contains(refused.err, "lower min_level to about")) << refused.err;
+    EXPECT_TRUE(contains(refused.out, "lx")) << refused.out;
 }
 
 TEST(Displayability, CheckCommandExitsTwoOrZeroAndWritesNothing) {

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
 #include <map>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "atonlab/display/tonemap.h"
 #include "calibrate/calibration_policy.h"
 #include "session/progress.h"
 #include "session/scene_queries.h"
@@ -39,10 +41,18 @@ std::string cache_key(const p::Frame& frame, const std::vector<std::string>& lig
     return key;
 }
 
+/// The codes of pixel (x, y), row 0 at the top.
+glm::ivec3 code_at(const s::EncodedImage& codes, int x, int y) {
+    const std::size_t i =
+        (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) * 3;
+    return {codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
+}
+
 /// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
 /// (row 0 at the top) for the codes given: the display model's luminance,
 /// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
-std::vector<float> emitted_window(const s::EncodedImage& codes, const display::DisplayModel& model, int x0, int y0, int n) {
+std::vector<float> emitted_window(const s::EncodedImage& codes, const display::DisplayModel& model, int x0, int y0,
+                                  int n) {
     std::map<std::uint64_t, float> emitted;
     std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
     for (int v = 0; v < n; ++v) {
@@ -51,10 +61,7 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const display::D
         for (int u = 0; u < n; ++u) {
             const int x = x0 + u;
             if (x < 0 || x >= codes.width) continue;
-            const std::size_t i =
-                (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
-                3;
-            const glm::ivec3 code{codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
+            const glm::ivec3 code = code_at(codes, x, y);
             const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
                                     (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
             auto [it, fresh] = emitted.try_emplace(k, 0.0f);
@@ -66,23 +73,50 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const display::D
 }
 
 /// The codes of window `w` (n x n pixels from (x0, y0), row 0 at the top)
-/// against the same pixels of `off` (the judged lights off; null: none).
-void summarise_codes(const s::EncodedImage& codes, const s::EncodedImage* off, int x0, int y0, int n, LightWindow& w) {
+/// against the same pixels of `off` (the judged lights off, the same dither
+/// frame; null: none, then the frame is its own background), and the
+/// displayed luminance of one code step at the pixel where the light adds most
+/// (displayability.h, the display's resolution there). `w.image` holds the
+/// window's displayed luminance (and, with `off`, its background).
+void summarise_codes(const s::EncodedImage& codes, const s::EncodedImage* off, const display::DisplayModel& model,
+                     int x0, int y0, int n, LightWindow& w) {
     w.white_code = (1 << codes.bits) - 1;
+    const s::EncodedImage& bg = off ? *off : codes;
     for (int y = std::max(y0, 0); y < std::min(y0 + n, codes.height); ++y)
-        for (int x = std::max(x0, 0); x < std::min(x0 + n, codes.width); ++x)
+        for (int x = std::max(x0, 0); x < std::min(x0 + n, codes.width); ++x) {
+            const glm::ivec3 on = code_at(codes, x, y);
+            const glm::ivec3 dark = code_at(bg, x, y);
             for (int ch = 0; ch < 3; ++ch) {
-                const std::size_t i =
-                    (static_cast<std::size_t>(y) * static_cast<std::size_t>(codes.width) + static_cast<std::size_t>(x)) *
-                        3 +
-                    static_cast<std::size_t>(ch);
-                const int on = codes.rgb[i];
-                const int bg = off ? off->rgb[i] : 0;
-                w.peak_code = std::max(w.peak_code, on);
-                w.background_code = std::max(w.background_code, bg);
-                w.rise_codes = std::max(w.rise_codes, on - bg);
-                w.clipped = w.clipped || (on == w.white_code && bg < w.white_code);
+                w.peak_code = std::max(w.peak_code, on[ch]);
+                w.clipped = w.clipped || (on[ch] == w.white_code && dark[ch] < w.white_code);
             }
+        }
+    // The pixel where the light adds most; where it adds nothing, the one under its centre.
+    glm::ivec2 at = glm::clamp(glm::ivec2(glm::floor(w.light_px)), glm::ivec2(0), glm::ivec2(n - 1));
+    float most = 0.0f;
+    if (w.image.has_background())
+        for (int v = 0; v < n; ++v)
+            for (int u = 0; u < n; ++u) {
+                const std::size_t i =
+                    static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u);
+                const float added = w.image.luminance_cd_m2[i] - w.image.background_cd_m2[i];
+                if (added > most) {
+                    most = added;
+                    at = {u, v};
+                }
+            }
+    w.brightest_px = at;
+    const int x = std::clamp(x0 + at.x, 0, codes.width - 1);
+    const int y = std::clamp(y0 + at.y, 0, codes.height - 1);
+    const glm::ivec3 on = code_at(codes, x, y);
+    w.background_code = code_at(bg, x, y);
+    w.background_cd_m2 = display::displayed_luminance_cd_m2(model, w.background_code, codes.bits);
+    // One code step of the channels the light raises there (of all three
+    // where it raises none), each as far as the display's white allows.
+    glm::ivec3 step = glm::ivec3(glm::greaterThan(on, w.background_code));
+    if (step == glm::ivec3(0)) step = glm::ivec3(1);
+    const glm::ivec3 up = glm::min(w.background_code + step, glm::ivec3(w.white_code));
+    w.code_step_cd_m2 = display::displayed_luminance_cd_m2(model, up, codes.bits) - w.background_cd_m2;
 }
 
 }  // namespace
@@ -230,8 +264,8 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
                 centre_win = draws[index].centre_px;
             } else if (index < sc.lights.size() || disc) {
                 // A disc's centre: the same pinhole (its outline is a circle of visual angle around it).
-                const glm::dvec3 v = proj.view_from_world((disc ? disc->position_m : sc.lights[index].position_m) -
-                                                          proj.eye_position_m);
+                const glm::dvec3 v =
+                    proj.view_from_world((disc ? disc->position_m : sc.lights[index].position_m) - proj.eye_position_m);
                 if (v.z < 0) {
                     centre_win = glm::dvec2(0.5 * proj.width_px, 0.5 * proj.height_px) +
                                  proj.focal_px * glm::dvec2(v.x, v.y) / -v.z;
@@ -255,25 +289,21 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         placed.push_back({{x0, y0}, on_screen});
         out->windows.push_back(std::move(w));
     }
-    // What each window shows with the judged lights off, at the same pixels, so
-    // that the model observer judges what a light adds to its surround
-    // (observer.h window_light_lux), not the surround itself.
+    // What each window shows with the judged lights off, at the same pixels
+    // (the same frame at the same moment and dither frame), so that the model
+    // observer judges what a light adds to its surround (observer.h
+    // window_light_lux), not the surround itself.
     bool any_named = false;
     for (const std::string& name : lights) any_named = any_named || !name.empty();
-    if (any_named) {
-        const s::EncodedImage& off = background_codes(frame, lights, out->time_s);
-        for (std::size_t i = 0; i < out->windows.size(); ++i) {
-            out->windows[i].image.background_cd_m2 =
-                placed[i].on_screen
-                    ? emitted_window(off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
-                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
-            if (placed[i].on_screen)
-                summarise_codes(codes, &off, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
-        }
-    } else {
-        for (std::size_t i = 0; i < out->windows.size(); ++i)
-            if (placed[i].on_screen)
-                summarise_codes(codes, nullptr, placed[i].origin.x, placed[i].origin.y, n, out->windows[i]);
+    const s::EncodedImage* off = any_named ? &background_codes(frame, lights, out->time_s) : nullptr;
+    for (std::size_t i = 0; i < out->windows.size(); ++i) {
+        LightWindow& w = out->windows[i];
+        if (off)
+            w.image.background_cd_m2 =
+                placed[i].on_screen ? emitted_window(*off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n)
+                                    : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+        if (placed[i].on_screen)
+            summarise_codes(codes, off, sc.output.display, placed[i].origin.x, placed[i].origin.y, n, w);
     }
     if (degrees_per_pixel) *degrees_per_pixel = dpp;
     views_.put(cache_key(frame, lights), out);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,8 +17,8 @@
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
-#include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "session/lru_cache.h"
@@ -32,11 +33,20 @@ struct LightWindow {
     protocols::DisplayedImage image;
     glm::dvec2 light_px{0.0};
     /// The code values sent to the screen in the same window (displayability.h):
-    int peak_code = 0;        ///< the highest code of any channel of any pixel
-    int background_code = 0;  ///< the same with the judged lights off
-    int rise_codes = 0;       ///< the most any channel of a pixel lies above that pixel with the lights off
-    bool clipped = false;     ///< a channel of a pixel is at the display's white where the lights-off frame is not
-    int white_code = 255;     ///< the display's white, 2^bits − 1
+    int peak_code = 0;     ///< the highest code of any channel of any pixel
+    bool clipped = false;  ///< a channel of a pixel is at the display's white where the lights-off frame is not
+    int white_code = 255;  ///< the display's white, 2^bits − 1
+    /// The pixel where the light adds the most displayed luminance (window
+    /// coordinates, row 0 at the top); where it adds none, the pixel under its
+    /// centre. What the screen shows there with the judged lights off (the
+    /// same frame, the same dither) ...
+    glm::ivec2 brightest_px{0};
+    glm::ivec3 background_code{0};  ///< ... in codes, per channel (R, G, B)
+    double background_cd_m2 = 0.0;  ///< ... in displayed luminance, cd/m²
+    /// ... and how much one code step there adds: the displayed luminance
+    /// (cd/m²) of raising by one code the channels the light raises at that
+    /// pixel (all three where it raises none), over the lights-off codes.
+    double code_step_cd_m2 = 0.0;
 };
 
 /// One rendered frame, as the observer sees it: a window per judged light.
@@ -98,6 +108,8 @@ public:
         scenes_ = LruCache<std::string, std::shared_ptr<const stimuli::Scene>>(scenes_.capacity());
     }
 
+    /// The radius (degrees of visual angle) of the observer's window around a light.
+    double window_radius_deg() const noexcept { return window_radius_deg_; }
     std::size_t frames_rendered() const noexcept { return rendered_; }
     std::size_t frames_requested() const noexcept { return requested_; }
     /// How many times the scene template was instantiated with a frame's overrides.
@@ -122,7 +134,7 @@ private:
     double interval_s_;
     stimuli::Pipeline pipeline_;  ///< with the renderer's default options (no display skips)
     LruCache<std::string, std::shared_ptr<const FrameViews>> views_;  ///< views(): cache_frames entries
-    LruCache<std::string, stimuli::EncodedImage> background_{8};       ///< background_codes()
+    LruCache<std::string, stimuli::EncodedImage> background_{8};      ///< background_codes()
     /// codes(): a trial's frames and its background, with room to spare.
     LruCache<std::string, std::shared_ptr<const stimuli::EncodedImage>> codes_{8};
     /// scene(): the scenes of the override lists asked for lately (a trial's
