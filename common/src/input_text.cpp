@@ -1,5 +1,9 @@
 #include "atonlab/common/input_text.h"
 
+// echo() and one_line() also escape every byte that is not part of well-formed
+// UTF-8 (as \xNN), so every message is one line of valid UTF-8 whatever it
+// quotes (a damaged record, a file name): docs/fuzzing.md, "Echoed values".
+
 #include <fmt/format.h>
 
 #include <cerrno>

@@ -17,15 +17,13 @@ inline constexpr std::size_t kEchoMax = 80;
 inline constexpr std::size_t kMessageMax = 2000;
 
 /// `value` as a message may echo it: control characters escaped (\n, \t, \r,
-/// \xNN), so a message stays on one line, bytes that are not well-formed UTF-8
-/// escaped as \xNN, so it is valid UTF-8, and cut after `max` characters with
+/// \xNN), so a message stays on one line, and cut after `max` characters with
 /// "…" and the value's full length in bytes. UTF-8 is kept whole (a cut never
 /// splits a character).
 std::string echo(std::string_view value, std::size_t max = kEchoMax);
 
-/// A whole message made safe to print as one line of valid UTF-8: control
-/// characters and bytes that are not well-formed UTF-8 escaped (\xNN) and,
-/// past kMessageMax bytes, cut with "…".
+/// A whole message made safe to print as one line: control characters escaped
+/// and, past kMessageMax bytes, cut with "…".
 std::string one_line(std::string_view message);
 
 /// Largest text input files, in bytes. A scene or protocol file is a page or
