@@ -85,8 +85,13 @@ def main(argv):
     if not os.path.exists(argv[1]):
         print(f"skipped tests: {argv[1]} does not exist (did ctest run with --output-junit?)", file=sys.stderr)
         return 2
-    found = skips(argv[1])
     ci = os.environ.get("CI", "") == "true"
+    try:
+        found = skips(argv[1])
+    except ET.ParseError as e:
+        # Without the list no skip can be judged: a failure under CI only.
+        print(f"skipped tests: {argv[1]} cannot be read ({e}); the skips are not listed")
+        return 1 if ci else 0
     print(f"Skipped tests: {len(found)}")
     for name, kind, why in sorted(found):
         print(f"  {name}  [{kind}] {why}")
