@@ -15,7 +15,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-math-dev libnlopt-cxx-dev libstb-dev fonts-dejavu-core
   gnuplot-nox
-  pfstools  # tests and bench only: `atonlab tonemap --operator reinhard` is compared with pfstmo_reinhard02
+  pfstools pfstmo  # tests and bench only: `atonlab tonemap --operator reinhard` is compared with pfstmo_reinhard02 (in pfstmo; pfsin/pfsout are in pfstools)
   xvfb xauth
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
   python3 sqlite3  # tests only: the README quick-start walk, the fake spotread's transcripts, reading study files from shell tests

@@ -270,7 +270,8 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
                                            {"sessions_read", static_cast<std::int64_t>(x.sessions_read)},
                                            {"trials_read", static_cast<std::int64_t>(x.trials_read)},
                                            {"sessions_unreadable", x.sessions_unreadable},
-                                           {"trials_unreadable", x.trials_unreadable}});
+                                           {"trials_unreadable", x.trials_unreadable},
+                                           {"skipped_rows", x.skipped_rows}});
     j["software_version"] = ctx.software_version;
     j["inputs"] = d.sources;
     j["options"] = Json{{"bootstrap", r.options.bootstrap},

@@ -279,8 +279,8 @@ std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
         "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
         "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "
         "(guess rate {}, target P {}). {} trials.</p>\n",
-        esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure),
-        esc(c.level_key), esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
+        esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure), esc(c.level_key),
+        esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
         esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
         esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
         esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
@@ -328,8 +328,8 @@ std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
             "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
             "<td>{}</td></tr>\n",
-            esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method),
-            slope, width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason, notes));
+            esc(g.observer), g.n_scored, f3(g.headline.value), ci_text(g.headline.ci), esc(g.headline.method), slope,
+            width, lapse, gof, yes_no(g.headline.reliable, g.headline.reason, notes));
     }
     h += "</table></div>\n" + notes.flush();
     return h;
@@ -525,12 +525,19 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     h += "<title>atonlab analysis</title>\n<style>\n" + std::string(kStyle) + "\n</style>\n</head>\n<body>\n";
     h += "<h1>atonlab analysis</h1>\n";
     // First, so a reader cannot miss it: inputs that were damaged and salvaged.
-    for (const DamagedInput& x : d.damaged)
+    for (const DamagedInput& x : d.damaged) {
         h += fmt::format(
             "<div class=\"warn\"><p><b>Damaged input: <code>{}</code></b> was read with <code>--salvage</code>: "
             "{} session(s) and {} trial(s) were read; {} trial row(s) and {} session row(s) could not be read. "
-            "What is wrong: {}</p></div>\n",
+            "What is wrong: {}</p>\n",
             esc(x.file), x.sessions_read, x.trials_read, x.trials_unreadable, x.sessions_unreadable, esc(x.problem));
+        if (!x.skipped_rows.empty()) {
+            h += "<p>Rows left out:</p>\n<ul>\n";
+            for (const std::string& row : x.skipped_rows) h += "<li>" + esc(row) + "</li>\n";
+            h += "</ul>\n";
+        }
+        h += "</div>\n";
+    }
     h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version),
                      esc(ctx.command_line));
     h += "<p>Inputs:</p>\n<ul>\n";

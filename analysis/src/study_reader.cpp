@@ -397,6 +397,8 @@ Dataset salvage_store(const std::filesystem::path& study_file, const store::Stor
     for (const store::SessionRecord& s : got.sessions) damaged.trials_read += static_cast<std::size_t>(s.trial_count);
     damaged.sessions_unreadable = got.unreadable_sessions;
     damaged.trials_unreadable = got.unreadable_trials;
+    for (const store::SkippedRow& r : got.skipped)
+        damaged.skipped_rows.push_back(fmt::format("{} row {}: {}", r.table, r.row_id, r.why));
     for (const std::string& p : got.problems) d.notes.push_back(fmt::format("{}: {}", file, p));
     d.damaged.push_back(std::move(damaged));
     return d;

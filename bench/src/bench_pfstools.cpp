@@ -49,7 +49,9 @@ std::vector<float> read_pfm_top_down(const std::filesystem::path& path, int w, i
 
 void bench_tonemap_pfstools(Bench& b) {
     if (std::system("command -v pfstmo_reinhard02 > /dev/null 2>&1 && command -v pfsoutpfm > /dev/null 2>&1") != 0) {
-        std::printf("  tonemap_pfstools: pfstools is not installed: skipped\n");
+        std::printf(
+            "  tonemap_pfstools: skipped: pfstmo_reinhard02 or pfsoutpfm is not installed (Debian packages "
+            "pfstmo, pfstools; scripts/setup.sh installs them)\n");
         return;
     }
     // A rendered frame (the other frame benches' scene) as an EXR on disk.

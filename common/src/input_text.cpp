@@ -1,5 +1,9 @@
 #include "atonlab/common/input_text.h"
 
+// echo() and one_line() also escape every byte that is not part of well-formed
+// UTF-8 (as \xNN), so every message is one line of valid UTF-8 whatever it
+// quotes (a damaged record, a file name): docs/fuzzing.md, "Echoed values".
+
 #include <fmt/format.h>
 
 #include <cerrno>
@@ -9,12 +13,34 @@
 namespace atonlab::text {
 namespace {
 
-/// Bytes of the UTF-8 sequence that starts with `lead` (1 for a stray byte).
-std::size_t utf8_length(unsigned char lead) {
-    if (lead >= 0xf0 && lead <= 0xf7) return 4;
-    if (lead >= 0xe0) return lead <= 0xef ? 3 : 1;
-    if (lead >= 0xc0) return 2;
-    return 1;
+/// Bytes of the well-formed UTF-8 sequence that starts at `s[i]`, or 0 when
+/// the bytes there are not one (a stray continuation byte, a lead byte cut
+/// short, an overlong form, a surrogate, past U+10FFFF): the table of
+/// well-formed byte sequences in RFC 3629 section 4 (Unicode 15, table 3-7).
+std::size_t utf8_sequence(std::string_view s, std::size_t i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) return 1;
+    std::size_t n = 0;
+    unsigned char low = 0x80, high = 0xbf;  // the second byte's range; later ones are 80..BF
+    if (c >= 0xc2 && c <= 0xdf) {
+        n = 2;
+    } else if (c >= 0xe0 && c <= 0xef) {
+        n = 3;
+        if (c == 0xe0) low = 0xa0;   // not overlong
+        if (c == 0xed) high = 0x9f;  // not a surrogate
+    } else if (c >= 0xf0 && c <= 0xf4) {
+        n = 4;
+        if (c == 0xf0) low = 0x90;   // not overlong
+        if (c == 0xf4) high = 0x8f;  // at most U+10FFFF
+    } else {
+        return 0;
+    }
+    if (s.size() - i < n) return 0;
+    for (std::size_t k = 1; k < n; ++k) {
+        const auto b = static_cast<unsigned char>(s[i + k]);
+        if (k == 1 ? (b < low || b > high) : (b < 0x80 || b > 0xbf)) return 0;
+    }
+    return n;
 }
 
 void append_escaped(std::string& out, unsigned char c) {
@@ -37,6 +63,20 @@ bool is_control(unsigned char c) {
     return c < 0x20 || c == 0x7f;
 }
 
+// The character at `s[i]` as a message shows it: a control character or a
+// byte that is not part of well-formed UTF-8 escaped (\n, \x1B, \xB0), so
+// every message is one line of valid UTF-8. Returns where the next starts.
+std::size_t append_character(std::string& out, std::string_view s, std::size_t i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const std::size_t n = is_control(c) ? 0 : utf8_sequence(s, i);
+    if (n == 0) {
+        append_escaped(out, c);
+        return i + 1;
+    }
+    out.append(s.substr(i, n));
+    return i + n;
+}
+
 std::string size_text(std::uintmax_t bytes) {
     if (bytes >= (1u << 20)) return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1u << 20));
     if (bytes >= (1u << 10)) return fmt::format("{:.1f} KiB", static_cast<double>(bytes) / (1u << 10));
@@ -54,15 +94,7 @@ std::string echo(std::string_view value, std::size_t max) {
             out += fmt::format("… ({} bytes in all)", value.size());
             return out;
         }
-        const auto c = static_cast<unsigned char>(value[i]);
-        if (is_control(c)) {
-            append_escaped(out, c);
-            ++i;
-        } else {
-            const std::size_t n = std::min(utf8_length(c), value.size() - i);
-            out.append(value.substr(i, n));
-            i += n;
-        }
+        i = append_character(out, value, i);
         ++chars;
     }
     return out;
@@ -76,15 +108,7 @@ std::string one_line(std::string_view message) {
             out += "…";
             break;
         }
-        const auto c = static_cast<unsigned char>(message[i]);
-        if (is_control(c)) {
-            append_escaped(out, c);
-            ++i;
-        } else {
-            const std::size_t n = std::min(utf8_length(c), message.size() - i);
-            out.append(message.substr(i, n));
-            i += n;
-        }
+        i = append_character(out, message, i);
     }
     return out;
 }

@@ -15,11 +15,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
-#include <functional>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <thread>
@@ -29,9 +29,9 @@
 #include "atonlab/analysis/report.h"
 #include "atonlab/analysis/study_analysis.h"
 #include "atonlab/display/colour.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/image_io.h"
-#include "atonlab/display/tonemap.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
 #include "commands.h"
@@ -174,8 +174,7 @@ Mapped map_tile(const stimuli::ImageRGBA32F& hdr, const Tile& t, double adaptati
     for (int k = 0; k < 3; ++k) {
         std::vector<double>& values = channel[static_cast<std::size_t>(k)];
         if (values.empty()) continue;
-        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
-                         values.end());
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
         m.background[k] = values[values.size() / 2];
     }
     // A power of two, 1 to 4096: the largest that keeps every channel's
@@ -248,7 +247,8 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
         row = std::max(row, t.h);
     }
     // Nothing dim enough to need it: one row.
-    const bool stretched_row = std::any_of(mapped.begin(), mapped.end(), [](const Mapped& m) { return m.stretch > 1.0; });
+    const bool stretched_row =
+        std::any_of(mapped.begin(), mapped.end(), [](const Mapped& m) { return m.stretch > 1.0; });
     const int height = stretched_row ? 2 * row + gap : row;
     std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 1.0f);  // white gaps
     int left = 0;
@@ -392,11 +392,19 @@ int run_analyze(const AnalyzeOptions& o) {
         return 2;
     }
 
-    for (const an::DamagedInput& x : data.damaged)
+    for (const an::DamagedInput& x : data.damaged) {
         std::fprintf(stderr,
                      "atonlab: warning: %s is damaged; salvaged %zu session(s) and %zu trial(s), %lld trial row(s) "
                      "unreadable\n",
                      x.file.c_str(), x.sessions_read, x.trials_read, static_cast<long long>(x.trials_unreadable));
+        // Each row left out, named (all of them are in summary.json and report.html).
+        constexpr std::size_t kListed = 20;
+        for (std::size_t i = 0; i < std::min(x.skipped_rows.size(), kListed); ++i)
+            std::fprintf(stderr, "atonlab: warning: %s: left out %s\n", x.file.c_str(), x.skipped_rows[i].c_str());
+        if (x.skipped_rows.size() > kListed)
+            std::fprintf(stderr, "atonlab: warning: %s: and %zu more rows left out (listed in summary.json)\n",
+                         x.file.c_str(), x.skipped_rows.size() - kListed);
+    }
 
     const auto started = std::chrono::steady_clock::now();
     BootstrapProgress progress(o.quiet);
@@ -441,8 +449,9 @@ int run_analyze(const AnalyzeOptions& o) {
         }
         for (const an::SessionInfo& s : data.sessions)
             if (s.displayable == false)
-                std::printf("  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
-                            s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
+                std::printf(
+                    "  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
+                    s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
         const std::size_t notes = results.warnings.size() + plots.problems.size() + ctx.problems.size();
         if (notes) std::printf("%zu note(s) and warning(s): see the report\n", notes);
         std::printf("report: %s\n", (out_dir / "report.html").string().c_str());

@@ -3,12 +3,15 @@
 
 #include <utility>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/store/records.h"
 
 namespace atonlab::store {
 
 StoreError::StoreError(StoreErrc kind, std::filesystem::path file, const std::string& message, int sqlite_code)
-    : std::runtime_error(message), kind_(kind), file_(std::move(file)), sqlite_code_(sqlite_code) {}
+    // One line of valid UTF-8 whatever a message quotes (a path, SQLite's
+    // report, a value read from the file): docs/fuzzing.md, "Echoed values".
+    : std::runtime_error(text::one_line(message)), kind_(kind), file_(std::move(file)), sqlite_code_(sqlite_code) {}
 
 const char* to_string(StoreErrc kind) noexcept {
     switch (kind) {

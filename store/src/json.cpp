@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "atonlab/common/input_text.h"
 #include "atonlab/store/error.h"
 
 namespace atonlab::store {
@@ -13,11 +14,12 @@ nlohmann::json parse_json(std::string_view text, std::string_view what) {
     } catch (const nlohmann::json::parse_error& e) {
         // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 6: syntax error ..."
         // -- a sentence for a programmer; the byte and the reason after the last ": " say where.
+        // The reason quotes the bytes last read, which need not be UTF-8: echoed escaped.
         const std::string why = e.what();
         const std::size_t colon = why.rfind(": ");
         throw StoreError(StoreErrc::invalid_argument, {},
                          fmt::format("{} is not valid JSON (at byte {}: {})", what, e.byte,
-                                     colon == std::string::npos ? why : why.substr(colon + 2)));
+                                     text::echo(colon == std::string::npos ? why : why.substr(colon + 2), 200)));
     }
 }
 

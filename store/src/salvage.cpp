@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 
+#include "constraints.h"
 #include "store_impl.h"
 
 namespace atonlab::store {
@@ -23,30 +24,56 @@ std::optional<std::int64_t> largest_id(sql::Connection& db, const char* sql, std
     }
 }
 
+// Why a row that is not read was left out.
+std::string unreadable(const StoreError& e) {
+    return fmt::format("cannot be read (SQLite: {})",
+                       e.sqlite_code() != 0 ? sqlite3_errstr(e.sqlite_code()) : e.what());
+}
+constexpr const char* kAbsent = "cannot be found (its page is lost, or the row was never written)";
+
+// The constraints of `table` as a column of a query over it, by row id (a
+// correlated subquery, so the query may join other tables).
+std::string broken_column(const detail::TableConstraints& c, const char* table, const char* id) {
+    return fmt::format("(SELECT {} FROM {} WHERE rowid = {})", c.which, table, id);
+}
+
 }  // namespace
 
 Salvage Store::salvage() const {
     sql::Connection& db = *impl_->db;
     Salvage out;
 
+    // A row that breaks its table's CHECK or NOT NULL constraints (a value
+    // overwritten inside its record) is left out and named, as is one that
+    // cannot be read or found.
+    const auto skip = [&out](const char* table, std::int64_t id, std::string why, std::int64_t& count) {
+        ++count;
+        out.skipped.push_back({table, id, std::move(why)});
+    };
+
     // Sessions, one row id at a time; the trial count is of the trials read below.
     if (const auto last = largest_id(db, "SELECT max(id) FROM sessions", out.problems, "sessions")) {
-        sql::Statement s(db,
-                         "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, "
-                         // displayability_json NULL: a damaged file may be of a schema before it (v3).
-                         "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL "
-                         "FROM sessions s JOIN observers o ON o.id = s.observer_id "
-                         "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1");
+        const detail::TableConstraints c = detail::table_constraints(db, "sessions");
+        sql::Statement s(
+            db, fmt::format("SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, "
+                            // displayability_json NULL: a damaged file may be of a schema before it (v3).
+                            "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL, {} "
+                            "FROM sessions s JOIN observers o ON o.id = s.observer_id "
+                            "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1",
+                            broken_column(c, "sessions", "s.id")));
         for (std::int64_t id = 1; id <= *last; ++id) {
             try {
                 s.bind(1, id);
-                if (s.step("read a session")) {
-                    out.sessions.push_back(session_from_row(s, db.path()));
+                if (!s.step("read a session")) {
+                    skip("sessions", id, kAbsent, out.unreadable_sessions);
+                } else if (!s.is_null(14)) {
+                    skip("sessions", id, "breaks " + c.names.at(static_cast<std::size_t>(s.int64(14))),
+                         out.unreadable_sessions);
                 } else {
-                    ++out.unreadable_sessions;
+                    out.sessions.push_back(session_from_row(s, db.path()));
                 }
-            } catch (const StoreError&) {
-                ++out.unreadable_sessions;
+            } catch (const StoreError& e) {
+                skip("sessions", id, unreadable(e), out.unreadable_sessions);
             }
             s.reset();
         }
@@ -54,20 +81,25 @@ Salvage Store::salvage() const {
 
     // Trials, by row id: the table's b-tree only, not the (session, index) index.
     if (const auto last = largest_id(db, "SELECT max(id) FROM trials", out.problems, "trials")) {
-        sql::Statement s(db,
-                         "SELECT session_id, trial_index, block, condition_id, procedure_id, level, test_on_left, "
-                         "stimulus_json, response, response_value, response_time_s, onset_time_s, dropped_frames, "
-                         "missed_deadline, procedure_state_json, recorded_at FROM trials WHERE id = ?1");
+        const detail::TableConstraints c = detail::table_constraints(db, "trials");
+        sql::Statement s(db, fmt::format("SELECT session_id, trial_index, block, condition_id, procedure_id, level, "
+                                         "test_on_left, stimulus_json, response, response_value, response_time_s, "
+                                         "onset_time_s, dropped_frames, missed_deadline, procedure_state_json, "
+                                         "recorded_at, {} FROM trials WHERE id = ?1",
+                                         c.which));
         for (std::int64_t id = 1; id <= *last; ++id) {
             try {
                 s.bind(1, id);
-                if (s.step("read a trial")) {
-                    out.trials.push_back({SessionId{s.int64(0)}, trial_from_row(s, 1)});
+                if (!s.step("read a trial")) {
+                    skip("trials", id, kAbsent, out.unreadable_trials);
+                } else if (!s.is_null(16)) {
+                    skip("trials", id, "breaks " + c.names.at(static_cast<std::size_t>(s.int64(16))),
+                         out.unreadable_trials);
                 } else {
-                    ++out.unreadable_trials;
+                    out.trials.push_back({SessionId{s.int64(0)}, trial_from_row(s, 1)});
                 }
-            } catch (const StoreError&) {
-                ++out.unreadable_trials;
+            } catch (const StoreError& e) {
+                skip("trials", id, unreadable(e), out.unreadable_trials);
             }
             s.reset();
         }

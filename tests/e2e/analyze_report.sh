@@ -9,7 +9,7 @@ atonlab=$1 csv=$2 outdir=$3
 rm -rf "$outdir" && mkdir -p "$outdir"
 "$atonlab" analyze --csv "$csv" --out "$outdir/report" --bootstrap 200 >"$outdir/out" 2>"$outdir/err"
 status=$?
-if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "skipped: gnuplot is not installed"; exit 77; fi
+if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "missing tool: gnuplot is not installed (Debian package gnuplot-nox)"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "atonlab analyze failed ($status):"; cat "$outdir/err"; exit 1; fi
 fail=0
 for f in report.html summary.json fits.csv trials.csv; do

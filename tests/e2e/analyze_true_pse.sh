@@ -11,7 +11,7 @@ atonlab=$1 protocol=$2 outdir=$3
 rm -rf "$outdir" && mkdir -p "$outdir"
 "$atonlab" run "$protocol" --db "$outdir/study.db" --model-observer --headless >"$outdir/run.out" 2>"$outdir/run.err"
 status=$?
-if [ "$status" -eq 3 ]; then echo "skipped: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "atonlab run failed ($status):"; cat "$outdir/run.err"; exit 1; fi
 # "  CONDITION   ...; model's true PSE 2.046 (estimate − true = ...)"
 sed -n "s/^  \([^ ]*\) .*model's true PSE \([-0-9.]*\).*/\1 \2/p" "$outdir/run.out" >"$outdir/true.txt"

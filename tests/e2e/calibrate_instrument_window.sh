@@ -24,7 +24,7 @@ chmod +x "$outdir/run.sh"
 bash "$xvfb" "$outdir/run.sh"
 status=$?
 cat "$outdir"/*.log
-if [ "$status" -eq 3 ]; then exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context or display server (atonlab exited with status 3)"; exit 77; fi
 [ "$status" -eq 0 ] || { echo "measure/check in the window failed with status $status"; exit 1; }
 grep -q "full-screen 1280 x 720 on monitor 0" "$outdir/measure.log" || { echo "not shown full screen"; exit 1; }
 grep -q "PASSED" "$outdir/check.log" || { echo "the check on the same display did not pass"; exit 1; }

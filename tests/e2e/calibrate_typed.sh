@@ -25,7 +25,7 @@ chmod +x "$outdir/check.sh"
 bash "$xvfb" "$outdir/check.sh" >"$outdir/check.log" 2>&1
 status=$?
 cat "$outdir/check.log"
-if [ "$status" -eq 3 ]; then exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context or display server (atonlab exited with status 3)"; exit 77; fi
 [ "$status" -eq 0 ] || { echo "the typed check failed with status $status"; exit 1; }
 fail=0
 grep -q "not a reading ('5.3x' is not a number)" "$outdir/check.log" || { echo "the typo was not refused"; fail=1; }

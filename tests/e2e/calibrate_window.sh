@@ -22,7 +22,7 @@ chmod +x "$outdir/check.sh"
 bash "$xvfb" "$outdir/check.sh" >"$outdir/check.log" 2>&1
 status=$?
 cat "$outdir/check.log"
-if [ "$status" -eq 3 ]; then exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context or display server (atonlab exited with status 3)"; exit 77; fi
 [ "$status" -eq 0 ] || { echo "check in the window failed with status $status"; exit 1; }
 grep -q "full-screen 1280 x 720 on monitor 0" "$outdir/check.log" || { echo "not shown full screen"; exit 1; }
 grep -q "PASSED" "$outdir/check.log" || { echo "the check did not pass"; exit 1; }

@@ -9,7 +9,7 @@ rm -rf "$outdir" && mkdir -p "$outdir"
 fail=0
 "$atonlab" psf --clear --pupil-mm 3 --size 128 --samples 8 --area-radius-px 4 --area-layers 3 -o "$outdir/psf.exr" >"$outdir/log" 2>&1
 status=$?
-if [ "$status" -eq 3 ]; then echo "no GL 4.5 context: skipped"; exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "psf failed with status $status"; cat "$outdir/log"; fail=1; fi
 for f in psf.exr psf-mono.exr psf-area-00.exr psf-area-02.exr; do
   [ -s "$outdir/$f" ] || { echo "missing $f"; fail=1; }

@@ -10,19 +10,19 @@
 set -uo pipefail
 atonlab=$1 input=$2 outdir=$3
 browser=$(command -v chromium || command -v chromium-browser || true)
-if [ -z "$browser" ]; then echo "skipped: chromium is not installed (scripts/setup.sh installs it)"; exit 77; fi
+if [ -z "$browser" ]; then echo "missing tool: chromium is not installed (scripts/setup.sh installs it)"; exit 77; fi
 rm -rf "$outdir" && mkdir -p "$outdir"
 if [[ "$input" == *.toml ]]; then
   "$atonlab" run "$input" --db "$outdir/study.db" --model-observer --headless >"$outdir/run.out" 2>"$outdir/run.err"
   status=$?
-  if [ "$status" -eq 3 ]; then echo "skipped: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
+  if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
   if [ "$status" -ne 0 ]; then echo "atonlab run failed ($status):"; cat "$outdir/run.err"; exit 1; fi
   "$atonlab" analyze "$outdir/study.db" --out "$outdir/report" --bootstrap 100 >"$outdir/out" 2>"$outdir/err"
 else
   "$atonlab" analyze --csv "$input" --out "$outdir/report" --bootstrap 100 >"$outdir/out" 2>"$outdir/err"
 fi
 status=$?
-if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "skipped: gnuplot is not installed"; exit 77; fi
+if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "missing tool: gnuplot is not installed (Debian package gnuplot-nox)"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "atonlab analyze failed ($status):"; cat "$outdir/err"; exit 1; fi
 
 # A copy of the page with a measuring script at its end (the report itself has

@@ -11,7 +11,7 @@ atonlab=$1 protocol=$2 outdir=$3
 rm -rf "$outdir" && mkdir -p "$outdir"
 "$atonlab" run "$protocol" --db "$outdir/study.db" --model-observer --headless --no-true-pse >"$outdir/run.out" 2>"$outdir/run.err"
 status=$?
-if [ "$status" -eq 3 ]; then echo "skipped: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "atonlab run failed ($status):"; cat "$outdir/run.err"; exit 1; fi
 fail=0
 # The stored views (read with the sqlite3 shell where it is installed).
@@ -24,7 +24,7 @@ else
 fi
 "$atonlab" analyze "$outdir/study.db" --out "$outdir/report" --bootstrap 50 >"$outdir/analyze.out" 2>"$outdir/analyze.err"
 status=$?
-if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "skipped: gnuplot is not installed"; exit 77; fi
+if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "missing tool: gnuplot is not installed (Debian package gnuplot-nox)"; exit 77; fi
 if [ "$status" -ne 0 ]; then echo "atonlab analyze failed ($status):"; cat "$outdir/analyze.err"; exit 1; fi
 # trials.csv: glare_test and glare_reference columns.
 header=$(head -1 "$outdir/report/trials.csv")

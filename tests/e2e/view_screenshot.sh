@@ -12,7 +12,7 @@ rm -rf "$outdir" && mkdir -p "$outdir"
 eval "render_args=($common $render_extra)"
 "$atonlab" render "$scene" -o "$outdir/render.exr" --png "$outdir/render.png" "${render_args[@]}" >"$outdir/render.log" 2>&1
 status=$?
-if [ "$status" -eq 3 ]; then cat "$outdir/render.log"; exit 77; fi
+if [ "$status" -eq 3 ]; then cat "$outdir/render.log"; echo "no GPU: no OpenGL 4.5 context (atonlab exited with status 3)"; exit 77; fi
 [ "$status" -eq 0 ] || { cat "$outdir/render.log"; echo "render failed with status $status"; exit 1; }
 
 # The command goes in a script, so that COMMON and VIEW_EXTRA keep their shell quoting.
@@ -24,7 +24,7 @@ chmod +x "$outdir/view.sh"
 bash "$xvfb" "$outdir/view.sh" >"$outdir/view.log" 2>&1
 status=$?
 cat "$outdir/view.log"
-if [ "$status" -eq 3 ]; then exit 77; fi
+if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context or display server (atonlab exited with status 3)"; exit 77; fi
 [ "$status" -eq 0 ] || { echo "view failed with status $status"; exit 1; }
 [ -s "$outdir/view.png" ] || { echo "view wrote no screenshot"; exit 1; }
 if ! cmp -s "$outdir/render.png" "$outdir/view.png"; then

@@ -43,6 +43,7 @@
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -144,7 +145,7 @@ void press(const std::string& keysym) {
 class runner : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!have_display()) GTEST_SKIP() << "no display server (DISPLAY unset); CTest runs this under Xvfb";
+        if (!have_display()) ATONLAB_SKIP_NO_GPU() << "no display server (DISPLAY unset); CTest runs this under Xvfb";
     }
     fs::path db() const { return dir_.path() / "study.db"; }
     Child start(const fs::path& protocol, const std::vector<std::string>& extra, const std::string& tag = "a") {
@@ -492,7 +493,7 @@ Xwd read_xwd(const fs::path& path) {
 
 TEST_F(runner, TheScreenShowsTheCodesTheHeadlessRendererMakes) {
     const char* screen_file = std::getenv("ATONLAB_XVFB_SCREEN_FILE");
-    if (!screen_file) GTEST_SKIP() << "ATONLAB_XVFB_SCREEN_FILE unset (run_under_xvfb.sh --framebuffer-file sets it)";
+    if (!screen_file) ATONLAB_SKIP_NOT_APPLICABLE() << "ATONLAB_XVFB_SCREEN_FILE unset (run_under_xvfb.sh --framebuffer-file sets it)";
     const fs::path protocol = kData / "screen_stall.toml";
     const fs::path shots = dir_.path() / "shots";
     // Trial 0 is all this needs: a script with one answer ends both runs after

@@ -20,6 +20,7 @@
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/stimuli/image_io.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -67,7 +68,7 @@ TEST(AnalyzeFigureNames, ConditionsWhoseNamesShareAFileNameGetTheirOwnFiguresEac
     const int run = test::run_to_files(
         {ATONLAB_BINARY, "run", kProtocol.string(), "--db", db.string(), "--headless", "--model-observer"},
         dir / "run.out", dir / "run.err");
-    if (run == 3) GTEST_SKIP() << "no GL 4.5 context: " << file_bytes(dir / "run.err");
+    if (run == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << file_bytes(dir / "run.err");
     ASSERT_EQ(run, 0) << file_bytes(dir / "run.err");
     const fs::path out = dir / "report";
     const int analyze = test::run_to_files(

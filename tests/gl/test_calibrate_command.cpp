@@ -34,6 +34,7 @@
 #include "atonlab/display/display_model.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -260,7 +261,7 @@ protected:
 
 TEST_F(CalibrateCommand, ExactReadingsGiveBackTheDisplaysLaw) {
     const Result r = measure(write_readings(dir_ / "exact.txt", patches_, 0.0, 1), "synthetic");
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(contains(r.out, "calibration 1 stored")) << r.out;
     EXPECT_TRUE(contains(r.out, "contrast")) << r.out;
@@ -296,7 +297,7 @@ TEST_F(CalibrateCommand, NoisyReadingsAreRecoveredAndChecked) {
     // 1 % per reading: the fitted law within three readings' noise everywhere.
     const Result r =
         measure(write_readings(dir_ / "noisy.txt", patches_, 0.01, 42), "lab-lcd", {"--date", "2024-05-01"});
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.err;
     store::Calibration cal;
     {
@@ -513,7 +514,7 @@ TEST(CalibrateRun, SessionsWarnAndRecordTheCalibrationTheyUsed) {
     const std::vector<std::string> run = {
         "run", protocol.string(), "--db", db.string(), "--model-observer", "--headless", "--quiet", "--no-true-pse"};
     Result r = atonlab(run, dir.path());
-    if (r.code == 3) GTEST_SKIP() << "no GL 4.5 context: " << r.err;
+    if (r.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << r.err;
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(contains(r.err, "warning: display \"booth-2\" has no calibration in")) << r.err;
     {

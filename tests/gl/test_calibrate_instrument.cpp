@@ -33,6 +33,7 @@
 #include "atonlab/display/display_model.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -154,7 +155,7 @@ protected:
 
 TEST_F(CalibrateVirtual, NoiseFreeMeasureRecoversEveryPatchAndGamma) {
     const Result r = measure(kDisplay, {"--quiet"});
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.err;
     Store s = Store::open_read_only(db());
     const auto cal = s.latest_calibration("virtual-lcd");
@@ -198,7 +199,7 @@ TEST_F(CalibrateVirtual, NoisyReadingsLieWithinTheirReportedUncertainty) {
     // from asking for a patch again.
     const Result r = measure(kDisplay, {"--virtual-noise", "0.01", "--virtual-seed", "7", "--repeats", "4",
                                         "--repeat-tolerance-percent", "6"});
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.err;
     std::istringstream in(r.out);
     std::string line;
@@ -251,7 +252,7 @@ TEST_F(CalibrateVirtual, DisagreeingRepeatsAreMeasuredAgainAtMostThreeTimes) {
     // > 3 % has probability 3.4 %; with seed 3, three patches), and the patch is measured
     // again; its transcript keeps every attempt.
     Result r = measure(kDisplay, {"--virtual-noise", "0.01", "--virtual-seed", "3", "--repeat-tolerance-percent", "3"});
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     const auto again = r.out.find("; measuring it again (attempt 2 of 3)");
     ASSERT_NE(again, std::string::npos) << r.out;
@@ -290,7 +291,7 @@ TEST_F(CalibrateVirtual, ALutDisplayLawIsReadBackThroughItsGreyReadings) {
         return lut.back().second;
     };
     const Result r = measure(kDisplay, {"--virtual-lut", (kData / "calibration/grey_ramp.csv").string(), "--quiet"});
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.err;
     Store s = Store::open_read_only(db());
     const auto readings = s.calibration_readings(s.latest_calibration("virtual-lcd").value().id);
@@ -308,7 +309,7 @@ TEST_F(CalibrateVirtual, ALutDisplayLawIsReadBackThroughItsGreyReadings) {
 
 TEST_F(CalibrateVirtual, CheckPassesOnTheSameDisplayAndFailsWhenThePeakDrops) {
     ASSERT_EQ(measure(kDisplay, {"--quiet"}).code, 0);
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     Result r = check(kDisplay);
     EXPECT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(contains(r.out, "PASSED")) << r.out;
@@ -342,7 +343,7 @@ fs::path protocol_for(const fs::path& dir, const std::string& display) {
 
 TEST_F(CalibrateVirtual, RunUsesTheMeasuredAndCheckedCalibration) {
     ASSERT_EQ(measure(kDisplay, {"--quiet"}).code, 0);
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(check(kDisplay).code, 0);
     const fs::path protocol = protocol_for(dir_.path(), "virtual-lcd");
     const Result r = atonlab(
@@ -400,7 +401,7 @@ protected:
     void expect_refused(const std::string& transcript, const std::string& what) {
         const std::string before = fs::exists(db()) ? file_bytes(db()) : std::string();
         const Result r = measure(transcript);
-        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
         EXPECT_EQ(r.code, 5) << r.out << r.err;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
         EXPECT_TRUE(contains(r.err, what)) << r.err;
@@ -416,7 +417,7 @@ protected:
 
 TEST_F(CalibrateSpotread, ReadingsAreParsedExactlyAndStoredWithTheirTranscripts) {
     const Result r = measure("normal.txt");
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_EQ(file_bytes(dir_ / "args.txt"), "-e -x -c 1\n");
     const auto results = transcript_results(kData / "spotread/normal.txt");
@@ -443,7 +444,7 @@ TEST_F(CalibrateSpotread, ReadingsAreParsedExactlyAndStoredWithTheirTranscripts)
 
 TEST_F(CalibrateSpotread, ANegativeReadingIsRefusedAndThePatchMeasuredAgain) {
     const Result r = measure("negative.txt");
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     ASSERT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(contains(r.out,
                          "black: X = -0.21 cd/m² is not a reading (finite, >= -0.01 cd/m²); measuring it "
@@ -463,7 +464,7 @@ TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) 
     // atonlab on a terminal (util-linux `script` gives it a pseudo-terminal), Enter typed:
     // the instruction is shown once, spotread is let go on, and the 18 patches are measured.
     if (access("/usr/bin/script", X_OK) != 0)
-        GTEST_SKIP() << "no /usr/bin/script (util-linux) to give atonlab a terminal";
+        ATONLAB_SKIP_MISSING_TOOL() << "no /usr/bin/script (util-linux) to give atonlab a terminal";
     setenv("ATONLAB_FAKE_SPOTREAD", (kData / "spotread/calibrate_then_read.txt").c_str(), 1);
     std::ofstream(dir_ / "enter.txt") << "\n";
     std::string command = std::string(ATONLAB_BINARY) + " calibrate measure --display booth --db " + db().string() +
@@ -475,7 +476,7 @@ TEST_F(CalibrateSpotread, ACalibrationRequestIsRelayedToTheOperatorOnATerminal) 
         dir_ / "out.txt", dir_ / "err.txt");
     std::string out = file_bytes(dir_ / "out.txt");
     std::erase(out, '\r');  // the terminal's line ends
-    if (contains(out, "OpenGL")) GTEST_SKIP() << out;
+    if (contains(out, "OpenGL")) ATONLAB_SKIP_NO_GPU() << out;
     ASSERT_EQ(code, 0) << out << file_bytes(dir_ / "err.txt");
     EXPECT_TRUE(contains(out,
                          "the instrument needs calibrating: Place cap on the instrument, or place on a dark "
@@ -508,7 +509,7 @@ TEST_F(CalibrateSpotread, NoInstrumentEndsInOneSentence) {
 
 TEST_F(CalibrateSpotread, ErrorsAfterAGoodMeasurementLeaveTheStudyFileAsItWas) {
     ASSERT_EQ(measure("normal.txt").code, 0);
-    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
     expect_refused("error.txt", "communication problem");
     expect_refused("hang.txt", "did not answer");
 }

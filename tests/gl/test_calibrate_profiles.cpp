@@ -22,6 +22,7 @@
 #include "atonlab/store/profiles.h"
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -160,7 +161,7 @@ TEST_F(CalibrateProfiles, OneImportServesTwoStudiesEachHoldingACopy) {
     for (const char* name : {"a.db", "b.db"}) {
         SCOPED_TRACE(name);
         r = run(protocol, dir_ / name, {"--profiles", profiles().string()});
-        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
         ASSERT_EQ(r.code, 0) << r.err;
         EXPECT_FALSE(contains(r.err, "has no calibration")) << r.err;
         const Store s = Store::open_read_only(dir_ / name);
@@ -228,7 +229,7 @@ TEST_F(CalibrateProfiles, OldStudyFilesWithTheirOwnCalibrationStillRun) {
     for (const fs::path& db : {v1, v2}) {
         SCOPED_TRACE(db.filename().string());
         r = run(protocol, db, {"--profiles", profiles().string()});
-        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
         ASSERT_EQ(r.code, 0) << r.err;
         const Store s = Store::open_read_only(db);
         EXPECT_EQ(s.file_schema_version(), store::schema_version());
@@ -251,7 +252,7 @@ TEST_F(CalibrateProfiles, ShowPrintsTheStoredCheckInTheDriftTable) {
     r = atonlab({"calibrate", "check", "--display", "booth-2", "--profiles", profiles().string(), "--headless",
                  "--readings", low.string(), "--no-plot", "--date", "2024-06-01"},
                 dir_.path());
-    if (r.code == 3) GTEST_SKIP() << "no GL 4.5 context: " << r.err;
+    if (r.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << r.err;
     ASSERT_EQ(r.code, 1) << r.out << r.err;
     r = atonlab({"calibrate", "show", "--display", "booth-2", "--profiles", profiles().string(), "--plot",
                  (dir_ / "drift.svg").string()},

@@ -46,6 +46,7 @@
 #include "displayability.h"
 #include "gl_test_support.h"
 #include "run_session.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -153,8 +154,8 @@ TEST(Displayability, ThereAreExamples) {
 // start runs `atonlab check`.
 TEST_P(Examples, Check) {
     if (const char* on = std::getenv("ATONLAB_LONG_TESTS"); on == nullptr || std::string(on) != "1")
-        GTEST_SKIP() << "long form: set ATONLAB_LONG_TESTS=1 to check every example at three displays";
-    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+        ATONLAB_SKIP_NOT_APPLICABLE() << "long form: set ATONLAB_LONG_TESTS=1 to check every example at three displays";
+    if (!test::gl_context()) ATONLAB_SKIP_NO_GPU() << test::gl_unavailable_reason();
     const fs::path& file = GetParam().protocol;
     const DisplayCase& d = GetParam().display;
     const Displayability r = check(file, d.width_px, d.height_px, d.width_m);
@@ -309,7 +310,7 @@ TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
     const fs::path db = dir / "study.db";
     const Result refused = atonlab(
         {"run", kUndisplayable.string(), "--db", db.string(), "--headless", "--model-observer"}, dir.path(), "refused");
-    if (refused.code == 3) GTEST_SKIP() << "no GL: " << refused.err;
+    if (refused.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << refused.err;
     EXPECT_EQ(refused.code, 2) << refused.err;
     EXPECT_FALSE(fs::exists(db)) << "a refused session must not create the study file";
     // One sentence for the condition, naming the file and its line, what is not displayable and what to change.
@@ -373,7 +374,7 @@ TEST(Displayability, RunRefusesARangeThatDoesNotStraddleTheTest) {
 TEST(Displayability, CheckCommandExitsTwoOrZeroAndWritesNothing) {
     TempDir dir;
     const Result bad = atonlab({"check", kUndisplayable.string()}, dir.path(), "bad");
-    if (bad.code == 3) GTEST_SKIP() << "no GL: " << bad.err;
+    if (bad.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << bad.err;
     EXPECT_EQ(bad.code, 2) << bad.err;
     EXPECT_TRUE(contains(bad.out, "NOT DISPLAYABLE")) << bad.out;
     EXPECT_TRUE(contains(bad.err, "condition \"too-dim\" cannot produce a match on this 320×180 display")) << bad.err;

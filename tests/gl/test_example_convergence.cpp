@@ -25,6 +25,7 @@
 #include "atonlab/protocols/protocol_schedule.h"
 #include "gl_test_support.h"
 #include "run_session.h"
+#include "../support/skip.h"
 
 namespace {
 
@@ -110,7 +111,7 @@ std::vector<p::TrackResult> run(const p::Protocol& protocol, std::uint64_t seed,
 }
 
 void expect_convergence(const std::string& name) {
-    if (!atonlab::test::gl_context()) GTEST_SKIP() << atonlab::test::gl_unavailable_reason();
+    if (!atonlab::test::gl_context()) ATONLAB_SKIP_NO_GPU() << atonlab::test::gl_unavailable_reason();
     p::Protocol protocol = p::load_protocol(example(name));
     // A quarter of the display's resolution at the same physical size and
     // distance: 16 times fewer pixels to render on llvmpipe (the full-size run,

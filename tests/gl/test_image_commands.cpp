@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "atonlab/stimuli/image_io.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -81,10 +82,11 @@ int srgb_code(double v) {
 
 TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
     if (shell("command -v pfstmo_reinhard02 > /dev/null && command -v pfsoutpfm > /dev/null") != 0)
-        GTEST_SKIP() << "pfstools is not installed (scripts/setup.sh installs it)";
+        ATONLAB_SKIP_MISSING_TOOL() << "pfstmo_reinhard02 or pfsoutpfm is not installed (Debian packages pfstmo, pfstools; "
+                                        "scripts/setup.sh installs them)";
     const fs::path dir = scratch("reinhard");
     const fs::path exr = dir / "four.exr";
-    if (!render(exr)) GTEST_SKIP() << "no OpenGL 4.5 context";
+    if (!render(exr)) ATONLAB_SKIP_NO_GPU() << "no OpenGL 4.5 context";
     // pfstmo_reinhard02's global operator: key 0.18, log-average with δ = 1e-5,
     // L_white = the brightest pixel, the curve applied to Y and XYZ scaled by
     // L_d / Y (no hue preservation, no blueshift). The display: sRGB, black 0,
@@ -146,7 +148,7 @@ TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
 TEST(ImageCommands, GlareKeepsTheLightsEnergyMinusTheReportedEdgeCut) {
     const fs::path dir = scratch("glare");
     const fs::path exr = dir / "noglare.exr";
-    if (!render(exr, "--set 'eye.glare=\"none\"'")) GTEST_SKIP() << "no OpenGL 4.5 context";
+    if (!render(exr, "--set 'eye.glare=\"none\"'")) ATONLAB_SKIP_NO_GPU() << "no OpenGL 4.5 context";
     const ExrImage in = read_exr(exr);
     ASSERT_GT(in.meta.degrees_per_pixel, 0);
     const double omega_sr = std::pow(in.meta.degrees_per_pixel * std::numbers::pi / 180.0, 2);

@@ -37,6 +37,7 @@
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -149,7 +150,7 @@ protected:
         ref_dir_ = nullptr;
     }
     void SetUp() override {
-        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
         ASSERT_EQ(ref_code_, 0) << ref_err_;
         ASSERT_EQ(reference_.size(), static_cast<std::size_t>(kTrials));
     }
@@ -330,7 +331,7 @@ TEST_F(run, SigtermQuitsBetweenTrialsAndTheSessionContinues) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     kill(pid, SIGTERM);
     const int code = wait_for(pid);
-    if (code == 0) GTEST_SKIP() << "the session finished before SIGTERM arrived";
+    if (code == 0) ATONLAB_SKIP_NOT_APPLICABLE() << "the session finished before SIGTERM arrived";
     ASSERT_EQ(code, 128 + SIGTERM) << text_of(err());
     {
         Store s = Store::open_read_only(db());
@@ -402,7 +403,7 @@ TEST_F(run, WriteProtectedFileStopsWithStatus4AndIsUnchanged) {
     // "nobody" must reach the directory (not write it) to be told the file is protected.
     ASSERT_EQ(chmod(dir_.path().c_str(), 0755), 0);
     const int code = run_atonlab({"--quiet"}, /*drop_root=*/true);
-    if (code == 121) GTEST_SKIP() << "running as root and cannot drop to nobody, for whom permissions apply";
+    if (code == 121) ATONLAB_SKIP_NOT_APPLICABLE() << "running as root and cannot drop to nobody, for whom permissions apply";
     EXPECT_EQ(code, 4) << text_of(err());
     const std::string message = text_of(err());
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;

@@ -23,6 +23,7 @@
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -85,7 +86,7 @@ TEST_F(RunnerVirtual, AStallMarksItsTrialWhichIsShownAgain) {
     const fs::path db = dir_.path() / "s.db";
     const int status = run(kData / "screen_stall.toml", db,
                            {"--model-observer", "--inject-stall-frames", "6", "--inject-stall-at-trial", "1"});
-    if (skipped_) GTEST_SKIP() << "no GL 4.5 context: " << err();
+    if (skipped_) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << err();
     ASSERT_EQ(status, 0) << err();
     const auto t = trials(db);
     ASSERT_EQ(t.size(), 5u);
@@ -120,7 +121,7 @@ TEST_F(RunnerVirtual, WithoutRepeatMissedTheStalledTrialCounts) {
     const fs::path db = dir_.path() / "s.db";
     const int status =
         run(protocol, db, {"--model-observer", "--inject-stall-frames", "3", "--inject-stall-at-trial", "0"});
-    if (skipped_) GTEST_SKIP() << "no GL 4.5 context: " << err();
+    if (skipped_) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << err();
     ASSERT_EQ(status, 0) << err();
     const auto t = trials(db);
     ASSERT_EQ(t.size(), 4u);
@@ -140,7 +141,7 @@ TEST_F(RunnerVirtual, AResumedSessionSkipsTheMissedTrialAsTheLiveOneDid) {
     std::vector<std::string> args{"--script", full_script.string()};
     args.insert(args.end(), stall.begin(), stall.end());
     const int status = run(protocol, full_db, args);
-    if (skipped_) GTEST_SKIP() << "no GL 4.5 context: " << err();
+    if (skipped_) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << err();
     ASSERT_EQ(status, 0) << err();
     const auto want = trials(full_db);
     ASSERT_EQ(want.size(), 5u);
@@ -179,7 +180,7 @@ TEST_F(RunnerVirtual, ALateAnswerTimesOutAndTheTrialIsShownAgain) {
     write_script(script, {"left 0.2", "right 2.0", "right 0.1", "left 0.1", "left 0.3"});
     const fs::path db = dir_.path() / "t.db";
     const int status = run(protocol, db, {"--script", script.string()});
-    if (skipped_) GTEST_SKIP() << "no GL 4.5 context: " << err();
+    if (skipped_) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << err();
     ASSERT_EQ(status, 0) << err();
     const auto t = trials(db);
     ASSERT_EQ(t.size(), 5u);

@@ -28,6 +28,7 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
+#include "../support/skip.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 
@@ -90,7 +91,7 @@ protected:
         dir_ = nullptr;
     }
     void SetUp() override {
-        if (!skip_.empty()) GTEST_SKIP() << skip_;
+        if (!skip_.empty()) ATONLAB_SKIP_NO_GPU() << skip_;
         ASSERT_EQ(setup_code_, 0) << setup_err_;
     }
     static fs::path good() { return dir_->path() / "good.db"; }
@@ -202,7 +203,7 @@ TEST_F(StudyRefusals, SalvageReadsWhatIsLeftAndTheReportSaysSoFirst) {
             leaves = raw.integer("SELECT count(*) FROM dbstat WHERE name = 'trials' AND pagetype = 'leaf'");
             leaf = raw.integer("SELECT min(pageno) FROM dbstat WHERE name = 'trials' AND pagetype = 'leaf'");
         } catch (const std::exception&) {
-            GTEST_SKIP() << "no dbstat in this SQLite build: the trials table's leaves cannot be found";
+            ATONLAB_SKIP_MISSING_TOOL() << "no dbstat in this SQLite build: the trials table's leaves cannot be found";
         }
     }
     ASSERT_EQ(trials, 9);
@@ -248,6 +249,123 @@ TEST_F(StudyRefusals, SalvageReadsWhatIsLeftAndTheReportSaysSoFirst) {
     EXPECT_LT(warn - h1, 60u) << html.substr(h1, 300);
     EXPECT_TRUE(contains(html.substr(warn, 600), fmt::format("3 session(s) and {} trial(s) were read", read)))
         << html.substr(warn, 600);
+}
+
+// --- Damage inside a record -------------------------------------------------------
+
+/// Overwrites, in `file`, the ':' after one key of the JSON text `json` with
+/// 0xB0, at a place whose next 32 bytes occur once in the file: the JSON is
+/// no longer valid, the record keeps its length and its page its structure.
+void break_json_in_file(const fs::path& file, const std::string& json) {
+    const std::string bytes = file_bytes(file);
+    for (std::size_t i = 2; i + 32 <= json.size(); ++i) {
+        if (json[i] != ':' || json[i - 1] != '"' || json[i - 2] == '\\') continue;
+        const std::string window = json.substr(i, 32);
+        const std::size_t at = bytes.find(window);
+        if (at == std::string::npos || bytes.find(window, at + 1) != std::string::npos) continue;
+        overwrite(file, static_cast<std::int64_t>(at), "\xb0");
+        return;
+    }
+    FAIL() << "no place in the file holds a unique part of " << json.substr(0, 200);
+}
+
+/// Whether `s` is valid UTF-8 (RFC 3629: no stray continuation bytes, lead
+/// bytes followed by their continuations), checked byte by byte here.
+bool valid_utf8(const std::string& s) {
+    for (std::size_t i = 0; i < s.size();) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        const std::size_t n = c < 0x80                 ? 1
+                              : c >= 0xc2 && c <= 0xdf ? 2
+                              : c >= 0xe0 && c <= 0xef ? 3
+                              : c >= 0xf0 && c <= 0xf4 ? 4
+                                                       : 0;
+        if (n == 0 || i + n > s.size()) return false;
+        for (std::size_t k = 1; k < n; ++k)
+            if ((static_cast<unsigned char>(s[i + k]) & 0xc0) != 0x80) return false;
+        i += n;
+    }
+    return true;
+}
+
+// A trial's stimulus_json overwritten inside its record: SQLite's read-only
+// integrity check says "ok", so analyze used to analyse it while run refused
+// it. Now run, calibrate and analyze all refuse it (exit 4) with the row
+// named; analyze --salvage leaves that trial out and names it.
+TEST_F(StudyRefusals, ATrialOverwrittenInsideItsRecordIsRefusedByEveryCommandAndSalvageNamesIt) {
+    const fs::path p = copy_of_good("record.db");
+    std::int64_t trials = 0;
+    {
+        RawDb raw(p, SQLITE_OPEN_READONLY);
+        trials = raw.integer("SELECT count(*) FROM trials");
+        ASSERT_GE(trials, 3);
+        break_json_in_file(p, raw.text("SELECT stimulus_json FROM trials WHERE id = 2"));
+    }
+    {
+        RawDb raw(p);  // SQLite's own verdicts, read-write
+        ASSERT_EQ(raw.text("PRAGMA integrity_check"), "CHECK constraint failed in trials");
+        ASSERT_EQ(raw.integer("SELECT id FROM trials WHERE NOT json_valid(stimulus_json)"), 2);
+    }
+    const std::string before = file_bytes(p);
+    const std::string sentence = "row 2 of trials breaks CHECK (json_valid(stimulus_json))";
+
+    const Result run = run_tiny(p, tmp_.path(), "run");
+    EXPECT_EQ(run.code, 4) << run.err;
+    expect_one_sentence_naming(run, p);
+    EXPECT_TRUE(contains(run.err, sentence)) << run.err;
+    const Result cal = atonlab({"calibrate", "import", (kData / "calibration/display.ti3").string(), "--display", "lcd",
+                                "--db", p.string(), "--width-px", "320", "--height-px", "180", "--width-m", "0.1",
+                                "--viewing-distance-m", "0.9", "--date", "2024-03-12"},
+                               tmp_.path(), "cal");
+    EXPECT_EQ(cal.code, 4) << cal.err;
+    EXPECT_TRUE(contains(cal.err, sentence)) << cal.err;
+    const fs::path out = tmp_.path() / "record-report";
+    const Result an = atonlab({"analyze", p.string(), "--out", out.string(), "--quiet"}, tmp_.path(), "an");
+    EXPECT_EQ(an.code, 4) << an.err;
+    expect_one_sentence_naming(an, p);
+    EXPECT_TRUE(contains(an.err, sentence)) << an.err;
+    EXPECT_TRUE(contains(an.err, "--salvage")) << an.err;
+    EXPECT_FALSE(fs::exists(out / "report.html"));
+    EXPECT_EQ(file_bytes(p), before) << "a command changed the refused file";
+
+    const Result salvaged = atonlab(
+        {"analyze", p.string(), "--out", out.string(), "--quiet", "--salvage", "--bootstrap", "0"}, tmp_.path(), "sv");
+    ASSERT_TRUE(salvaged.code == 0 || salvaged.code == 5) << salvaged.err;  // 5: figures missing without gnuplot
+    EXPECT_TRUE(contains(salvaged.err, "left out trials row 2: breaks CHECK (json_valid(stimulus_json))"))
+        << salvaged.err;
+    const nlohmann::json summary = store::parse_json(file_bytes(out / "summary.json"), "summary.json");
+    EXPECT_EQ(store::string_at(summary, "/damaged_inputs/0/skipped_rows/0").value_or(""),
+              "trials row 2: breaks CHECK (json_valid(stimulus_json))");
+    EXPECT_EQ(store::number_at(summary, "/damaged_inputs/0/trials_read").value_or(-1), trials - 1);
+    EXPECT_TRUE(contains(file_bytes(out / "report.html"), "trials row 2: breaks CHECK (json_valid(stimulus_json))"));
+    EXPECT_EQ(file_bytes(p), before) << "salvage changed the file";
+}
+
+// A session's displayability_json overwritten inside its record: analyze
+// used to read it and echo the JSON parser's raw bytes ("at byte 2042:
+// doc\xb0", not UTF-8). Now refused at the open, naming the row, in UTF-8.
+TEST_F(StudyRefusals, ADisplayabilityOverwrittenInsideItsRecordIsRefusedInValidUtf8) {
+    const fs::path p = copy_of_good("displayability.db");
+    {
+        RawDb raw(p, SQLITE_OPEN_READONLY);
+        const std::string json = raw.text("SELECT displayability_json FROM sessions WHERE id = 1");
+        ASSERT_GT(json.size(), 40u) << "the session records what the display showed";
+        break_json_in_file(p, json);
+    }
+    ASSERT_EQ(RawDb(p).text("PRAGMA integrity_check"), "CHECK constraint failed in sessions");
+    const std::string before = file_bytes(p);
+    const std::string sentence =
+        "row 1 of sessions breaks CHECK (displayability_json IS NULL OR json_valid(displayability_json))";
+    const fs::path out = tmp_.path() / "displayability-report";
+    const Result an = atonlab({"analyze", p.string(), "--out", out.string(), "--quiet"}, tmp_.path(), "an");
+    EXPECT_EQ(an.code, 4) << an.err;
+    expect_one_sentence_naming(an, p);
+    EXPECT_TRUE(contains(an.err, sentence)) << an.err;
+    EXPECT_TRUE(valid_utf8(an.err)) << an.err;
+    const Result run = run_tiny(p, tmp_.path(), "run");
+    EXPECT_EQ(run.code, 4) << run.err;
+    EXPECT_TRUE(contains(run.err, sentence)) << run.err;
+    EXPECT_TRUE(valid_utf8(run.err)) << run.err;
+    EXPECT_EQ(file_bytes(p), before);
 }
 
 // --- Refusals of `run` leave nothing behind --------------------------------------

@@ -21,6 +21,7 @@
 
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/gl/window.h"
+#include "../support/skip.h"
 
 namespace atonlab::test {
 namespace {
@@ -86,7 +87,7 @@ Screen10 read_screen(const char* path) {
 class Window10 : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!std::getenv("DISPLAY")) GTEST_SKIP() << "no display server (DISPLAY unset); CTest runs this under Xvfb";
+        if (!std::getenv("DISPLAY")) ATONLAB_SKIP_NO_GPU() << "no display server (DISPLAY unset); CTest runs this under Xvfb";
         gl::WindowOptions opt;
         opt.fullscreen = true;
         opt.monitor = 0;
@@ -98,7 +99,7 @@ protected:
         for (int i = 0; i < 3; ++i)
             glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_BACK_LEFT, names[i], &bits[i]);
         if (bits[0] != 10 || bits[1] != 10 || bits[2] != 10)
-            GTEST_SKIP() << "the window's framebuffer has " << bits[0] << "/" << bits[1] << "/" << bits[2]
+            ATONLAB_SKIP_NO_GPU() << "the window's framebuffer has " << bits[0] << "/" << bits[1] << "/" << bits[2]
                          << " bits, not 10: the X server (depth of its screen) or the GL driver ("
                          << window_->info().renderer << ") offers no 10-bit visual";
         width_ = window_->framebuffer_width();

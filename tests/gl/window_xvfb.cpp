@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "atonlab/stimuli/gl/window.h"
+#include "../support/skip.h"
 
 namespace atonlab::test {
 namespace {
@@ -14,7 +15,7 @@ namespace {
 bool have_display() { return std::getenv("DISPLAY") != nullptr || std::getenv("WAYLAND_DISPLAY") != nullptr; }
 
 TEST(GLWindow, WindowedContextClearsItsFramebuffer) {
-    if (!have_display()) GTEST_SKIP() << "no display server (DISPLAY unset); CTest runs this under xvfb-run";
+    if (!have_display()) ATONLAB_SKIP_NO_GPU() << "no display server (DISPLAY unset); CTest runs this under xvfb-run";
     gl::WindowOptions opt;
     opt.width = 64;
     opt.height = 48;
@@ -36,7 +37,7 @@ TEST(GLWindow, WindowedContextClearsItsFramebuffer) {
 }
 
 TEST(GLWindow, FullScreenOnMonitorZeroTakesItsNativeMode) {
-    if (!have_display()) GTEST_SKIP() << "no display server (DISPLAY unset); CTest runs this under xvfb-run";
+    if (!have_display()) ATONLAB_SKIP_NO_GPU() << "no display server (DISPLAY unset); CTest runs this under xvfb-run";
     gl::WindowOptions opt;
     opt.fullscreen = true;
     opt.monitor = 0;
@@ -47,7 +48,7 @@ TEST(GLWindow, FullScreenOnMonitorZeroTakesItsNativeMode) {
 }
 
 TEST(GLWindow, AMissingMonitorIsAClearError) {
-    if (!have_display()) GTEST_SKIP() << "no display server (DISPLAY unset)";
+    if (!have_display()) ATONLAB_SKIP_NO_GPU() << "no display server (DISPLAY unset)";
     gl::WindowOptions opt;
     opt.fullscreen = true;
     opt.monitor = 7;

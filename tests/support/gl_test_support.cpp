@@ -1,10 +1,11 @@
 #include "gl_test_support.h"
 
+#include <cstdlib>
+
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/gl/objects.h"
-
-#include <cstdlib>
+#include "skip.h"
 
 namespace atonlab::gl::detail {
 // The tests' own shaders (tests/shaders/, embedded by tests/CMakeLists.txt).
@@ -41,7 +42,7 @@ const std::string& gl_unavailable_reason() {
 
 void GLTest::SetUp() {
     gl::Context* ctx = gl_context();
-    if (!ctx) GTEST_SKIP() << "no OpenGL 4.5 core context: " << g_reason;
+    if (!ctx) ATONLAB_SKIP_NO_GPU() << "no OpenGL 4.5 core context: " << g_reason;
     ctx->make_current();
 }
 

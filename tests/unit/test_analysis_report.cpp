@@ -22,6 +22,7 @@
 #include "atonlab/display/display_model.h"
 #include "atonlab/display/fit_json.h"
 #include "atonlab/store/json.h"
+#include "../support/skip.h"
 
 namespace atonlab::analysis {
 namespace {
@@ -213,7 +214,7 @@ TEST(AnalysisReport, RecoversAKnownPseAndWritesAWellFormedSelfContainedReport) {
         EXPECT_DOUBLE_EQ(*g->match_ratio->value, *g->headline.value - 2.0);
     }
 
-    if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (Debian package gnuplot-nox)";
+    if (!have_gnuplot()) ATONLAB_SKIP_MISSING_TOOL() << "gnuplot is not installed (Debian package gnuplot-nox)";
     const fs::path out = dir / "out";
     fs::create_directories(out);
     const PlotResult plots = make_figures(out, d, r);
@@ -398,7 +399,7 @@ TEST(AnalysisReport, ConditionsWhoseNamesShareASlugGetTheirOwnFigures) {
     AnalysisOptions o;
     o.bootstrap = 0;
     const StudyResults r = analyze_study(d, o);
-    if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (Debian package gnuplot-nox)";
+    if (!have_gnuplot()) ATONLAB_SKIP_MISSING_TOOL() << "gnuplot is not installed (Debian package gnuplot-nox)";
     TempDir dir;
     const PlotResult plots = make_figures(dir.path(), d, r);
     std::map<std::string, const Figure*> psychometric;

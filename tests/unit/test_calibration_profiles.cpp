@@ -29,6 +29,7 @@
 #include "calibrate/calibration_policy.h"
 #include "calibrate/calibration_record.h"
 #include "calibrate/profile_location.h"
+#include "../support/skip.h"
 
 namespace atonlab::runner {
 namespace {
@@ -260,7 +261,7 @@ TEST(CalibrationProfiles, DriftTableAndFigureHoldTheStoredChecks) {
     // The figure, when gnuplot is there (scripts/setup.sh installs it).
     const fs::path svg = dir / "drift.svg";
     const std::string why = analysis::plot_drift(svg, d, "booth-2");
-    if (why.find("not installed") != std::string::npos) GTEST_SKIP() << why;
+    if (why.find("not installed") != std::string::npos) ATONLAB_SKIP_MISSING_TOOL() << why;
     ASSERT_EQ(why, "");
     const std::string text = file_bytes(svg);
     EXPECT_NE(text.find("<svg"), std::string::npos);
@@ -312,7 +313,7 @@ TEST(CalibrationProfiles, TheReportShowsTheChecksTheStudyHolds) {
     const nlohmann::json j = store::parse_json(file_bytes(out / "summary.json"), "summary.json");
     EXPECT_EQ(store::number_at(j, "/calibrations/0/checks/1/peak_cd_m2"), 0.9 * white);
     EXPECT_EQ(store::boolean_at(j, "/calibrations/0/checks/1/passed"), false);
-    if (plots.gnuplot_missing) GTEST_SKIP() << "gnuplot is not installed: no figures";
+    if (plots.gnuplot_missing) ATONLAB_SKIP_MISSING_TOOL() << "gnuplot is not installed: no figures";
     bool drawn = false;
     for (const analysis::Figure& f : plots.figures) drawn = drawn || f.kind == "calibration-drift";
     EXPECT_TRUE(drawn);

@@ -18,6 +18,7 @@
 
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/image_io.h"
+#include "../support/skip.h"
 
 namespace fs = std::filesystem;
 using atonlab::InputError;
@@ -224,7 +225,7 @@ TEST_F(ImageIo, FailedRenameLeavesNoTemporary) {
 }
 
 TEST_F(ImageIo, ReadOnlyDirectoryIsAnInputError) {
-    if (::geteuid() == 0) GTEST_SKIP() << "running as root: directory permissions do not stop writes";
+    if (::geteuid() == 0) ATONLAB_SKIP_NOT_APPLICABLE() << "running as root: directory permissions do not stop writes";
     fs::permissions(dir_, fs::perms::owner_read | fs::perms::owner_exec);
     const fs::path p = dir_ / "out.exr";
     const std::string what = what_of([&] { write_exr(p, test_image(2, 2), ExrMetadata{}); });

@@ -26,6 +26,24 @@ TEST(InputText, EchoKeepsShortValuesAndEscapesControlCharacters) {
     EXPECT_EQ(echo("0.5 cd/m² at 4°"), "0.5 cd/m² at 4°") << "UTF-8 is not escaped";
 }
 
+// Bytes that are not well-formed UTF-8 (RFC 3629 section 4) are escaped as
+// \xNN, so that every message is valid UTF-8 (a damaged record echoed "doc"
+// and the raw byte 0xB0). Each case by hand from the RFC's table.
+TEST(InputText, EchoEscapesBytesThatAreNotUtf8) {
+    EXPECT_EQ(echo("doc\xb0"), "doc\\xB0") << "a stray continuation byte";
+    EXPECT_EQ(echo("\xc3"), "\\xC3") << "a lead byte cut short at the end";
+    EXPECT_EQ(echo("\xc3("), "\\xC3(") << "a lead byte without its continuation";
+    EXPECT_EQ(echo("\xc0\xaf"), "\\xC0\\xAF") << "an overlong '/'";
+    EXPECT_EQ(echo("\xe0\x80\xaf"), "\\xE0\\x80\\xAF") << "an overlong 3-byte form";
+    EXPECT_EQ(echo("\xed\xa0\x80"), "\\xED\\xA0\\x80") << "a surrogate (U+D800)";
+    EXPECT_EQ(echo("\xf4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80") << "past U+10FFFF";
+    EXPECT_EQ(echo("\xff\xfe"), "\\xFF\\xFE");
+    EXPECT_EQ(echo("\xf0\x9f\x92\xa1 \xe2\x82\xac \xc2\xb0"), "\xf0\x9f\x92\xa1 \xe2\x82\xac \xc2\xb0")
+        << "4-, 3- and 2-byte characters are kept";
+    EXPECT_EQ(echo("\xed\x9f\xbf\xf4\x8f\xbf\xbf"), "\xed\x9f\xbf\xf4\x8f\xbf\xbf") << "U+D7FF and U+10FFFF are kept";
+    EXPECT_EQ(one_line("at byte 2042: doc\xb0\n"), "at byte 2042: doc\\xB0\\n");
+}
+
 TEST(InputText, EchoCutsLongValuesAtEightyCharactersAndSaysHowLong) {
     const std::string four_mib(4u << 20, 'x');
     EXPECT_EQ(echo(four_mib), std::string(80, 'x') + "… (4194304 bytes in all)");

@@ -9,6 +9,7 @@
 
 #include "atonlab/runner/text.h"
 #include "atonlab/stimuli/error.h"
+#include "../support/skip.h"
 
 namespace atonlab::runner {
 namespace {
@@ -41,7 +42,7 @@ TEST(ScreenText, AMissingFontIsOneSentenceNamingTheFile) {
 }
 
 TEST(ScreenText, LinesHaveTheFontsHeightAndWrapAtSpaces) {
-    if (!have_font()) GTEST_SKIP() << kDefaultFontFile << " is not installed (fonts-dejavu-core)";
+    if (!have_font()) ATONLAB_SKIP_MISSING_TOOL() << kDefaultFontFile << " is not installed (fonts-dejavu-core)";
     const Font f = Font::load(kDefaultFontFile);
     // DejaVu Sans: ascent 1901, descent −483, line gap 0 (units per em 2048),
     // so a pixel height h (ascent − descent) puts lines h apart.

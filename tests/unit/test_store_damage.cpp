@@ -19,6 +19,7 @@
 #include "../store/store_test_support.h"
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
+#include "../support/skip.h"
 
 namespace atonlab::store {
 namespace {
@@ -300,7 +301,7 @@ TEST(StoreDamage, SalvageReadsWhatIsLeftOfADamagedFile) {
     const int n = 400;
     write_study(path, n);
     const std::vector<std::int64_t> pages = trials_pages(path);
-    if (pages.size() < 3) GTEST_SKIP() << "no dbstat in this SQLite build: the leaves cannot be found";
+    if (pages.size() < 3) ATONLAB_SKIP_MISSING_TOOL() << "no dbstat in this SQLite build: the leaves cannot be found";
     // One leaf's structure overwritten: the rows on the other leaves stay readable.
     const std::int64_t page = page_size_of(path);
     write_bytes(path, (pages[2] - 1) * page, std::string(12, '\xee'));

@@ -172,6 +172,8 @@ struct DamagedInput {
     std::size_t trials_read = 0;
     std::int64_t sessions_unreadable = 0;  ///< session rows that could not be read
     std::int64_t trials_unreadable = 0;    ///< trial rows that could not be read
+    /// Every row left out, named: "trials row 4: breaks CHECK (json_valid(stimulus_json))".
+    std::vector<std::string> skipped_rows;
 };
 
 /// Everything read, from every input.

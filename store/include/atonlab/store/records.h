@@ -172,6 +172,13 @@ struct SalvagedTrial {
     TrialRecord trial;
 };
 
+/// A session or trial row that Store::salvage() left out, and why.
+struct SkippedRow {
+    std::string table;  ///< "sessions" or "trials"
+    std::int64_t row_id = 0;
+    std::string why;  ///< "breaks CHECK (json_valid(stimulus_json))", "cannot be read (…)", "cannot be found (…)"
+};
+
 /// What Store::salvage() could read of a damaged study file.
 struct Salvage {
     std::vector<SessionRecord> sessions;   ///< readable sessions; trial_count = the trials read for each
@@ -179,6 +186,7 @@ struct Salvage {
     std::int64_t unreadable_sessions = 0;  ///< session row ids up to the largest that could not be read
     std::int64_t unreadable_trials = 0;    ///< trial row ids up to the largest that could not be read
     std::vector<std::string> problems;     ///< one sentence for each part that could not be read at all
+    std::vector<SkippedRow> skipped;       ///< every session and trial row id up to the largest that was left out
 };
 
 }  // namespace atonlab::store
