@@ -213,7 +213,7 @@ double pixel_sr(int width_px, double width_m, double distance_m) {
 // it; what the check calls the display's resolution there is one code step of
 // all three channels (the light raises none) over the background's codes.
 TEST(Displayability, TooDimTestLightAddsNothingAndIsRefused) {
-    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    if (!test::gl_context()) ATONLAB_SKIP_NO_GPU() << test::gl_unavailable_reason();
     const Displayability d = check(kUndisplayable, 320, 180, 0.1);
     ASSERT_EQ(d.conditions.size(), 1u);
     const runner::ConditionDisplayability& c = d.conditions[0];
@@ -245,7 +245,7 @@ TEST(Displayability, TooDimTestLightAddsNothingAndIsRefused) {
 // are the same pixel of the same colour, so they are equal exactly where
 // their intensities are (the analytic match): level log10(1e-4 cd) = −4.
 TEST(Displayability, ReferenceBrighterAtItsLowestLevelIsRefusedWithTheBoundToMove) {
-    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    if (!test::gl_context()) ATONLAB_SKIP_NO_GPU() << test::gl_unavailable_reason();
     TempDir dir;
     const fs::path too_bright = variant(dir.path(), "too-bright.toml", kUndisplayable,
                                         {{kTestIntensity, "light.test.intensity_cd=1e-4"},
@@ -285,7 +285,7 @@ TEST(Displayability, ReferenceBrighterAtItsLowestLevelIsRefusedWithTheBoundToMov
 // A condition whose test is well shown and whose range brackets it passes, its
 // equal level near the analytic match (log10 of the test's intensity).
 TEST(Displayability, GoodConditionPasses) {
-    if (!test::gl_context()) GTEST_SKIP() << test::gl_unavailable_reason();
+    if (!test::gl_context()) ATONLAB_SKIP_NO_GPU() << test::gl_unavailable_reason();
     TempDir dir;
     const fs::path good =
         variant(dir.path(), "good.toml", kUndisplayable, {{kTestIntensity, "light.test.intensity_cd=1e-3"}});
@@ -362,7 +362,7 @@ TEST(Displayability, RunRefusesARangeThatDoesNotStraddleTheTest) {
     const fs::path db = dir / "study.db";
     const Result refused = atonlab({"run", too_bright.string(), "--db", db.string(), "--headless", "--model-observer"},
                                    dir.path(), "refused");
-    if (refused.code == 3) GTEST_SKIP() << "no GL: " << refused.err;
+    if (refused.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << refused.err;
     EXPECT_EQ(refused.code, 2) << refused.err;
     EXPECT_FALSE(fs::exists(db)) << "a refused session must not create the study file";
     EXPECT_TRUE(contains(refused.err, too_bright.string() + ":52: condition \"too-dim\" cannot produce a match"))
