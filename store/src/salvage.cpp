@@ -31,12 +31,20 @@ Salvage Store::salvage() const {
 
     // Sessions, one row id at a time; the trial count is of the trials read below.
     if (const auto last = largest_id(db, "SELECT max(id) FROM sessions", out.problems, "sessions")) {
-        sql::Statement s(db,
-                         "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, "
-                         // displayability_json NULL: a damaged file may be of a schema before it (v3).
-                         "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL "
-                         "FROM sessions s JOIN observers o ON o.id = s.observer_id "
-                         "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1");
+        // displayability_json NULL: a damaged file may be of a schema before it
+        // (v4); the scene's hash and name where the file has them (v6).
+        const bool scenes = file_schema_version() >= 6;
+        sql::Statement s(db, scenes ? "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, "
+                                      "s.seed, s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, "
+                                      "0, NULL, sc.sha256, sc.name "
+                                      "FROM sessions s JOIN observers o ON o.id = s.observer_id "
+                                      "JOIN protocols p ON p.id = s.protocol_id "
+                                      "LEFT JOIN scenes sc ON sc.id = s.scene_id WHERE s.id = ?1"
+                                    : "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, "
+                                      "s.seed, s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, "
+                                      "0, NULL, NULL, NULL "
+                                      "FROM sessions s JOIN observers o ON o.id = s.observer_id "
+                                      "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1");
         for (std::int64_t id = 1; id <= *last; ++id) {
             try {
                 s.bind(1, id);
