@@ -142,7 +142,7 @@ std::vector<Tile> brightest_tiles(const stimuli::ImageRGBA32F& hdr, const std::v
         const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
         const int x0 = std::clamp(bx - w / 2, 0, hdr.width - w);
         const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
-        tiles.push_back({x0, y0, w, h});
+        tiles.push_back({x0, y0, w, h, {}});
     }
     return tiles;
 }

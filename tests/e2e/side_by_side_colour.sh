@@ -37,10 +37,10 @@ grep -q "frame 0 test (red, Fl(1) 4s, glare wave-optics)" "$r/report.html" &&
   grep -q "frame 0 reference (white, F, glare none)" "$r/report.html" ||
   { echo "the snapshot's caption does not name both lights"; fail=1; }
 grep -q '"colour": "red"' "$r/summary.json" || { echo "summary.json does not name the red test"; fail=1; }
-header=$(head -1 "$r/fits.csv")
-col() { echo "$header" | tr ',' '\n' | grep -nx "$1" | cut -d: -f1; }
-tc=$(tail -n +2 "$r/fits.csv" | cut -d, -f"$(col test_colour)" | sort -u)
-rc=$(tail -n +2 "$r/fits.csv" | cut -d, -f"$(col reference_colour)" | sort -u)
+# fits.csv quotes fields that hold commas (reasons, methods): read it with a CSV reader.
+fits_col() { python3 -c 'import csv, sys; print("\n".join(sorted({r[sys.argv[2]] for r in csv.DictReader(open(sys.argv[1]))})))' "$r/fits.csv" "$1"; }
+tc=$(fits_col test_colour)
+rc=$(fits_col reference_colour)
 if [ "$tc" != "red" ] || [ "$rc" != "white" ]; then echo "fits.csv test_colour $tc, reference_colour $rc"; fail=1; fi
 echo "test $tc / reference $rc"
 exit $fail

@@ -30,7 +30,7 @@ if [ "$status" -eq 5 ] && ! command -v gnuplot >/dev/null; then echo "skipped: g
 if [ "$status" -ne 0 ]; then echo "atonlab analyze failed ($status):"; cat "$outdir/analyze.err"; exit 1; fi
 # trials.csv: glare_test and glare_reference columns.
 header=$(head -1 "$outdir/report/trials.csv")
-col() { echo "$header" | tr ',' '\n' | grep -nx "$1" | cut -d: -f1; }
+col() { echo "$header" | tr ',' '\n' | grep -nxF -- "$1" | cut -d: -f1; }
 gt=$(col glare_test) gr=$(col glare_reference)
 pairs=$(tail -n +2 "$outdir/report/trials.csv" | cut -d, -f"$gt,$gr" | sort -u)
 if [ "$pairs" != "wave-optics,none" ]; then echo "trials.csv glare_test,glare_reference: $pairs"; fail=1; fi
