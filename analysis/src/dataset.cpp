@@ -59,6 +59,7 @@ const std::vector<std::string>& trials_csv_columns() {
                                                "observer",
                                                "trial_index",
                                                "block",
+                                               "block_index",
                                                "condition",
                                                "track",
                                                "procedure",
@@ -80,6 +81,12 @@ const std::vector<std::string>& trials_csv_columns() {
                                                "glare_test",
                                                "glare_reference",
                                                "test_intensity_cd",
+                                               "test_colour",
+                                               "test_rhythm",
+                                               "test_spectrum",
+                                               "reference_colour",
+                                               "reference_rhythm",
+                                               "reference_spectrum",
                                                "chose_reference",
                                                "guess_rate",
                                                "target_p",
@@ -103,6 +110,7 @@ public:
               const std::vector<std::string>& fields)
         : file_(file), line_(line), index_(index), fields_(fields) {}
 
+    bool has(const std::string& column) const { return index_.count(column) > 0; }
     /// The field's text, or nullopt when the column is absent or the field empty.
     std::optional<std::string> text(const std::string& column) const {
         const auto it = index_.find(column);
@@ -236,7 +244,14 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     }
     if (const auto s = row.text("session")) t.session = *s;
     if (const auto v = row.integer("trial_index", 0)) t.trial_index = *v;
-    if (const auto v = row.integer("block", 0)) t.block = static_cast<int>(*v);
+    // `block` is the block's name (trials.csv from 0.2 on; earlier, and in
+    // hand-made files, its 0-based index), `block_index` its index.
+    if (const auto s = row.text("block")) {
+        t.block_name = *s;
+        if (!row.has("block_index") && std::all_of(s->begin(), s->end(), [](char c) { return c >= '0' && c <= '9'; }))
+            if (const auto v = row.integer("block", 0)) t.block = static_cast<int>(*v);
+    }
+    if (const auto v = row.integer("block_index", 0)) t.block = static_cast<int>(*v);
     if (const auto s = row.text("track")) t.track = *s;
     if (const auto s = row.text("procedure")) {
         static const std::set<std::string, std::less<>> kinds{"staircase", "weighted-staircase", "quest",
@@ -257,6 +272,11 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     if (const auto s = row.text("tone_operator")) t.tone_operator = *s;
     if (const auto s = row.text("glare_test")) t.glare_test = *s;
     if (const auto s = row.text("glare_reference")) t.glare_reference = *s;
+    for (const auto& [look, side] : {std::pair{&t.test_look, "test"}, std::pair{&t.reference_look, "reference"}}) {
+        look->colour = row.text(fmt::format("{}_colour", side)).value_or("");
+        look->rhythm = row.text(fmt::format("{}_rhythm", side)).value_or("");
+        look->spectrum = row.text(fmt::format("{}_spectrum", side)).value_or("");
+    }
     t.test_intensity_cd = row.number("test_intensity_cd");
     if (t.test_intensity_cd && *t.test_intensity_cd <= 0.0)
         row.fail("test_intensity_cd", "must be an intensity > 0 cd");
@@ -345,8 +365,27 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
                                          header->fields.size()));
         const RowReader row(file, rec->line, index, rec->fields);
         Trial t = trial_from_row(row, file);
-        for (const auto& [name, i] : setting_columns)
-            if (const std::string v = RowReader::trim(rec->fields[i]); !v.empty()) t.settings[name] = toml_of_field(v);
+        // "KEY[0]", "KEY[1]", ...: one array setting (write_trials_csv writes a position so).
+        std::map<std::string, std::map<std::size_t, std::string>> arrays;
+        for (const auto& [name, i] : setting_columns) {
+            const std::string v = RowReader::trim(rec->fields[i]);
+            if (v.empty()) continue;
+            const auto open = name.rfind('[');
+            std::size_t element = 0;
+            if (open != std::string::npos && name.back() == ']' &&
+                std::from_chars(name.data() + open + 1, name.data() + name.size() - 1, element).ptr ==
+                    name.data() + name.size() - 1 &&
+                setting_value(v).number) {
+                arrays[name.substr(0, open)][element] = v;
+                continue;
+            }
+            t.settings[name] = toml_of_field(v);
+        }
+        for (const auto& [key, values] : arrays) {
+            std::string toml = "[";
+            for (const auto& [element, v] : values) toml += (toml.size() > 1 ? ", " : "") + v;
+            t.settings[key] = toml + "]";
+        }
         if (t.session.empty())
             t.session = fmt::format("{}:{}", std::filesystem::path(file).filename().string(), t.observer);
         if (!index.count("trial_index")) t.trial_index = next_index[t.session]++;
@@ -405,7 +444,20 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
     std::set<std::string> setting_keys;
     for (const Trial& t : data.trials)
         for (const auto& kv : t.settings) setting_keys.insert(kv.first);
-    for (const std::string& k : setting_keys) out << ',' << detail::csv_field(k);
+    // A setting that is an array of numbers (a position) is one column per
+    // element, "KEY[0]", "KEY[1]", ..., each a number (read_trials_csv joins them back).
+    std::map<std::string, std::size_t> elements;
+    for (const Trial& t : data.trials)
+        for (const auto& [k, v] : t.settings)
+            if (const auto xs = setting_value(v).numbers) elements[k] = std::max(elements[k], xs->size());
+    for (const std::string& k : setting_keys) {
+        const auto e = elements.find(k);
+        if (e == elements.end()) {
+            out << ',' << detail::csv_field(k);
+            continue;
+        }
+        for (std::size_t i = 0; i < e->second; ++i) out << ',' << detail::csv_field(fmt::format("{}[{}]", k, i));
+    }
     out << '\n';
     auto num = [](const std::optional<double>& v) { return v ? detail::number_text(*v) : std::string(); };
     auto flag = [](const std::optional<bool>& v) { return v ? std::string(*v ? "1" : "0") : std::string(); };
@@ -414,12 +466,13 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
         const std::vector<std::string> f{csv_field(t.session),
                                          csv_field(t.observer),
                                          std::to_string(t.trial_index),
+                                         csv_field(t.block_name.empty() ? std::to_string(t.block) : t.block_name),
                                          std::to_string(t.block),
                                          csv_field(t.condition),
                                          csv_field(t.track),
                                          csv_field(t.procedure),
                                          std::string(to_string(t.task)),
-                                         detail::number_text(t.level),
+                                         detail::number_text(t.level),  // noise removed by read_study
                                          csv_field(t.level_key),
                                          csv_field(t.level_scale),
                                          csv_field(t.level_on),
@@ -436,6 +489,12 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
                                          csv_field(t.glare_test),
                                          csv_field(t.glare_reference),
                                          num(t.test_intensity_cd),
+                                         csv_field(t.test_look.colour),
+                                         csv_field(t.test_look.rhythm),
+                                         csv_field(t.test_look.spectrum),
+                                         csv_field(t.reference_look.colour),
+                                         csv_field(t.reference_look.rhythm),
+                                         csv_field(t.reference_look.spectrum),
                                          chose_reference(t),
                                          detail::number_text(t.guess_rate),
                                          detail::number_text(t.target_p),
@@ -448,7 +507,20 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
         for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
         for (const std::string& k : setting_keys) {
             const auto it = t.settings.find(k);
-            out << ',' << (it == t.settings.end() ? std::string() : setting_field(it->second));
+            const auto e = elements.find(k);
+            if (e == elements.end()) {
+                out << ',' << (it == t.settings.end() ? std::string() : setting_field(it->second));
+                continue;
+            }
+            const std::optional<std::vector<double>> xs =
+                it == t.settings.end() ? std::nullopt : setting_value(it->second).numbers;
+            for (std::size_t i = 0; i < e->second; ++i) {
+                out << ',';
+                if (xs && i < xs->size())
+                    out << detail::number_text((*xs)[i]);
+                else if (i == 0 && it != t.settings.end() && !xs)
+                    out << setting_field(it->second);
+            }
         }
         out << '\n';
     }

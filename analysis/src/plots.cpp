@@ -338,10 +338,12 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
     };
     std::map<std::string, std::vector<Row>> series;  // by tone mapper
     bool all_adaptation = true;
+    bool glare_only = true;  // every condition drawn differs in glare alone: an enhancement by glare
     int index = 0;
     for (const ConditionInfo& c : r.conditions) {
         const GroupResult* g = r.main_group(c.condition);
-        if (!c.compares_glare() || !g || !g->match_ratio || !g->match_ratio->value) continue;
+        if ((!c.compares_glare() && c.differences.empty()) || !g || !g->match_ratio || !g->match_ratio->value) continue;
+        glare_only = glare_only && c.glare_only_difference();
         ++index;
         const MatchRatio& m = *g->match_ratio;
         all_adaptation = all_adaptation && c.adaptation_cd_m2.has_value();
@@ -372,7 +374,8 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
         plot += fmt::format(
             ", \\\n     {} using 1:2 with points pt 6 ps 3 lw 1.5 lc rgb '#b3261e' title 'unreliable (see the report)'",
             d.data("enhancement-unreliable.tsv", unreliable));
-    plot += ", \\\n     0 with lines dt 2 lc rgb '#000000' title 'no enhancement'";
+    plot += fmt::format(", \\\n     0 with lines dt 2 lc rgb '#000000' title '{}'",
+                        glare_only ? "no enhancement" : "match = test");
     std::string body = "reset\nset datafile separator '\\t'\nset key outside right top\nset grid\n";
     if (all_adaptation)
         body +=
@@ -380,17 +383,27 @@ void enhancement_figure(Drawer& d, const StudyResults& r) {
             "graph 0.1, graph 0.1, graph 0.1\n";
     else
         body += "set xlabel 'condition (adaptation not stated)'\nset offsets 0.5, 0.5, graph 0.1, graph 0.1\n";
-    body += "set ylabel 'log10(matched no-glare intensity / glare test intensity)'\n";
-    body += fmt::format("set title 'Brightness enhancement by glare, {:.0f}% intervals'\n", 100.0 * r.options.ci_level);
+    // Named by what it measures (ConditionInfo::difference_label): glare
+    // alone, or test − reference where the lights differ in more.
+    body += glare_only ? "set ylabel 'log10(matched no-glare intensity / glare test intensity)'\n"
+                       : "set ylabel 'log10(matched reference intensity / test intensity)'\n";
+    body +=
+        fmt::format("set title '{}, {:.0f}% intervals'\n",
+                    glare_only ? "Brightness enhancement by glare" : "Test - reference", 100.0 * r.options.ci_level);
     body += plot + "\n";
     Figure f;
     f.id = "enhancement";
     f.kind = "enhancement";
-    f.title = "Brightness enhancement by glare";
-    f.caption =
-        "log10 of the intensity of the light without glare that matches the light with glare, over the "
-        "glare light's own intensity (both put the same illuminance into the eye), per adaptation level and "
-        "tone mapper. Above 0: the glare rendering looks brighter than its energy-matched twin.";
+    f.title = glare_only ? "Brightness enhancement by glare" : "Test − reference";
+    f.caption = glare_only
+                    ? "log10 of the intensity of the light without glare that matches the light with glare, over "
+                      "the glare light's own intensity (both put the same illuminance into the eye), per adaptation "
+                      "level and tone mapper. Above 0: the glare rendering looks brighter than its energy-matched "
+                      "twin."
+                    : "log10 of the reference intensity that matches the test, over the test's own intensity, per "
+                      "adaptation level and tone mapper. The test and the reference differ in more than glare "
+                      "(colour, rhythm, spectrum or frame settings: see each condition), so this is not an effect "
+                      "of glare alone. Above 0: the test looks brighter than an equally intense reference.";
     d.draw(std::move(f), body);
 }
 

@@ -119,6 +119,13 @@ Json track_json(const TrackResult& t) {
     return j;
 }
 
+/// A judged light as the stored scene gives it, with the glare it was drawn with.
+Json light_json(const LightLook& l, const std::string& glare) {
+    const auto text = [](const std::string& v) { return v.empty() ? Json(nullptr) : Json(v); };
+    return Json{
+        {"colour", text(l.colour)}, {"rhythm", text(l.rhythm)}, {"spectrum", text(l.spectrum)}, {"glare", text(glare)}};
+}
+
 Json group_json(const GroupResult& g, const ConditionInfo& c) {
     Json j;
     j["observer"] = g.observer;
@@ -149,11 +156,9 @@ Json group_json(const GroupResult& g, const ConditionInfo& c) {
     j["match_ratio"] = nullptr;
     if (g.match_ratio) {
         const MatchRatio& m = *g.match_ratio;
-        j["match_ratio"] = Json{{"log10_ratio", or_null(m.value)},
-                                {"ci", interval(m.ci)},
-                                {"method", m.method},
-                                {"reliable", m.reliable},
-                                {"reason", m.reason}};
+        j["match_ratio"] = Json{{"label", c.difference_label()}, {"log10_ratio", or_null(m.value)},
+                                {"ci", interval(m.ci)},          {"method", m.method},
+                                {"reliable", m.reliable},        {"reason", m.reason}};
     }
     return j;
 }
@@ -175,6 +180,7 @@ Json setting_json(const std::string& toml_value) {
     const SettingValue v = setting_value(toml_value);
     if (v.number) return *v.number;
     if (v.boolean) return *v.boolean;
+    if (v.numbers) return *v.numbers;  // a position as an array of numbers
     return v.text;
 }
 
@@ -252,7 +258,14 @@ const std::vector<std::string>& fits_csv_columns() {
                                                "tone_operator",
                                                "glare_test",
                                                "glare_reference",
-                                               "test_intensity_cd"};
+                                               "test_intensity_cd",
+                                               "test_colour",
+                                               "test_rhythm",
+                                               "test_spectrum",
+                                               "reference_colour",
+                                               "reference_rhythm",
+                                               "reference_spectrum",
+                                               "difference"};
     return cols;
 }
 
@@ -289,6 +302,8 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
                {"observer", s.observer},
                {"protocol_name", s.protocol_name},
                {"protocol_sha256", s.protocol_sha256},
+               {"scene_name", s.scene_sha256.empty() ? Json(nullptr) : Json(s.scene_name)},
+               {"scene_sha256", s.scene_sha256.empty() ? Json(nullptr) : Json(s.scene_sha256)},
                {"software_version", s.software_version},
                {"seed", std::to_string(s.seed)},
                {"status", s.status},
@@ -316,6 +331,11 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
                {"glare_test", c.glare_test},
                {"glare_reference", c.glare_reference},
                {"test_intensity_cd", or_null(c.test_intensity_cd)},
+               {"test_light", light_json(c.test_look, c.glare_test)},
+               {"reference_light", light_json(c.reference_look, c.glare_reference)},
+               {"lights_known", c.lights_known()},
+               {"differences", c.differences},
+               {"difference", c.difference_label()},
                {"guess_rate", c.guess_rate},
                {"target_p", c.target_p},
                {"n_trials", c.n_trials}};
@@ -407,6 +427,13 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
             m["glare_test"] = csv_field(c->glare_test);
             m["glare_reference"] = csv_field(c->glare_reference);
             m["test_intensity_cd"] = opt(c->test_intensity_cd);
+            m["test_colour"] = csv_field(c->test_look.colour);
+            m["test_rhythm"] = csv_field(c->test_look.rhythm);
+            m["test_spectrum"] = csv_field(c->test_look.spectrum);
+            m["reference_colour"] = csv_field(c->reference_look.colour);
+            m["reference_rhythm"] = csv_field(c->reference_look.rhythm);
+            m["reference_spectrum"] = csv_field(c->reference_look.spectrum);
+            m["difference"] = g.match_ratio ? csv_field(c->difference_label()) : std::string();
             for (const std::string& key : r.factor_columns) {
                 const auto it = c->settings.find(key);
                 m[key] = it == c->settings.end() ? std::string() : setting_csv(it->second);

@@ -238,17 +238,49 @@ private:
     std::vector<std::pair<std::string, std::string>> out_;
 };
 
+/// A judged light in a table cell: "red, Fl(1) 4s, –, glare wave-optics".
+std::string light_cell(const LightLook& l, const std::string& glare) {
+    const std::string g = "glare " + (glare.empty() ? std::string("(scene default)") : glare);
+    if (l.colour.empty()) return esc(g);
+    return esc(fmt::format("{}, {}, ", l.colour, l.rhythm)) + (l.spectrum.empty() ? "&ndash;" : esc(l.spectrum)) +
+           ", " + esc(g);
+}
+
+/// A sentence naming the condition's two lights and what differs between them.
+std::string lights_sentence(const ConditionInfo& c) {
+    if (c.test_look.colour.empty())
+        return " The lights' colour, rhythm and spectrum are not known: the study file does not hold the scene "
+               "(or the CSV does not give them).";
+    const auto one = [](const LightLook& l) {
+        return fmt::format("{}, rhythm {}, spectrum {}", l.colour, l.rhythm,
+                           l.spectrum.empty() ? std::string("not given (spd)") : l.spectrum);
+    };
+    std::string out = " The test light: " + esc(one(c.test_look));
+    if (c.reference_look.colour.empty()) return out + ".";
+    out += "; the reference light: " + esc(one(c.reference_look)) + ".";
+    if (c.differences.empty()) return out + " They differ in nothing but intensity (and position).";
+    std::string list;
+    for (std::size_t i = 0; i < c.differences.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == c.differences.size() ? " and " : ", ") + c.differences[i];
+    return out + " They differ in " + esc(list) + ": log10(match / test) is labelled <i>" + esc(c.difference_label()) +
+           "</i>.";
+}
+
 /// The summary table: one row per condition.
 std::string summary_html(const StudyResults& r, const std::map<std::string, std::string>& slugs, Footnotes& notes) {
     std::string h;
     h += "<h2>Summary</h2>\n";
     h += "<p>One row per condition (pooled over observers when there are several). <i>Estimate</i>: the PSE or "
          "threshold of the fitted psychometric function (2AFC, yes-no), or the mean match (adjustment). "
-         "<i>Enhancement</i>: log10(matched no-glare intensity / glare test intensity).</p>\n";
+         "<i>log10(match / test)</i>: log10(matched reference intensity / test intensity), named under its value "
+         "by what it measures: the effect of glare where glare is the only difference between the test and the "
+         "reference light (colour, rhythm, spectrum and frame settings the same), else test &minus; reference. "
+         "Each light: colour, rhythm, spectrum (the scene's <code>spd</code>; &ndash; none given), glare.</p>\n";
     // Each number over its interval in one cell, so that the table fits 1280 px.
     h += "<div class=\"table-wrap\"><table>\n<tr><th>condition</th><th>task / procedure</th>"
-         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>glare test / reference</th><th>test (cd)</th>"
-         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>enhancement [interval]</th>"
+         "<th>adaptation (cd/m²)</th><th>tone mapper</th><th>test / reference light</th><th>test (cd)</th>"
+         "<th>observer</th><th>trials</th><th>estimate [interval]</th><th>unit</th><th>log10(match / test) "
+         "[interval]</th>"
          "<th>reliable</th></tr>\n";
     for (const ConditionInfo& c : r.conditions) {
         const GroupResult* g = r.main_group(c.condition);
@@ -256,15 +288,17 @@ std::string summary_html(const StudyResults& r, const std::map<std::string, std:
         const HeadlineEstimate& e = g->headline;
         std::string enh = "&ndash;";
         if (g->match_ratio && g->match_ratio->value)
-            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci);
+            enh = f3(g->match_ratio->value) + "<br>" + ci_text(g->match_ratio->ci) + "<br><i>" +
+                  esc(c.difference_label()) + "</i>";
         h += fmt::format(
-            "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{} / {}</td>"
+            "<tr><td><a href=\"#c-{}\">{}</a></td><td>{} / {}</td><td class=\"num\">{}</td><td>{}</td><td>{}<br>{}</td>"
             "<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}<br>{}</td>"
             "<td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
             esc(slugs.at(c.condition)), esc(c.condition), esc(std::string(to_string(c.task))),
             esc(c.procedure.empty() ? "(not stated)" : c.procedure), g3(c.adaptation_cd_m2), esc(c.tone_operator),
-            esc(c.glare_test), esc(c.glare_reference), g3(c.test_intensity_cd), esc(g->observer), g->n_scored,
-            f3(e.value), ci_text(e.ci), esc(c.level_unit()), enh, yes_no(e.reliable, e.reason, notes));
+            light_cell(c.test_look, c.glare_test), light_cell(c.reference_look, c.glare_reference),
+            g3(c.test_intensity_cd), esc(g->observer), g->n_scored, f3(e.value), ci_text(e.ci), esc(c.level_unit()),
+            enh, yes_no(e.reliable, e.reason, notes));
     }
     h += "</table></div>\n" + notes.flush();
     return h;
@@ -277,13 +311,14 @@ std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
     h += fmt::format("<h2 id=\"c-{}\">Condition {}</h2>\n", esc(slugs.at(c.condition)), esc(c.condition));
     h += fmt::format(
         "<p>Task {}, procedure {}; the level sets <code>{}</code> ({}, on the {}); adaptation {} cd/m², tone "
-        "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd. Outcome counted: {} "
+        "mapper {}, glare {} on the test and {} on the reference, test intensity {} cd.{} Outcome counted: {} "
         "(guess rate {}, target P {}). {} trials.</p>\n",
         esc(std::string(to_string(c.task))), esc(c.procedure.empty() ? "(not stated)" : c.procedure), esc(c.level_key),
         esc(c.level_unit()), esc(c.level_on), g3(c.adaptation_cd_m2),
         esc(c.tone_operator.empty() ? "(scene default)" : c.tone_operator),
         esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
         esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
+        lights_sentence(c),
         c.task == Task::YesNo    ? "yes"
         : c.task == Task::Adjust ? "the confirmed match"
         : c.level_on == "test"   ? "chose the test"
@@ -610,8 +645,10 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
          "<li>Staircases: the mean of each track's last reversals (Levitt 1971). QUEST: the posterior mean and "
          "the 2.5% and 97.5% posterior quantiles (Watson &amp; Pelli 1983; Psychtoolbox QuestMean, "
          "QuestQuantile), from the logged answers replayed through the protocol's procedure.</li>\n"
-         "<li>Adjustment: the mean of the confirmed matches with a bootstrap interval over matches. Brightness "
-         "enhancement: log10(PSE or match / test intensity), both in cd.</li>\n"
+         "<li>Adjustment: the mean of the confirmed matches with a bootstrap interval over matches. "
+         "log10(PSE or match / test intensity), both in cd: a brightness enhancement when glare is the only "
+         "difference between the lights (read from the scene stored in the study file), else test &minus; "
+         "reference.</li>\n"
          "<li>Observed proportions carry Clopper-Pearson intervals.</li>\n"
          "</ul>\n";
     h += "<p>Files next to this report: <a href=\"trials.csv\">trials.csv</a> (one row per trial), "

@@ -27,6 +27,30 @@ std::unique_ptr<bool[]> as_bools(const std::vector<bool>& v) {
     return out;
 }
 
+/// ConditionInfo::differences of a condition whose first trial is `f`.
+std::vector<std::string> side_differences(const ConditionInfo& c, const Trial& f) {
+    std::vector<std::string> out;
+    if (c.lights_known()) {
+        if (c.test_look.colour != c.reference_look.colour) out.push_back("colour");
+        if (c.test_look.rhythm != c.reference_look.rhythm) out.push_back("rhythm");
+        if (c.test_look.spectrum != c.reference_look.spectrum) out.push_back("spectrum");
+    }
+    if (c.glare_test != c.glare_reference) out.push_back("glare");
+    // Frame-wide keys the test's and the reference's frames set differently
+    // (Trial::settings "test.KEY" / "reference.KEY"); a light's own keys there
+    // are the lights switched off in each other's frame, and the glare is above.
+    std::set<std::string> keys;
+    for (const auto& [key, value] : f.settings) {
+        for (const std::string_view side : {"test.", "reference."}) {
+            if (!key.starts_with(side)) continue;
+            const std::string k = key.substr(side.size());
+            if (!k.starts_with("light") && !k.starts_with("disc") && k != "eye.glare") keys.insert(k);
+        }
+    }
+    out.insert(out.end(), keys.begin(), keys.end());
+    return out;
+}
+
 ConditionInfo condition_info(const std::string& name, const std::vector<const Trial*>& trials) {
     ConditionInfo c;
     c.condition = name;
@@ -43,6 +67,8 @@ ConditionInfo condition_info(const std::string& name, const std::vector<const Tr
     c.glare_test = f.glare_test;
     c.glare_reference = f.glare_reference;
     c.test_intensity_cd = f.test_intensity_cd;
+    c.test_look = f.test_look;
+    c.reference_look = f.reference_look;
     c.guess_rate = f.guess_rate;
     c.target_p = f.target_p;
     auto check = [&](const char* what, auto get) {
@@ -65,6 +91,8 @@ ConditionInfo condition_info(const std::string& name, const std::vector<const Tr
     // With the level on the test, the test's intensity is the level: not a parameter of the condition.
     if (c.level_on != "test") check("test_intensity_cd", [](const Trial& t) { return t.test_intensity_cd; });
     if (c.level_on == "test") c.test_intensity_cd.reset();
+    check("test light", [](const Trial& t) { return t.test_look; });
+    check("reference light", [](const Trial& t) { return t.reference_look; });
     check("guess_rate", [](const Trial& t) { return t.guess_rate; });
     check("target_p", [](const Trial& t) { return t.target_p; });
     // A setting that changes within the condition is not one of its factors.
@@ -79,6 +107,7 @@ ConditionInfo condition_info(const std::string& name, const std::vector<const Tr
         }
         if (same) c.settings[key] = value;
     }
+    c.differences = side_differences(c, f);
     return c;
 }
 
@@ -312,7 +341,8 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
         }
     }
 
-    // log10(PSE / test intensity): brightness enhancement when the test has glare.
+    // log10(PSE / test intensity): a brightness enhancement by glare when glare
+    // is the only difference (ConditionInfo::difference_label).
     if (log_levels && info.level_on == "reference" && std::abs(info.target_p - 0.5) < 1e-12 && info.guess_rate == 0.0) {
         MatchRatio mr;
         mr.method = "log10(PSE / test intensity)";
@@ -350,6 +380,10 @@ std::string single_factor(const ConditionInfo& a, const ConditionInfo& b) {
 }
 
 }  // namespace
+
+std::string ConditionInfo::difference_label() const {
+    return glare_only_difference() ? "enhancement by glare" : "test − reference";
+}
 
 std::string ConditionInfo::level_unit() const {
     std::string unit;
@@ -402,6 +436,14 @@ SettingValue setting_value(std::string_view toml_value) {
         v.boolean = *b;
     else if (const auto t = n->value<std::string>(); t && n->is_string())
         v.text = *t;
+    else if (const toml::array* a = n->as_array(); a && !a->empty()) {
+        std::vector<double> xs;
+        for (const toml::node& e : *a) {
+            if (!e.is_integer() && !e.is_floating_point()) return v;
+            xs.push_back(*e.value<double>());
+        }
+        v.numbers = std::move(xs);
+    }
     return v;
 }
 

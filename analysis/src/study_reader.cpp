@@ -15,6 +15,7 @@
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
+#include "csv.h"
 #include "gnuplot.h"
 #include "procedure_replay.h"
 
@@ -60,7 +61,7 @@ std::optional<std::string> glare_of(const Frame& frame, const std::string& light
 
 /// Fills the trial's task, level scale and stimulus parameters from its
 /// stimulus JSON (docs/running.md "What each trial stores").
-void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& problems) {
+void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, std::vector<std::string>& problems) {
     nlohmann::json j;
     try {
         j = store::parse_json(json, fmt::format("the stimulus_json of trial {}", t.trial_index));
@@ -89,16 +90,22 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
     // it (its own model, else the eye's); absent in files written before lights
     // had their own model.
     std::optional<std::string> test_glare, reference_glare;
+    std::optional<std::size_t> test_frame, reference_frame;  // the frame each view is in
     for (const nlohmann::json& view : store::array_at(j, "/views")) {
         const std::string role = store::string_at(view, "/role").value_or("");
         const std::string light = store::string_at(view, "/light").value_or("");
         const std::optional<std::string> glare = store::string_at(view, "/glare");
+        std::optional<std::size_t> frame;
+        if (const auto f = store::number_at(view, "/frame"); f && *f >= 0 && *f < static_cast<double>(frames.size()))
+            frame = static_cast<std::size_t>(*f);
         if (role == "test") {
             test_light = light;
             test_glare = glare;
+            test_frame = frame;
         } else if (role == "reference") {
             reference_light = light;
             reference_glare = glare;
+            reference_frame = frame;
         }
     }
     const Frame* test = nullptr;
@@ -124,6 +131,17 @@ void read_stimulus(Trial& t, const std::string& json, std::vector<std::string>& 
     }
     if (test_glare) t.glare_test = *test_glare;
     if (reference_glare) t.glare_reference = *reference_glare;
+    // Each judged light's colour, rhythm and spectrum: the stored scene with
+    // the overrides of the frame its view is in.
+    if (scene) {
+        const auto look = [&](const std::string& light, std::optional<std::size_t> frame, const Frame* fallback) {
+            const Frame* f = frame ? &frames[*frame] : fallback;
+            if (light.empty() || f == nullptr) return LightLook{};
+            return scene->look(light, f->overrides).value_or(LightLook{});
+        };
+        t.test_look = look(test_light, test_frame, test);
+        t.reference_look = look(reference_light, reference_frame, reference);
+    }
     // The other overrides, as factor columns (Trial::settings).
     std::set<std::string> keys;
     for (const Frame& f : frames)
@@ -254,6 +272,26 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
                 "display (docs/running.md, \"Displayability\"); their estimates say little about the observer",
                 file, s.id.value, fmt::join(info.undisplayable, ", ")));
     }
+    info.scene_name = s.scene_name;
+    info.scene_sha256 = s.scene_sha256.value_or("");
+    std::optional<SceneLights> scene;
+    if (s.scene_sha256) {
+        try {
+            std::string why;
+            if (const std::optional<std::string> text = db.scene_text(s.id)) {
+                scene = SceneLights::parse(*text, why);
+                if (!scene)
+                    d.notes.push_back(
+                        fmt::format("{} session {}: {}; the lights' colour, rhythm and spectrum are "
+                                    "not reported",
+                                    file, s.id.value, why));
+            }
+        } catch (const store::StoreError&) {
+            if (!salvage) throw;
+            d.notes.push_back(
+                fmt::format("{} session {}: its scene text could not be read from the damaged file", file, s.id.value));
+        }
+    }
     std::string protocol_text;
     try {
         protocol_text = db.protocol_text(s.id);
@@ -281,6 +319,8 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         t.observer = s.observer_code;
         t.trial_index = r.trial_index;
         t.block = r.block;
+        if (design.protocol && r.block >= 0 && static_cast<std::size_t>(r.block) < design.protocol->blocks.size())
+            t.block_name = design.protocol->blocks[static_cast<std::size_t>(r.block)].name;
         t.condition = r.condition_id;
         t.track = r.procedure_id;
         t.level = r.level;
@@ -291,7 +331,10 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         t.onset_time_s = r.onset_time_s;
         t.dropped_frames = r.dropped_frames;
         t.missed_deadline = r.missed_deadline;
-        read_stimulus(t, r.stimulus_json, problems);
+        read_stimulus(t, r.stimulus_json, scene ? &*scene : nullptr, problems);
+        // Without the noise of decimal steps summed in binary (csv.h level_value):
+        // what trials.csv writes, so that it reads back as the same trials.
+        t.level = detail::level_value(r.level, t.level_scale == "log10");
         t.outcome = outcome_of(t);
         if (const auto it = design.conditions.find(t.condition); it != design.conditions.end()) {
             t.procedure = it->second.procedure;
@@ -356,6 +399,19 @@ void add_calibrations(Dataset& d, const store::Store& db, const std::string& fil
     }
 }
 
+/// One note for the sessions of `file` that hold no scene (schema before v6).
+void note_sessions_without_scene(Dataset& d, const std::string& file) {
+    std::vector<std::int64_t> without;
+    for (const SessionInfo& s : d.sessions)
+        if (s.source == file && s.scene_sha256.empty()) without.push_back(s.id);
+    if (without.empty()) return;
+    d.notes.push_back(fmt::format(
+        "{}: the study file does not hold the scene of session{} {} (written before the scene was stored with "
+        "the protocol, schema version 6): the lights' colour, rhythm and spectrum are not known, so the "
+        "difference between test and reference is labelled test − reference",
+        file, without.size() == 1 ? "" : "s", fmt::join(without, ", ")));
+}
+
 Dataset read_store(const store::Store& db, const std::string& file) {
     Dataset d;
     d.sources.push_back(file);
@@ -363,6 +419,7 @@ Dataset read_store(const store::Store& db, const std::string& file) {
     for (const store::SessionRecord& s : db.sessions())
         add_session(d, db, file, s, db.trials(s.id), calibrations, false);
     add_calibrations(d, db, file, calibrations, false);
+    note_sessions_without_scene(d, file);
     return d;
 }
 
@@ -390,6 +447,7 @@ Dataset salvage_store(const std::filesystem::path& study_file, const store::Stor
         add_session(d, *db, file, s, records, calibrations, true);
     }
     add_calibrations(d, *db, file, calibrations, true);
+    note_sessions_without_scene(d, file);
     DamagedInput damaged;
     damaged.file = file;
     damaged.problem = damage.what();

@@ -117,6 +117,8 @@ std::vector<std::pair<int, int>> frame_rows(const std::string& note, int height)
 
 struct Tile {
     int x0, y0, w, h;
+    std::string
+        label;  ///< what the tile shows: "frame 0 test (red, F, glare none)"; empty: its frame's brightest pixel
 };
 
 /// Per frame (rows r0-r1), a tile of up to 2*half pixels square around its brightest pixel.
@@ -140,7 +142,65 @@ std::vector<Tile> brightest_tiles(const stimuli::ImageRGBA32F& hdr, const std::v
         const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
         const int x0 = std::clamp(bx - w / 2, 0, hdr.width - w);
         const int y0 = std::clamp(by - h / 2, r0, r1 + 1 - h);
-        tiles.push_back({x0, y0, w, h});
+        tiles.push_back({x0, y0, w, h, {}});
+    }
+    return tiles;
+}
+
+/// A judged light as the caption names it.
+std::string light_label(const an::LightLook& l, const std::string& glare) {
+    std::string out = l.colour.empty() ? std::string() : fmt::format("{}, {}", l.colour, l.rhythm);
+    if (!l.spectrum.empty()) out += ", spd " + l.spectrum;
+    if (!glare.empty()) out += (out.empty() ? "glare " : ", glare ") + glare;
+    return out;
+}
+
+/// A tile around every judged light the snapshot's "lights" attribute places
+/// (snapshot.cpp: "frame F ROLE at X,Y (LIGHT); ..."), so that a side-by-side
+/// frame shows both its lights; two lights of a frame closer than half a tile
+/// share one tile. Empty for a snapshot without the attribute (made before it).
+std::vector<Tile> light_tiles(const stimuli::ImageRGBA32F& hdr, const std::vector<std::pair<int, int>>& frames,
+                              const std::string& note, int half, const an::ConditionInfo& c) {
+    struct Placed {
+        int frame;
+        double x, y;
+        std::string label;
+    };
+    std::vector<Placed> placed;
+    for (std::size_t at = 0; at < note.size();) {
+        const std::size_t end = std::min(note.find("; ", at), note.size());
+        const std::string item = note.substr(at, end - at);
+        at = end + 2;
+        int f = 0;
+        char role[16] = {};
+        double x = 0.0, y = 0.0;
+        if (std::sscanf(item.c_str(), "frame %d %15s at %lf,%lf", &f, role, &x, &y) != 4 || f < 0 ||
+            static_cast<std::size_t>(f) >= frames.size() || !std::isfinite(x) || !std::isfinite(y))
+            continue;
+        const bool test = std::string_view(role) == "test";
+        const std::string look =
+            test ? light_label(c.test_look, c.glare_test) : light_label(c.reference_look, c.glare_reference);
+        placed.push_back({f, x, y, fmt::format("frame {} {}{}", f, role, look.empty() ? "" : " (" + look + ")")});
+    }
+    std::vector<Tile> tiles;
+    std::vector<bool> used(placed.size(), false);
+    for (std::size_t i = 0; i < placed.size(); ++i) {
+        if (used[i]) continue;
+        double x = placed[i].x, y = placed[i].y;
+        std::string label = placed[i].label;
+        for (std::size_t j = i + 1; j < placed.size(); ++j)
+            if (!used[j] && placed[j].frame == placed[i].frame && std::abs(placed[j].x - placed[i].x) < 0.5 * half &&
+                std::abs(placed[j].y - placed[i].y) < 0.5 * half) {
+                used[j] = true;
+                x = 0.5 * (x + placed[j].x);
+                y = 0.5 * (y + placed[j].y);
+                label += " and " + placed[j].label;
+            }
+        const auto [r0, r1] = frames[static_cast<std::size_t>(placed[i].frame)];
+        const int w = std::min(2 * half, hdr.width), h = std::min(2 * half, r1 - r0 + 1);
+        const int x0 = std::clamp(static_cast<int>(std::lround(x)) - w / 2, 0, hdr.width - w);
+        const int y0 = std::clamp(static_cast<int>(std::lround(y)) - h / 2, r0, r1 + 1 - h);
+        tiles.push_back({x0, y0, w, h, label});
     }
     return tiles;
 }
@@ -237,7 +297,9 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
                          ? std::max(8, static_cast<int>(std::lround(0.5 * crop_deg / img.meta.degrees_per_pixel)))
                          : 128;
     const auto frames = frame_rows(img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "", hdr.height);
-    const std::vector<Tile> tiles = brightest_tiles(hdr, frames, half);
+    std::vector<Tile> tiles =
+        light_tiles(hdr, frames, img.meta.strings.count("lights") ? img.meta.strings.at("lights") : "", half, c);
+    if (tiles.empty()) tiles = brightest_tiles(hdr, frames, half);
     std::vector<Mapped> mapped;
     for (const Tile& t : tiles) mapped.push_back(map_tile(hdr, t, adaptation, tm));
     const int gap = 8;
@@ -277,11 +339,16 @@ std::string snapshot_png(const store::Snapshot& snap, const an::ConditionInfo& c
     }
     std::string factors;
     for (const Mapped& m : mapped) factors += fmt::format("{}×{:g}", factors.empty() ? "" : ", ", m.stretch);
+    std::string placed;
+    for (const Tile& t : tiles) placed += (placed.empty() ? "" : "; ") + t.label;
     caption = fmt::format(
-        "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames left to right in "
-        "presentation order: {}), each cropped to {:g}° around its brightest pixel and shown here with the {} tone "
+        "The stimulus of condition {} as the session rendered it (stored EXR, cd/m²; frames in presentation order: "
+        "{}), {} and shown here with the {} tone "
         "mapper at {:g} cd/m² and the sRGB curve (the CPU reference, not the calibrated display encoding).{}",
-        c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame", crop_deg,
+        c.condition, img.meta.strings.count("frames") ? img.meta.strings.at("frames") : "one frame",
+        tiles.front().label.empty()
+            ? fmt::format("each frame cropped to {:g}° around its brightest pixel, left to right", crop_deg)
+            : fmt::format("cropped to {:g}° around each judged light, left to right: {}", crop_deg, placed),
         display::tone_operator_name(tm.tone_operator), adaptation,
         stretched_row
             ? fmt::format(" Top row: as displayed. Bottom row: the same frames, each channel stretched about its "

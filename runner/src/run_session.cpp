@@ -136,6 +136,8 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
     start.observer_code = code;
     start.protocol_text = in.protocol_text;
     start.protocol_name = std::filesystem::path(o.protocol).filename().string();
+    start.scene_text = in.scene_text;
+    start.scene_name = in.protocol.scene.filename().string();
     start.seed = run.seed;
     start.displayability_json = displayability_json(displayability, o.allow_undisplayable);
     start.calibration = calibration.calibration     ? *calibration.calibration
@@ -162,7 +164,7 @@ int run_session(const RunOptions& o) {
     st::StoreOptions store_options;
     store_options.max_size_bytes = o.db_max_bytes;
     std::optional<st::Store> existing = read_existing_study(o.db, store_options);
-    const SessionToRun run = session_to_run(o, existing, protocol, in.protocol_sha, code);
+    const SessionToRun run = session_to_run(o, existing, protocol, in.protocol_sha, in.scene_sha, code);
     SessionObserver observer(o, observer_seed_to_run(o, run), std::move(in.script));
     Replayed replayed = replay_logged(protocol, run, o.db, observer);
 

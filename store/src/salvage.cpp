@@ -54,20 +54,24 @@ Salvage Store::salvage() const {
     // Sessions, one row id at a time; the trial count is of the trials read below.
     if (const auto last = largest_id(db, "SELECT max(id) FROM sessions", out.problems, "sessions")) {
         const detail::TableConstraints c = detail::table_constraints(db, "sessions");
+        // displayability_json NULL: a damaged file may be of a schema before it (v4); the
+        // scene's hash and name where the file has them (v6); last, the first constraint the
+        // row breaks (NULL when none).
+        const bool scenes = file_schema_version() >= 6;
         sql::Statement s(
             db, fmt::format("SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, "
-                            // displayability_json NULL: a damaged file may be of a schema before it (v3).
-                            "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL, {} "
+                            "s.calibration_id, s.started_at, s.ended_at, s.status, s.resume_count, 0, NULL, {}, {} "
                             "FROM sessions s JOIN observers o ON o.id = s.observer_id "
-                            "JOIN protocols p ON p.id = s.protocol_id WHERE s.id = ?1",
-                            broken_column(c, "sessions", "s.id")));
+                            "JOIN protocols p ON p.id = s.protocol_id {}WHERE s.id = ?1",
+                            scenes ? "sc.sha256, sc.name" : "NULL, NULL", broken_column(c, "sessions", "s.id"),
+                            scenes ? "LEFT JOIN scenes sc ON sc.id = s.scene_id " : ""));
         for (std::int64_t id = 1; id <= *last; ++id) {
             try {
                 s.bind(1, id);
                 if (!s.step("read a session")) {
                     skip("sessions", id, kAbsent, out.unreadable_sessions);
-                } else if (!s.is_null(14)) {
-                    skip("sessions", id, "breaks " + c.names.at(static_cast<std::size_t>(s.int64(14))),
+                } else if (!s.is_null(16)) {
+                    skip("sessions", id, "breaks " + c.names.at(static_cast<std::size_t>(s.int64(16))),
                          out.unreadable_sessions);
                 } else {
                     out.sessions.push_back(session_from_row(s, db.path()));

@@ -155,12 +155,28 @@ FROM trials t, json_each(t.stimulus_json, '$.frames') f, json_each(f.value, '$.o
 WHERE instr(o.value, '=') > 0;
 )sql";
 
-constexpr std::array<Migration, 5> migrations = {
+// Version 6: the scene file a session rendered, byte for byte, stored once per
+// distinct text like the protocol's, so that the colour, rhythm and spectrum
+// of what was shown can be read from the study file alone (docs/store.md).
+// NULL for sessions from before.
+constexpr std::string_view schema_v6 = R"sql(
+CREATE TABLE scenes (
+    id       INTEGER PRIMARY KEY,
+    sha256   TEXT NOT NULL UNIQUE CHECK (length(sha256) = 64),  -- lowercase hex SHA-256 of text (FIPS 180-4)
+    name     TEXT NOT NULL,                      -- the name it was first stored under (the protocol's `scene`)
+    text     TEXT NOT NULL,
+    added_at TEXT NOT NULL
+);
+ALTER TABLE sessions ADD COLUMN scene_id INTEGER REFERENCES scenes(id);
+)sql";
+
+constexpr std::array<Migration, 6> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", sql::text(schema_v1)},
     Migration{2, "calibration readings and checks; calibrations append-only", sql::text(schema_v2)},
     Migration{3, "instrument transcripts of calibration readings", schema_v3},
     Migration{4, "sessions.displayability_json", schema_v4},
     Migration{5, "view trial_settings: each trial's overrides, typed and unquoted", schema_v5},
+    Migration{6, "scenes; sessions.scene_id", schema_v6},
 };
 
 }  // namespace

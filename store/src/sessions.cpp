@@ -13,15 +13,17 @@ namespace {
 constexpr const char* select_sessions =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
+    "LEFT JOIN scenes sc ON sc.id = s.scene_id "
     "ORDER BY s.id";
 
 constexpr const char* select_one_session =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
+    "LEFT JOIN scenes sc ON sc.id = s.scene_id "
     "WHERE s.id = ?1";
 
 // An observer code, not a name: short, and no spaces, so "Jane Doe" is refused.
@@ -55,7 +57,36 @@ SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::p
     r.resume_count = s.int32(11);
     r.trial_count = s.int64(12);
     r.displayability_json = s.optional_text(13);
+    r.scene_sha256 = s.optional_text(14);
+    r.scene_name = s.optional_text(15).value_or("");
     return r;
+}
+
+std::int64_t Store::Impl::put_text(StoredText kind, std::string_view name, std::string_view text,
+                                   std::string_view doing) {
+    // Two tables of one shape; the SQL stays literal (no SQL is built from a value).
+    const bool scene = kind == StoredText::scene;
+    const std::string hash = sha256_hex(text);
+    sql::Use ins(
+        db->cached(scene ? "INSERT INTO scenes (sha256, name, text, added_at) VALUES (?1, ?2, ?3, " ATONLAB_STORE_NOW
+                           ") ON CONFLICT (sha256) DO NOTHING"
+                         : "INSERT INTO protocols (sha256, name, text, added_at) VALUES (?1, ?2, ?3, " ATONLAB_STORE_NOW
+                           ") ON CONFLICT (sha256) DO NOTHING"));
+    ins->bind(1, hash);
+    ins->bind(2, name);
+    ins->bind(3, text);
+    ins->run(doing);
+    sql::Use sel(db->cached(scene ? "SELECT id, text FROM scenes WHERE sha256 = ?1"
+                                  : "SELECT id, text FROM protocols WHERE sha256 = ?1"));
+    sel->bind(1, hash);
+    sel->step(doing);
+    const std::int64_t id = sel->int64(0);
+    if (sel->text(1) != text) {  // only if someone edited the stored text by hand
+        throw StoreError(StoreErrc::corrupt, path(),
+                         fmt::format("{}: cannot {}: the stored {} with SHA-256 {} has different text", path().string(),
+                                     doing, scene ? "scene" : "protocol", hash));
+    }
+    return id;
 }
 
 SessionStatus Store::Impl::status_of(SessionId session, std::string_view doing) {
@@ -81,6 +112,13 @@ std::string Store::Impl::read_protocol_text(SessionId session, std::string_view 
     return s->text(0);
 }
 
+std::optional<std::string> Store::Impl::read_scene_text(SessionId session, std::string_view doing) {
+    sql::Use s(db->cached("SELECT sc.text FROM sessions s LEFT JOIN scenes sc ON sc.id = s.scene_id WHERE s.id = ?1"));
+    s->bind(1, session.value);
+    if (!s->step(doing)) not_found(doing, fmt::format("session {}", session.value));
+    return s->optional_text(0);
+}
+
 ResumePoint Store::Impl::read_resume_point(SessionId session, std::string_view doing) {
     ResumePoint r;
     r.session = read_session(session, doing);
@@ -97,7 +135,6 @@ SessionId Store::begin_session(const SessionStart& start) {
         impl_->invalid(doing, "an observer code is 1 to 32 letters, digits, '-' or '_' (a code, never a name)");
     }
     if (start.protocol_text.empty()) impl_->invalid(doing, "the protocol text is empty");
-    const std::string hash = sha256_hex(start.protocol_text);
     const std::string_view version = start.software_version.empty() ? std::string_view(software_version())
                                                                     : std::string_view(start.software_version);
 
@@ -122,29 +159,15 @@ SessionId Store::begin_session(const SessionStart& start) {
         observer_id = sel->int64(0);
     }
 
-    std::int64_t protocol_id = 0;
-    {
-        sql::Use ins(
-            db.cached("INSERT INTO protocols (sha256, name, text, added_at) VALUES (?1, ?2, ?3, " ATONLAB_STORE_NOW
-                      ") ON CONFLICT (sha256) DO NOTHING"));
-        ins->bind(1, hash);
-        ins->bind(2, start.protocol_name);
-        ins->bind(3, start.protocol_text);
-        ins->run(doing);
-        sql::Use sel(db.cached("SELECT id, text FROM protocols WHERE sha256 = ?1"));
-        sel->bind(1, hash);
-        sel->step(doing);
-        protocol_id = sel->int64(0);
-        if (sel->text(1) != start.protocol_text) {  // only if someone edited the stored text by hand
-            throw StoreError(StoreErrc::corrupt, impl_->path(),
-                             fmt::format("{}: cannot {}: the stored protocol with SHA-256 {} has different text",
-                                         impl_->path().string(), doing, hash));
-        }
-    }
+    const std::int64_t protocol_id =
+        impl_->put_text(StoredText::protocol, start.protocol_name, start.protocol_text, doing);
+    std::optional<std::int64_t> scene_id;
+    if (!start.scene_text.empty())
+        scene_id = impl_->put_text(StoredText::scene, start.scene_name, start.scene_text, doing);
 
-    sql::Use ins(
-        db.cached("INSERT INTO sessions (observer_id, protocol_id, calibration_id, software_version, seed, "
-                  "started_at, displayability_json) VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ", ?6)"));
+    sql::Use ins(db.cached(
+        "INSERT INTO sessions (observer_id, protocol_id, calibration_id, software_version, seed, "
+        "started_at, displayability_json, scene_id) VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ", ?6, ?7)"));
     ins->bind(1, observer_id);
     ins->bind(2, protocol_id);
     if (start.calibration) {
@@ -158,6 +181,11 @@ SessionId Store::begin_session(const SessionStart& start) {
         ins->bind_null(6);
     } else {
         ins->bind(6, start.displayability_json);
+    }
+    if (scene_id) {
+        ins->bind(7, *scene_id);
+    } else {
+        ins->bind_null(7);
     }
     ins->run(doing);
     const SessionId id{sqlite3_last_insert_rowid(db.get())};
@@ -208,6 +236,10 @@ std::vector<SessionRecord> Store::sessions() const {
 
 SessionRecord Store::session(SessionId session) const {
     return impl_->read_session(session, fmt::format("read session {}", session.value));
+}
+
+std::optional<std::string> Store::scene_text(SessionId session) const {
+    return impl_->read_scene_text(session, fmt::format("read the scene of session {}", session.value));
 }
 
 std::string Store::protocol_text(SessionId session) const {

@@ -15,6 +15,9 @@ namespace atonlab::store {
 /// SQL for "now" as the store stamps it (see schema.cpp's conventions).
 #define ATONLAB_STORE_NOW "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
 
+/// The texts a session stores once per hash: the protocol's and the scene's.
+enum class StoredText { protocol, scene };
+
 struct Store::Impl {
     std::unique_ptr<sql::Connection> db;
     bool read_only = false;
@@ -35,12 +38,17 @@ struct Store::Impl {
     SessionRecord read_session(SessionId session, std::string_view doing);
     std::vector<TrialRecord> read_trials(SessionId session, std::string_view doing);
     std::string read_protocol_text(SessionId session, std::string_view doing);
+    std::optional<std::string> read_scene_text(SessionId session, std::string_view doing);
+    /// Stores `text` in the protocols or scenes table once per SHA-256 and
+    /// returns its row id. Call inside the write transaction.
+    std::int64_t put_text(StoredText kind, std::string_view name, std::string_view text, std::string_view doing);
     ResumePoint read_resume_point(SessionId session, std::string_view doing);
 };
 
 /// A sessions row as selected by sessions.cpp (id, observer code, protocol id,
 /// name and hash, software version, seed, calibration, started, ended, status,
-/// resume count, trial count).
+/// resume count, trial count, displayability JSON, scene hash and name; the
+/// last two NULL where no scene is stored).
 SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::path& path);
 /// A trials row from column `first` on: trial_index, block, condition_id,
 /// procedure_id, level, test_on_left, stimulus_json, response, response_value,

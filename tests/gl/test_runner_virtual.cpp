@@ -22,6 +22,7 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
+#include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
 #include "../support/skip.h"
 
@@ -171,6 +172,39 @@ TEST_F(RunnerVirtual, AResumedSessionSkipsTheMissedTrialAsTheLiveOneDid) {
         EXPECT_NEAR(got[i].onset_time_s, want[i].onset_time_s, 1e-9);
         EXPECT_NEAR(got[i].response_time_s, want[i].response_time_s, 1e-9);
     }
+}
+
+// Issue 24: the study stores the scene text with its SHA-256 beside the
+// protocol; a session continues only with the scene it began with, as with
+// its protocol text (and the conditions files stored in it).
+TEST_F(RunnerVirtual, TheSceneIsStoredAndAResumeWithAnEditedSceneIsRefused) {
+    const fs::path protocol = dir_.path() / "screen_stall.toml";
+    const fs::path scene = dir_.path() / "screen.scene.toml";
+    std::ofstream(protocol) << file_bytes(kData / "screen_stall.toml");
+    const std::string scene_text = file_bytes(kData / "screen.scene.toml");
+    std::ofstream(scene) << scene_text;
+    const fs::path script = dir_.path() / "part.txt";
+    write_script(script, {"left 0.3", "right 0.2"});
+    const fs::path db = dir_.path() / "study.db";
+    const int status = run(protocol, db, {"--script", script.string()});
+    if (skipped_) GTEST_SKIP() << "no GL 4.5 context: " << err();
+    ASSERT_EQ(status, 2) << err();  // the script ran out: the session stays open
+    {
+        Store s = Store::open_read_only(db);
+        const store::SessionRecord r = s.sessions().back();
+        EXPECT_EQ(r.scene_sha256, store::sha256_hex(scene_text));
+        EXPECT_EQ(r.scene_name, "screen.scene.toml");
+        EXPECT_EQ(s.scene_text(r.id), scene_text);
+    }
+    const std::size_t before = trials(db).size();
+    std::ofstream(scene, std::ios::app) << "# edited\n";
+    write_script(script, {"left 0.3", "right 0.2", "left 0.1", "right 0.4", "left 0.2"});
+    EXPECT_EQ(run(protocol, db, {"--script", script.string(), "--resume-last"}), 2);
+    EXPECT_NE(err().find("ran a different text of this scene"), std::string::npos) << err();
+    EXPECT_NE(err().find("screen.scene.toml"), std::string::npos) << err();
+    EXPECT_EQ(trials(db).size(), before);
+    std::ofstream(scene) << scene_text;  // the scene it began with: it continues
+    EXPECT_EQ(run(protocol, db, {"--script", script.string(), "--resume-last"}), 0) << err();
 }
 
 TEST_F(RunnerVirtual, ALateAnswerTimesOutAndTheTrialIsShownAgain) {

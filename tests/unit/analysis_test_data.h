@@ -69,13 +69,43 @@ inline double phi(double z) {
     return 0.5 * std::erfc(-z / std::sqrt(2.0));
 }
 
+/// The scene the simulated sessions store (schema v6, docs/store.md
+/// `scenes`): the lights the test protocols name, all white and fixed, so
+/// that a protocol whose test and reference differ in glare alone is a
+/// glare comparison.
+inline const std::string kWhiteLightsScene = R"(
+[display]
+width_px = 320
+height_px = 180
+width_m = 0.1
+viewing_distance_m = 0.9
+
+[[light]]
+name = "test"
+position_m = [0.0, 3.0, -500.0]
+intensity_cd = 100.0
+colour = "white"
+
+[[light]]
+name = "reference"
+position_m = [0.0, 3.0, -500.0]
+intensity_cd = 100.0
+
+[[light]]
+name = "flash"
+position_m = [0.0, 3.0, -500.0]
+intensity_cd = 1.0
+)";
+
 /// Runs `protocol_text` (its scene need not exist) with the simulated
-/// observer into the study file `db` as one completed session. Returns the
-/// session's id.
+/// observer into the study file `db` as one completed session, storing
+/// `scene_text` as its scene (empty: none, as a file from before schema v6).
+/// Returns the session's id.
 inline store::SessionId run_simulated(const std::filesystem::path& db, const std::string& protocol_text,
                                       const SimObserver& obs, std::uint64_t seed = 7, bool finish = true,
                                       std::size_t max_trials = 1u << 30,
-                                      std::optional<store::CalibrationId> calibration = std::nullopt) {
+                                      std::optional<store::CalibrationId> calibration = std::nullopt,
+                                      const std::string& scene_text = kWhiteLightsScene) {
     namespace p = atonlab::protocols;
     const p::Protocol protocol = p::parse_protocol(protocol_text, "sim.toml");
     p::Schedule schedule(protocol, seed);
@@ -86,6 +116,8 @@ inline store::SessionId run_simulated(const std::filesystem::path& db, const std
     start.protocol_name = "sim.toml";
     start.seed = seed;
     start.calibration = calibration;
+    start.scene_text = scene_text;
+    start.scene_name = "none.scene.toml";
     const store::SessionId session = s.begin_session(start);
     p::Rng rng(obs.seed);
     std::size_t n = 0;

@@ -74,8 +74,8 @@ TEST(Store, NewFileHasSchemaWalAndVersion) {
     EXPECT_EQ(raw.integer("PRAGMA application_id"), 0x41544F4E);
     EXPECT_EQ(raw.text("SELECT group_concat(name, ',') FROM (SELECT name FROM sqlite_schema WHERE type = 'table' "
                        "ORDER BY name)"),
-              "calibration_checks,calibration_readings,calibrations,displays,observers,protocols,schema_history,"
-              "sessions,snapshots,trials");
+              "calibration_checks,calibration_readings,calibrations,displays,observers,protocols,scenes,"
+              "schema_history,sessions,snapshots,trials");
     EXPECT_EQ(raw.text("SELECT software_version FROM schema_history WHERE version = 1"), software_version());
     EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
     EXPECT_EQ(raw.text("PRAGMA foreign_key_check"), "");
@@ -149,6 +149,70 @@ TEST(Store, ProtocolTextIsStoredOncePerHash) {
     EXPECT_EQ(raw.integer("SELECT count(*) FROM observers"), 2);
     EXPECT_EQ(raw.text("SELECT sha256 FROM protocols WHERE id = " + std::to_string(s.session(c).protocol_id)),
               sha256_hex(other.protocol_text));
+}
+
+TEST(Store, SceneTextIsStoredOncePerHashBesideTheProtocol) {
+    TempDir dir;
+    Store s = Store::create_or_open(dir / "study.db");
+    SessionStart a = make_start("A1");
+    a.scene_text = "abc";  // SHA-256 known from FIPS 180-2
+    a.scene_name = "night.scene.toml";
+    const SessionId ia = s.begin_session(a);
+    SessionStart b = make_start("B2");
+    b.scene_text = "abc";
+    b.scene_name = "renamed.scene.toml";
+    const SessionId ib = s.begin_session(b);
+    SessionStart edited = make_start("C3");
+    edited.scene_text = "abd";  // one byte changed
+    const SessionId ic = s.begin_session(edited);
+    const SessionId none = s.begin_session(make_start("D4"));
+
+    EXPECT_EQ(s.session(ia).scene_sha256, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_EQ(s.scene_text(ia), "abc");
+    EXPECT_EQ(s.session(ia).scene_name, "night.scene.toml");
+    // The same text is one row, under the name it was first stored with.
+    EXPECT_EQ(s.session(ib).scene_sha256, s.session(ia).scene_sha256);
+    EXPECT_EQ(s.session(ib).scene_name, "night.scene.toml");
+    // A changed text has a changed hash: what a resumed session is checked against.
+    ASSERT_TRUE(s.session(ic).scene_sha256);
+    EXPECT_NE(s.session(ic).scene_sha256, s.session(ia).scene_sha256);
+    EXPECT_EQ(*s.session(ic).scene_sha256, sha256_hex(edited.scene_text));
+    EXPECT_EQ(s.scene_text(ic), "abd");
+    // Begun without one: none stored, and the list of sessions agrees.
+    EXPECT_FALSE(s.session(none).scene_sha256);
+    EXPECT_FALSE(s.scene_text(none));
+    EXPECT_EQ(s.sessions().at(2).scene_sha256, s.session(ic).scene_sha256);
+    RawDb raw(dir / "study.db");
+    EXPECT_EQ(raw.integer("SELECT count(*) FROM scenes"), 2);
+    EXPECT_EQ(raw.text("SELECT sha256 FROM scenes WHERE text = 'abd'"), sha256_hex("abd"));
+    EXPECT_EQ(raw.text("SELECT scene_id FROM sessions WHERE id = " + std::to_string(none.value)), "NULL");
+}
+
+TEST(StoreMigrations, AVersionFiveFileKeepsItsSessionsWhichHoldNoScene) {
+    TempDir dir;
+    const auto path = dir / "study.db";
+    // A file as version 5 made it, filled through SQLite itself.
+    detail::migrate_file(path, schema_migrations().first(5));
+    {
+        RawDb raw(path);
+        ASSERT_EQ(raw.exec("INSERT INTO observers (code, added_at) VALUES ('P1', '2024-01-01T00:00:00.000Z');"
+                           "INSERT INTO protocols (sha256, name, text, added_at) VALUES ('" +
+                           sha256_hex("proto") +
+                           "', 'p.toml', 'proto', '2024-01-01T00:00:00.000Z');"
+                           "INSERT INTO sessions (observer_id, protocol_id, software_version, seed, started_at) "
+                           "VALUES (1, 1, '0.1.0', 9, '2024-01-01T00:00:00.000Z');"),
+                  "");
+        ASSERT_EQ(raw.integer("PRAGMA user_version"), 5);
+    }
+    expect_store_error(StoreErrc::older_schema, [&] { Store::open_read_only(path); });
+    Store s = Store::create_or_open(path);  // a writer migrates it
+    EXPECT_EQ(s.file_schema_version(), schema_version());
+    const SessionRecord r = s.session(SessionId{1});
+    EXPECT_EQ(r.observer_code, "P1");
+    EXPECT_EQ(s.protocol_text(r.id), "proto");
+    EXPECT_FALSE(r.scene_sha256);
+    EXPECT_EQ(r.scene_name, "");
+    EXPECT_FALSE(s.scene_text(r.id));
 }
 
 // --- What record_trial refuses ------------------------------------------------

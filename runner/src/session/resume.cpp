@@ -66,7 +66,7 @@ st::SessionRecord named_session(const RunOptions& o, st::Store& existing, const 
 }  // namespace
 
 SessionToRun session_to_run(const RunOptions& o, std::optional<st::Store>& existing, const p::Protocol& protocol,
-                            const std::string& protocol_sha, const std::string& code) {
+                            const std::string& protocol_sha, const std::string& scene_sha, const std::string& code) {
     if (!existing && (o.resume || o.resume_last))
         throw InputError(SourceLocation{o.resume ? "--resume" : "--resume-last", 0, 0, ""},
                          fmt::format("{} does not exist (or is empty): there is no session to continue.", o.db));
@@ -83,6 +83,13 @@ SessionToRun session_to_run(const RunOptions& o, std::optional<st::Store>& exist
                          fmt::format("session {} in {} ran a different text of this protocol (SHA-256 {}…); a "
                                      "session continues only with the protocol it began with.",
                                      rec.id.value, o.db, rec.protocol_sha256.substr(0, 12)));
+    // The scene is stored beside the protocol (schema v6) and held to it the
+    // same way; a session from before stored none, and continues as it did.
+    if (rec.scene_sha256 && *rec.scene_sha256 != scene_sha)
+        throw InputError(SourceLocation{protocol.scene.string(), 0, 0, ""},
+                         fmt::format("session {} in {} ran a different text of this scene (SHA-256 {}…); a "
+                                     "session continues only with the scene it began with.",
+                                     rec.id.value, o.db, rec.scene_sha256->substr(0, 12)));
     if (rec.observer_code != code)
         throw InputError(SourceLocation::command_line("--observer"),
                          fmt::format("session {} in {} is observer \"{}\"'s, not \"{}\".", rec.id.value, o.db,

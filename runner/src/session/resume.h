@@ -36,11 +36,12 @@ struct SessionToRun {
 };
 
 /// The session --resume or --resume-last names in `existing` (checked: not
-/// completed, the same protocol text, observer and seed), or a new session
-/// with --seed or the protocol's. Throws InputError naming the option.
+/// completed, the same protocol text, scene text, observer and seed), or a
+/// new session with --seed or the protocol's. Throws InputError naming the
+/// option (the protocol or scene file for a text that changed).
 SessionToRun session_to_run(const RunOptions& o, std::optional<store::Store>& existing,
                             const protocols::Protocol& protocol, const std::string& protocol_sha,
-                            const std::string& code);
+                            const std::string& scene_sha, const std::string& code);
 
 /// The model observer's seed: --observer-seed or one derived from the seed; a
 /// resumed session keeps the one its first trial recorded.

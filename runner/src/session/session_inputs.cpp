@@ -59,7 +59,9 @@ SessionInputs load_session_inputs(const RunOptions& o) {
     if (!o.script.empty()) in.script = p::ScriptedObserver::load(o.script);
     in.protocol_text = p::with_conditions_files(files::read_text(o.protocol, "protocol file"), o.protocol);
     in.protocol_sha = store::sha256_hex(in.protocol_text);
-    in.scene = s::SceneTemplate::parse(files::read_text(in.protocol.scene, "scene template"), in.protocol.scene.string());
+    in.scene_text = files::read_text(in.protocol.scene, "scene template");
+    in.scene_sha = store::sha256_hex(in.scene_text);
+    in.scene = s::SceneTemplate::parse(in.scene_text, in.protocol.scene.string());
     // The template with the display first: its own errors name its file and
     // line, the display's its [display] lines.
     in.display_scene = in.scene->instantiate(in.protocol.display_overrides());

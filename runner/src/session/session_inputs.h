@@ -29,6 +29,12 @@ struct SessionInputs {
     /// comments: the study stores the whole design (protocol_file.h).
     std::string protocol_text;
     std::string protocol_sha;  ///< SHA-256 of protocol_text, hex
+    /// The scene file's text, as the template was parsed from: the study
+    /// stores it beside the protocol (docs/store.md, `scenes`). Its [display]
+    /// calibration and glare aperture_image name files that are not stored:
+    /// neither says anything of a light's colour, rhythm or spectrum.
+    std::string scene_text;
+    std::string scene_sha;  ///< SHA-256 of scene_text, hex
     /// The scene file, read and parsed once: a session renders the template
     /// as it was when it began.
     std::optional<stimuli::SceneTemplate> scene;

@@ -23,9 +23,10 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
                                     const p::ScheduledTrial& t, std::int64_t session) {
     s::ImageRGBA32F stacked;
     double dpp = 0.0;
-    std::string frames_note;
+    std::string frames_note, lights_note;
     for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
-        const s::ImageRGBA32F img = renderer.hdr(t.stimulus.frames[f], judged_lights(t.stimulus, f), dpp);
+        std::vector<glm::dvec2> light_px;
+        const s::ImageRGBA32F img = renderer.hdr(t.stimulus.frames[f], judged_lights(t.stimulus, f), dpp, &light_px);
         if (f == 0) {
             stacked.width = img.width;
         } else if (img.width != stacked.width) {
@@ -34,6 +35,16 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
         frames_note +=
             fmt::format("{}rows {}-{}: frame {} ({})", f ? "; " : "", stacked.height, stacked.height + img.height - 1,
                         f, t.stimulus.frames[f].role ? p::to_string(*t.stimulus.frames[f].role) : "both");
+        // Where each judged light of the frame is in the stacked image, so that
+        // the report crops around every one of them (docs/analysis.md, "Stimulus
+        // pictures"): "frame F ROLE at X,Y (LIGHT)", in view order.
+        std::size_t k = 0;
+        for (const p::StimulusView& v : t.stimulus.views) {
+            if (v.frame != f || k >= light_px.size()) continue;
+            const glm::dvec2 at = light_px[k++];
+            lights_note += fmt::format("{}frame {} {} at {:.1f},{:.1f} ({})", lights_note.empty() ? "" : "; ", f,
+                                       p::to_string(v.role), at.x, at.y + stacked.height, v.light);
+        }
         stacked.height += img.height;
         stacked.rgba.insert(stacked.rgba.end(), img.rgba.begin(), img.rgba.end());
     }
@@ -44,6 +55,7 @@ std::vector<std::byte> snapshot_exr(StimulusRenderer& renderer, const p::Protoco
     meta.strings["protocol"] = protocol.file;
     meta.strings["condition"] = c.name;
     meta.strings["frames"] = frames_note;
+    if (!lights_note.empty()) meta.strings["lights"] = lights_note;
     meta.strings["level"] = fmt::format("{} ({} = {})", t.stimulus.level, c.level_key, t.stimulus.scene_value);
     const std::filesystem::path tmp =
         std::filesystem::temp_directory_path() / fmt::format("atonlab-snapshot-{}-{}.exr", getpid(), session);

@@ -150,9 +150,13 @@ std::shared_ptr<const FrameViews> StimulusRenderer::views(const p::Frame& frame,
 }
 
 s::ImageRGBA32F StimulusRenderer::hdr(const p::Frame& frame, const std::vector<std::string>& lights,
-                                      double& degrees_per_pixel) {
+                                      double& degrees_per_pixel, std::vector<glm::dvec2>* light_px) {
     s::ImageRGBA32F image;
-    render(frame, lights, &image, &degrees_per_pixel);
+    const auto views = render(frame, lights, &image, &degrees_per_pixel);
+    if (light_px) {
+        light_px->clear();
+        for (const LightWindow& w : views->windows) light_px->push_back(w.frame_px);
+    }
     return image;
 }
 
@@ -283,6 +287,7 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         const int x0 = static_cast<int>(std::floor(centre.x)) - half;
         const int y0 = static_cast<int>(std::floor(centre.y)) - half;
         w.light_px = centre - glm::dvec2(x0, y0);
+        w.frame_px = centre;
         const bool on_screen = !behind && std::isfinite(centre.x) && std::isfinite(centre.y);
         w.image.luminance_cd_m2 = on_screen ? emitted_window(codes, sc.output.display, x0, y0, n)
                                             : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);

@@ -32,6 +32,8 @@ namespace atonlab::runner {
 struct LightWindow {
     protocols::DisplayedImage image;
     glm::dvec2 light_px{0.0};
+    /// The light's centre in the whole frame (pixels, row 0 at the top).
+    glm::dvec2 frame_px{0.0};
     /// The code values sent to the screen in the same window (displayability.h):
     int peak_code = 0;     ///< the highest code of any channel of any pixel
     bool clipped = false;  ///< a channel of a pixel is at the display's white where the lights-off frame is not
@@ -77,9 +79,11 @@ public:
     std::shared_ptr<const FrameViews> views(const protocols::Frame& frame, const std::vector<std::string>& lights);
 
     /// Renders the frame afresh (also filling the cache) and returns its
-    /// scene-referred HDR image (cd/m²) and the degrees per pixel at its centre.
+    /// scene-referred HDR image (cd/m²) and the degrees per pixel at its centre;
+    /// `light_px`, when given, gets each light's centre in the image (pixels,
+    /// row 0 at the top), in the order of `lights`.
     stimuli::ImageRGBA32F hdr(const protocols::Frame& frame, const std::vector<std::string>& lights,
-                              double& degrees_per_pixel);
+                              double& degrees_per_pixel, std::vector<glm::dvec2>* light_px = nullptr);
 
     // --- On screen (SessionDisplay draws through these) ------------------
     /// The frame's code values for the screen: rendered at the moment of its

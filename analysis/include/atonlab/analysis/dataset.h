@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "atonlab/analysis/calibration_drift.h"
+#include "atonlab/analysis/scene_lights.h"
 #include "atonlab/common/input_error.h"
 
 namespace atonlab::analysis {
@@ -47,6 +48,7 @@ struct Trial {
     std::string observer;          ///< the observer's code
     std::int64_t trial_index = 0;  ///< 0-based within the session
     int block = 0;                 ///< 0-based block of the protocol
+    std::string block_name;        ///< the protocol's name of the block; empty when unknown
     std::string condition;         ///< the protocol's condition name
     std::string track;             ///< the procedure instance ("CONDITION/rREP/tTRACK"); empty when unknown
     /// "staircase", "weighted-staircase", "quest", "constant-stimuli",
@@ -55,7 +57,10 @@ struct Trial {
 
     // --- what was shown and answered --------------------------------------------
     Task task = Task::TwoAfc;
-    double level = 0.0;                  ///< the procedure's level, its own units
+    /// The procedure's level, its own units; from a study file without the
+    /// noise of decimal steps summed in binary (-0.30000000000000004 is -0.3:
+    /// within 1e-12, docs/analysis.md "trials.csv"; the file keeps it bit for bit).
+    double level = 0.0;
     std::string level_key;               ///< the scene key the level sets, e.g. "light.reference.intensity_cd"
     std::string level_scale = "log10";   ///< "log10" (scene value = 10^level) or "linear"
     std::string level_on = "reference";  ///< "test" or "reference": the stimulus the level sets
@@ -79,6 +84,11 @@ struct Trial {
     std::string glare_test;
     std::string glare_reference;              ///< the same for the reference light
     std::optional<double> test_intensity_cd;  ///< the test light's intensity_cd, cd
+    /// The test and reference lights as the stored scene gives them in their
+    /// views' frames, the frames' overrides applied (scene_lights.h); empty
+    /// where unknown: a study file that holds no scene, a CSV without them,
+    /// or a task without a reference.
+    LightLook test_look, reference_look;
     /// Every other override of the trial's frames, by factor column (raw TOML
     /// value text): the scene key where the test's and the reference's frames
     /// agree, else "test.KEY" and "reference.KEY". The level's own key and the
@@ -106,6 +116,10 @@ struct SessionInfo {
     std::string observer;
     std::string protocol_name;
     std::string protocol_sha256;
+    /// The scene the session rendered, as stored beside its protocol (docs/store.md,
+    /// `scenes`): its name and SHA-256; both empty when the file holds none
+    /// (written before schema version 6), and the lights are then unknown.
+    std::string scene_name, scene_sha256;
     std::string software_version;
     std::uint64_t seed = 0;
     std::string started_at, ended_at;
@@ -211,8 +225,12 @@ const std::vector<std::string>& trials_csv_columns();
 Dataset read_trials_csv(const std::filesystem::path& csv_file);
 
 /// Writes `data.trials` as the tidy trials.csv: a header of trials_csv_columns()
-/// and one row per trial. Numbers in their shortest round-trip form, so that
-/// read_trials_csv gives back the same values. Written whole or not at all
+/// and one row per trial, then one column per setting (an array of numbers,
+/// such as a position, one column per element: "KEY[0]", ...). `block` is the
+/// block's name, `block_index` its index. Numbers in their shortest round-trip
+/// form, so that read_trials_csv gives back the same values; the level
+/// without the noise of summed decimal steps (csv.h level_value, applied by read_study:
+/// -0.30000000000000004 is written -0.3). Written whole or not at all
 /// (files::write_file_atomically); throws files::WriteError (a
 /// std::runtime_error) when the file cannot be written.
 void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data);

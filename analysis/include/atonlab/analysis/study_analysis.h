@@ -55,6 +55,15 @@ struct ConditionInfo {
     std::optional<double> adaptation_cd_m2;
     std::string tone_operator, glare_test, glare_reference;
     std::optional<double> test_intensity_cd;
+    /// The test and reference lights' colour, rhythm and spectrum (Trial::test_look,
+    /// reference_look); empty where the study file holds no scene.
+    LightLook test_look, reference_look;
+    /// What differs between the test as shown and the reference as shown:
+    /// "colour", "rhythm", "spectrum", "glare" (the model each was drawn
+    /// with), and any frame-wide key the two frames set differently
+    /// ("tonemap.operator", ...). Intensities and positions are not listed:
+    /// a match varies the one and a side-by-side needs the other.
+    std::vector<std::string> differences;
     double guess_rate = 0.0;
     double target_p = 0.5;
     std::vector<std::string> mixed;
@@ -69,6 +78,17 @@ struct ConditionInfo {
     bool compares_glare() const noexcept {
         return task != Task::YesNo && !glare_test.empty() && glare_test != "none" && glare_test != glare_reference;
     }
+    /// Both lights are known from the stored scene.
+    bool lights_known() const noexcept { return !test_look.colour.empty() && !reference_look.colour.empty(); }
+    /// Glare on the test is the only difference between test and reference
+    /// (known from the stored scene): log10(match / test) is then a
+    /// brightness enhancement by glare.
+    bool glare_only_difference() const {
+        return compares_glare() && lights_known() && differences == std::vector<std::string>{"glare"};
+    }
+    /// What log10(match / test) is called: "enhancement by glare" when
+    /// glare_only_difference(), else "test − reference".
+    std::string difference_label() const;
 };
 
 /// One adaptive track (a staircase or QUEST of one session).
@@ -162,6 +182,8 @@ struct StudyResults {
 struct SettingValue {
     std::optional<double> number;
     std::optional<bool> boolean;
+    /// An array of numbers ("[0.0, 3.0, -500.0]": a position), element by element.
+    std::optional<std::vector<double>> numbers;
     std::string text;
 };
 SettingValue setting_value(std::string_view toml_value);

@@ -99,6 +99,10 @@ struct SessionStart {
     std::string protocol_name;                 ///< e.g. the file name, for people reading the file
     std::uint64_t seed = 0;                    ///< the session's random seed
     std::optional<CalibrationId> calibration;  ///< the calibration the runner used, if any
+    /// The scene file's full text (stored once per hash, like the protocol's);
+    /// empty: none stored (the session's scene_id is NULL).
+    std::string scene_text;
+    std::string scene_name;  ///< e.g. the scene file's name as the protocol gives it
     /// What the display showed of the stimuli before the first trial, JSON
     /// (docs/running.md, "Displayability"); empty: not worked out (stored NULL).
     std::string displayability_json;
@@ -123,6 +127,10 @@ struct SessionRecord {
     int resume_count = 0;  ///< how many times resume_session() reopened it
     std::int64_t trial_count = 0;
     std::optional<std::string> displayability_json;  ///< SessionStart's; none for a session from before schema v3
+    /// Lowercase hex SHA-256 of the stored scene text; none when the session
+    /// stored no scene (a session from before schema v6).
+    std::optional<std::string> scene_sha256;
+    std::string scene_name;  ///< SessionStart's; empty with no scene stored
 };
 
 /// One trial: what was shown, what the observer answered, how well the frames

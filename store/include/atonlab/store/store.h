@@ -106,6 +106,10 @@ public:
     SessionRecord session(SessionId session) const;
     /// The protocol text the session ran (byte for byte what begin_session got).
     std::string protocol_text(SessionId session) const;
+    /// The scene text the session rendered (byte for byte what begin_session
+    /// got), or std::nullopt when none was stored (a session from before
+    /// schema version 6, or begun without one).
+    std::optional<std::string> scene_text(SessionId session) const;
 
     // --- Trials -------------------------------------------------------------
     /// Appends one trial in its own transaction, durable when this returns.

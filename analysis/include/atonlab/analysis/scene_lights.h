@@ -1,0 +1,60 @@
+#pragma once
+// What a study's stored scene says of its lights (docs/analysis.md, "The
+// lights"): each [[light]]'s (and [[disc]]'s) colour, rhythm and spectrum as
+// the scene file writes them, with a trial's overrides applied in order.
+//
+// analysis/ has no GL and no stimuli/ dependency, so the scene loader
+// (stimuli::SceneTemplate) is not at hand. The runner has already checked the
+// scene with these very overrides (it refuses a session otherwise), so this
+// reads only the few keys a report names, with the common TOML parser, and
+// applies the overrides as the loader does: "light.NAME.key" or
+// "light[INDEX].key", later ones winning, and `colour`, `xy` and `spd`
+// excluding each other (a value that is not TOML is a string, as for --set).
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace atonlab::analysis {
+
+/// One light as the report names it.
+struct LightLook {
+    /// An IALA name ("red"), "xy 0.31, 0.33", "spd NAME", "white" (the
+    /// default), a chart letter's colour for one colour of an alternating
+    /// light ("NAME/R": "red"), or "alternating W, R" for the whole light.
+    std::string colour;
+    /// The light character as written ("Fl(1) 4s"); "F" (fixed) by default;
+    /// "steady" for a disc.
+    std::string rhythm;
+    /// The `spd` name the scene gives; empty: none given (the renderer picks
+    /// the glare spectrum from the colour, docs/scene-file.md).
+    std::string spectrum;
+    friend bool operator==(const LightLook&, const LightLook&) = default;
+};
+
+/// The stored scene text, parsed once.
+class SceneLights {
+public:
+    /// Parses `scene_text` (TOML). std::nullopt, with `error` set, when it
+    /// does not parse or its [[light]] array is not an array of tables.
+    static std::optional<SceneLights> parse(std::string_view scene_text, std::string& error);
+
+    /// Light (or disc) `name` with `overrides` ((key, TOML value) pairs, as
+    /// stored in a trial's frame) applied in order. "NAME/LETTER" names one
+    /// colour of an alternating light. std::nullopt: no light or disc has the name.
+    std::optional<LightLook> look(std::string_view name,
+                                  const std::vector<std::pair<std::string, std::string>>& overrides) const;
+
+private:
+    struct Entry {
+        std::string name;
+        bool disc = false;
+        std::string colour_key;    ///< "colour", "xy", "spd" or "" (none: white)
+        std::string colour_value;  ///< the value as the report writes it
+        std::string rhythm = "F";
+    };
+    std::vector<Entry> lights_, discs_;
+};
+
+}  // namespace atonlab::analysis

@@ -1,0 +1,139 @@
+// The lights of a stored scene text, with a trial's overrides (scene_lights.h).
+#include "atonlab/analysis/scene_lights.h"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <tuple>
+
+#include "atonlab/display/colour.h"
+
+namespace atonlab::analysis {
+
+namespace {
+
+/// A value as a report writes it: a string's contents, numbers shortest round-trip.
+std::string value_text(const toml::node& n) {
+    if (const auto s = n.value<std::string>(); s && n.is_string()) return *s;
+    if (n.is_integer() || n.is_floating_point()) return fmt::format("{}", *n.value<double>());
+    if (const toml::array* a = n.as_array()) {
+        std::string out;
+        for (const toml::node& e : *a) out += (out.empty() ? "" : ", ") + value_text(e);
+        return out;
+    }
+    if (const auto b = n.value<bool>(); b && n.is_boolean()) return *b ? "true" : "false";
+    return {};
+}
+
+/// An override's TOML value text, parsed; a value that is not TOML is a
+/// string, as the scene loader takes it (docs/scene-file.md "Overrides with --set").
+std::string override_value(const std::string& toml_value) {
+    try {
+        const toml::table t = toml::parse("v = " + toml_value);
+        if (const toml::node* n = t.get("v")) return value_text(*n);
+    } catch (const toml::parse_error&) {
+    }
+    return toml_value;
+}
+
+constexpr std::string_view kColourKeys[] = {"colour", "xy", "spd"};
+
+}  // namespace
+
+std::optional<SceneLights> SceneLights::parse(std::string_view scene_text, std::string& error) {
+    toml::table root;
+    try {
+        root = toml::parse(scene_text);
+    } catch (const toml::parse_error& e) {
+        error = fmt::format("the stored scene text does not parse (line {}: {})", e.source().begin.line,
+                            std::string(e.description()));
+        return std::nullopt;
+    }
+    SceneLights out;
+    for (const std::string_view array : {std::string_view("light"), std::string_view("disc")}) {
+        const toml::node* n = root.get(array);
+        if (n == nullptr) continue;
+        const toml::array* a = n->as_array();
+        if (a == nullptr) {
+            error = fmt::format("the stored scene's {} is not an array of tables", array);
+            return std::nullopt;
+        }
+        for (std::size_t i = 0; i < a->size(); ++i) {
+            const toml::table* t = a->get(i)->as_table();
+            if (t == nullptr) {
+                error = fmt::format("the stored scene's {}[{}] is not a table", array, i);
+                return std::nullopt;
+            }
+            Entry e;
+            e.disc = array == "disc";
+            e.name = t->get("name") && t->get("name")->is_string() ? *t->get("name")->value<std::string>()
+                                                                   : fmt::format("{}{}", array, i);
+            for (const std::string_view k : kColourKeys)
+                if (const toml::node* v = t->get(k); v && e.colour_key.empty()) {
+                    e.colour_key = std::string(k);
+                    e.colour_value = value_text(*v);
+                }
+            if (const toml::node* r = t->get("rhythm"); r && !e.disc) e.rhythm = value_text(*r);
+            (e.disc ? out.discs_ : out.lights_).push_back(std::move(e));
+        }
+    }
+    return out;
+}
+
+std::optional<LightLook> SceneLights::look(std::string_view name,
+                                           const std::vector<std::pair<std::string, std::string>>& overrides) const {
+    // The light or disc itself, or the base of "NAME/LETTER" (an alternating light's colour).
+    std::string letter;
+    const auto find = [&](std::string_view n) -> std::pair<const std::vector<Entry>*, std::size_t> {
+        for (const std::vector<Entry>* list : {&lights_, &discs_})
+            for (std::size_t i = 0; i < list->size(); ++i)
+                if ((*list)[i].name == n) return {list, i};
+        return {nullptr, 0};
+    };
+    auto [list, index] = find(name);
+    if (list == nullptr) {
+        const auto slash = name.rfind('/');
+        if (slash == std::string_view::npos) return std::nullopt;
+        std::tie(list, index) = find(name.substr(0, slash));
+        if (list == nullptr || list != &lights_) return std::nullopt;
+        letter = std::string(name.substr(slash + 1));
+    }
+    const std::string array = list == &lights_ ? "light" : "disc";
+    Entry e = (*list)[index];
+    // The overrides that address this element: ARRAY.NAME.KEY (NAME may hold
+    // dots; KEY never does) or ARRAY[INDEX].KEY, applied in order.
+    for (const auto& [key, value] : overrides) {
+        const auto last_dot = key.rfind('.');
+        if (last_dot == std::string::npos) continue;
+        const std::string element = key.substr(0, last_dot);
+        const std::string leaf = key.substr(last_dot + 1);
+        const bool by_name = element == array + "." + (*list)[index].name;
+        const bool by_index = element == fmt::format("{}[{}]", array, index);
+        if (!by_name && !by_index) continue;
+        if (std::find(std::begin(kColourKeys), std::end(kColourKeys), leaf) != std::end(kColourKeys)) {
+            e.colour_key = leaf;  // the others of the group are removed (scene_reader.h exclusive_groups)
+            e.colour_value = override_value(value);
+        } else if (leaf == "rhythm" && !e.disc) {
+            e.rhythm = override_value(value);
+        }
+    }
+    LightLook out;
+    out.rhythm = e.disc ? "steady" : e.rhythm;
+    const bool alternating = !e.disc && e.rhythm.starts_with("Al");
+    if (!letter.empty()) {
+        out.colour = display::iala_colour_from_chart_letter(letter).value_or(letter);
+    } else if (e.colour_key == "colour") {
+        out.colour = e.colour_value;
+    } else if (e.colour_key == "xy") {
+        out.colour = "xy " + e.colour_value;
+    } else if (e.colour_key == "spd") {
+        out.colour = "spd " + e.colour_value;
+        out.spectrum = e.colour_value;
+    } else {
+        out.colour = alternating ? "alternating (" + e.rhythm + ")" : "white";
+    }
+    return out;
+}
+
+}  // namespace atonlab::analysis
