@@ -133,6 +133,11 @@ std::optional<LightLook> SceneLights::look(std::string_view name,
     } else {
         out.colour = alternating ? "alternating (" + e.rhythm + ")" : "white";
     }
+    // A light without `spd` has its glare integrated over its colour's representative spectrum,
+    // or D65 for an `xy` colour (docs/glare.md "The light's spectrum"); a disc has no glare.
+    if (out.spectrum.empty() && !e.disc && !(alternating && letter.empty())) {
+        out.spectrum = e.colour_key == "xy" ? "d65" : display::iala_colour_spectrum_name(out.colour).value_or("");
+    }
     return out;
 }
 

@@ -31,9 +31,12 @@ std::unique_ptr<bool[]> as_bools(const std::vector<bool>& v) {
 std::vector<std::string> side_differences(const ConditionInfo& c, const Trial& f) {
     std::vector<std::string> out;
     if (c.lights_known()) {
-        if (c.test_look.colour != c.reference_look.colour) out.push_back("colour");
+        const bool colour = c.test_look.colour != c.reference_look.colour;
+        if (colour) out.push_back("colour");
         if (c.test_look.rhythm != c.reference_look.rhythm) out.push_back("rhythm");
-        if (c.test_look.spectrum != c.reference_look.spectrum) out.push_back("spectrum");
+        // Another colour has its own glare spectrum; a spectrum is a difference of its own only
+        // between lights of one colour.
+        if (!colour && c.test_look.spectrum != c.reference_look.spectrum) out.push_back("spectrum");
     }
     if (c.glare_test != c.glare_reference) out.push_back("glare");
     // Frame-wide keys the test's and the reference's frames set differently

@@ -70,13 +70,14 @@ SceneLights scene_lights(const char* text) {
 
 TEST(AnalysisLights, TheSceneGivesEachLightsColourRhythmAndSpectrum) {
     const SceneLights s = scene_lights(kScene);
-    EXPECT_EQ(s.look("buoy", {}), (LightLook{"red", "Fl(1) 4s", ""}));
+    EXPECT_EQ(s.look("buoy", {}), (LightLook{"red", "Fl(1) 4s", "iala-red"}));
     // A light without a name is "light1" (its index), as the scene loader names it; xy as written.
-    EXPECT_EQ(s.look("light1", {}), (LightLook{"xy 0.31, 0.33", "F", ""}));
+    EXPECT_EQ(s.look("light1", {}), (LightLook{"xy 0.31, 0.33", "F", "d65"}));
     // An alternating light: the whole, and one colour of it by its chart letter.
     EXPECT_EQ(s.look("lh", {}), (LightLook{"alternating (Al.WR 4s)", "Al.WR 4s", ""}));
-    EXPECT_EQ(s.look("lh/R", {}), (LightLook{"red", "Al.WR 4s", ""}));
-    // A disc is steady; an spd is its spectrum.
+    EXPECT_EQ(s.look("lh/R", {}), (LightLook{"red", "Al.WR 4s", "iala-red"}));
+    // A light without spd takes its colour's representative spectrum, an xy light D65, an
+    // alternating light none (each colour its own). A disc is steady; an spd is its spectrum.
     EXPECT_EQ(s.look("patch", {}), (LightLook{"spd led-white", "steady", "led-white"}));
     EXPECT_FALSE(s.look("nothing", {}));
     std::string why;
@@ -91,13 +92,13 @@ TEST(AnalysisLights, OverridesApplyInOrderByNameOrIndexAndColourKeysExcludeEachO
               (LightLook{"spd led-white", "Fl(1) 4s", "led-white"}));
     // By index; a value that is not TOML is a string, as for --set.
     EXPECT_EQ(s.look("buoy", Overrides{{"light[0].rhythm", "Oc 6s"}, {"light[0].colour", "'white'"}}),
-              (LightLook{"white", "Oc 6s", ""}));
+              (LightLook{"white", "Oc 6s", "d65"}));
     // xy replaced by colour; overrides of other lights and other keys are not this light's.
     EXPECT_EQ(s.look("light1", Overrides{{"light[1].colour", "\"yellow\""},
                                          {"light.buoy.colour", "\"blue\""},
                                          {"light[1].intensity_cd", "3"},
                                          {"eye.glare", "\"none\""}}),
-              (LightLook{"yellow", "F", ""}));
+              (LightLook{"yellow", "F", "iala-yellow"}));
 }
 
 // --- The analysis of a study ----------------------------------------------------
@@ -190,8 +191,8 @@ TEST(AnalysisLights, ARedFlashingTestBesideAWhiteReferenceIsNamedAndNotCalledAnE
         td::kWhiteLightsScene);
     ASSERT_EQ(a.results.conditions.size(), 1u);
     const ConditionInfo& c = a.results.conditions[0];
-    EXPECT_EQ(c.test_look, (LightLook{"red", "Fl(1) 4s", ""}));
-    EXPECT_EQ(c.reference_look, (LightLook{"white", "F", ""}));
+    EXPECT_EQ(c.test_look, (LightLook{"red", "Fl(1) 4s", "iala-red"}));
+    EXPECT_EQ(c.reference_look, (LightLook{"white", "F", "d65"}));
     EXPECT_EQ(c.differences, (std::vector<std::string>{"colour", "rhythm", "glare"}));
     EXPECT_EQ(c.difference_label(), "test − reference");
     for (const std::string* out : {&a.html, &a.summary, &a.fits})

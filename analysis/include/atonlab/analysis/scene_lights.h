@@ -27,8 +27,10 @@ struct LightLook {
     /// The light character as written ("Fl(1) 4s"); "F" (fixed) by default;
     /// "steady" for a disc.
     std::string rhythm;
-    /// The `spd` name the scene gives; empty: none given (the renderer picks
-    /// the glare spectrum from the colour, docs/scene-file.md).
+    /// The spectrum the light's glare is integrated over: the `spd` name the
+    /// scene gives, else its IALA colour's representative spectrum ("iala-red"),
+    /// "d65" for an `xy` colour; empty for a disc and an alternating light
+    /// (each of its colours has its own; docs/glare.md "The light's spectrum").
     std::string spectrum;
     friend bool operator==(const LightLook&, const LightLook&) = default;
 };
