@@ -1,20 +1,37 @@
 #!/usr/bin/env bash
 # Builds the fuzz targets (fuzz/, docs/fuzzing.md) with clang into build-fuzz/
-# (or $ATONLAB_FUZZ_BUILD_DIR) and runs each for $ATONLAB_FUZZ_SECONDS
-# (default 20) under CTest. Only the libraries the targets need are built
-# (common, stimuli, protocols). Needs clang and libclang-rt-14-dev (libFuzzer),
+# (or $ATONLAB_FUZZ_BUILD_DIR), every library instrumented with ASan + UBSan,
+# and runs each target for $ATONLAB_FUZZ_SECONDS (default 20) under CTest.
+# The same build first runs the unit tests that need no GL and no runner
+# (unit_tests: tests/unit; display_tests: tests/display) under ASan + UBSan:
+# the sanitizer step of CI (docs/measured.md). ATONLAB_FUZZ_UNIT_TESTS=0 skips
+# them. Only what these need is built (common, display, stimuli, protocols,
+# store, analysis and the tests). Needs clang and libclang-rt-14-dev (libFuzzer),
 # which scripts/setup.sh installs.
-#   bash scripts/fuzz.sh                            # CI: 20 s per target
-#   ATONLAB_FUZZ_SECONDS=600 bash scripts/fuzz.sh   # a longer run
+#   bash scripts/fuzz.sh                            # CI: the unit tests, then 20 s per target
+#   ATONLAB_FUZZ_SECONDS=600 ATONLAB_FUZZ_UNIT_TESTS=0 bash scripts/fuzz.sh   # a longer fuzz run alone
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir="${ATONLAB_FUZZ_BUILD_DIR:-build-fuzz}"
 seconds="${ATONLAB_FUZZ_SECONDS:-20}"
+unit_tests="${ATONLAB_FUZZ_UNIT_TESTS:-1}"
+targets=(fuzz_scene_file fuzz_protocol_file fuzz_set_override)
+if [ "$unit_tests" = 1 ]; then targets+=(unit_tests display_tests); fi
 # shellcheck disable=SC2086
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
-  -DCMAKE_CXX_COMPILER=clang++ -DATONLAB_FUZZ=ON -DATONLAB_BUILD_TESTS=OFF \
+  -DCMAKE_CXX_COMPILER=clang++ -DATONLAB_FUZZ=ON -DATONLAB_BUILD_TESTS="$([ "$unit_tests" = 1 ] && echo ON || echo OFF)" \
   -DATONLAB_FUZZ_SECONDS="$seconds" ${ATONLAB_FUZZ_CMAKE_ARGS:-}
-cmake --build "$build_dir" --parallel "$(nproc)" --target fuzz_scene_file fuzz_protocol_file fuzz_set_override
+cmake --build "$build_dir" --parallel "$(nproc)" --target "${targets[@]}"
+if [ "$unit_tests" = 1 ]; then
+  # Every unit.* test of the two executables (not the shape and GL-free checks,
+  # which test.sh runs). A sanitizer report fails the test: UBSan stops at the
+  # first (-fno-sanitize-recover), ASan always does. detect_leaks=0 as in
+  # fuzz/run_fuzz.sh (LeakSanitizer needs ptrace, which containers often
+  # forbid); ASAN_OPTIONS=detect_leaks=1 turns it on.
+  ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0}" UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
+    ctest --test-dir "$build_dir" -R '^unit\.' -E '^unit\.(source_shape|display_is_gl_free)$' \
+    --output-on-failure --parallel "$(nproc)" --timeout 600
+fi
 # One target at a time: each is a single process, and the machine's cores are
 # better spent on one fuzzer's speed than on three fighting for them. -V: the
 # log keeps each run's statistics (executions, coverage, corpus size).

@@ -11,7 +11,8 @@
 # (The example scenes render with scripts/render-examples.sh.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+# Only the program: scripts/test.sh builds the rest into the same build/.
+ATONLAB_BUILD_TARGETS="${ATONLAB_BUILD_TARGETS:-atonlab}" bash scripts/setup.sh
 atonlab="${ATONLAB_BUILD_DIR:-build}/runner/atonlab"
 mkdir -p out
 rm -f out/study.db out/study.db-wal out/study.db-shm out/side_by_side.db out/side_by_side.db-wal out/side_by_side.db-shm

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages atonlab needs (only those missing; as root or
 # via sudo), then configures and builds into build/ (or $ATONLAB_BUILD_DIR).
-# Extra CMake arguments can be given in $ATONLAB_CMAKE_ARGS.
+# scripts/main.sh and scripts/test.sh share this one build: the same flags
+# (warnings are errors), so running one after the other rebuilds nothing.
+# Extra CMake arguments can be given in $ATONLAB_CMAKE_ARGS; $ATONLAB_BUILD_TARGETS
+# names the targets to build (default: all).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -39,5 +42,6 @@ fi
 
 build_dir="${ATONLAB_BUILD_DIR:-build}"
 # shellcheck disable=SC2086
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo ${ATONLAB_CMAKE_ARGS:-}
-cmake --build "$build_dir" --parallel "$(nproc)"
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DATONLAB_WERROR=ON ${ATONLAB_CMAKE_ARGS:-}
+# shellcheck disable=SC2086
+cmake --build "$build_dir" --parallel "$(nproc)" ${ATONLAB_BUILD_TARGETS:+--target $ATONLAB_BUILD_TARGETS}

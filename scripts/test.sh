@@ -1,19 +1,20 @@
 #!/usr/bin/env bash
-# Set up, build with warnings as errors, and run every test (unit, GL on the
-# headless EGL context, end-to-end), then a short fuzz run of the loaders. ATONLAB_SANITIZE=1 builds with ASan/UBSan
-# into build-asan/. Ends by listing every skipped test with its reason
-# (scripts/skipped_tests.py); under CI=true a skip for a missing tool or
-# library, or one that does not say why, fails the run (a missing GPU or
-# display server stays a skip).
+# Set up, build with warnings as errors (into build/, the build scripts/main.sh
+# uses too), and run every test (unit, GL on the headless EGL context,
+# end-to-end); then scripts/fuzz.sh: one clang build with ASan + UBSan runs the
+# unit tests (tests/unit but the runner's, tests/display) and a short fuzz run
+# of the loaders. ATONLAB_SANITIZE=1 instead builds everything with ASan/UBSan
+# into build-asan/ and runs every test there. The ctest step ends by listing
+# every skipped test with its reason (scripts/skipped_tests.py); under CI=true
+# a skip for a missing tool or library, or one that does not say why, fails
+# the run (a missing GPU or display server stays a skip).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "${ATONLAB_SANITIZE:-0}" = 1 ]; then
   export ATONLAB_BUILD_DIR="${ATONLAB_BUILD_DIR:-build-asan}"
-  export ATONLAB_CMAKE_ARGS="${ATONLAB_CMAKE_ARGS:-} -DATONLAB_WERROR=ON -DATONLAB_SANITIZE=ON"
+  export ATONLAB_CMAKE_ARGS="${ATONLAB_CMAKE_ARGS:-} -DATONLAB_SANITIZE=ON"
   # LeakSanitizer reports Mesa's own one-time allocations; leaks in atonlab code are still found by ASan's other checks.
   export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0}"
-else
-  export ATONLAB_CMAKE_ARGS="${ATONLAB_CMAKE_ARGS:-} -DATONLAB_WERROR=ON"
 fi
 bash scripts/setup.sh
 build_dir="${ATONLAB_BUILD_DIR:-build}"
@@ -32,7 +33,8 @@ if [ "$skip_status" -ne 0 ]; then
   echo "test: failed: under CI=true, tests were skipped for a missing tool or library or without a reason (listed above)" >&2
   exit "$skip_status"
 fi
-# The loaders' fuzz targets, built with clang into build-fuzz/, 20 s each (docs/fuzzing.md).
+# The sanitizer step: the unit tests under ASan + UBSan, then the loaders' fuzz
+# targets 20 s each, from one clang build in build-fuzz/ (docs/fuzzing.md).
 if [ "${ATONLAB_SANITIZE:-0}" != 1 ]; then
   bash scripts/fuzz.sh
 fi
