@@ -33,8 +33,8 @@ done
 grep -q "red, rhythm Fl(1) 4s" "$r/report.html" || { echo "report.html does not name the red test"; fail=1; }
 grep -q "white, rhythm F" "$r/report.html" || { echo "report.html does not name the white reference"; fail=1; }
 grep -q "test − reference" "$r/report.html" || { echo "report.html does not say test − reference"; fail=1; }
-grep -q "frame 0 test (red, Fl(1) 4s, glare wave-optics)" "$r/report.html" &&
-  grep -q "frame 0 reference (white, F, glare none)" "$r/report.html" ||
+grep -q "frame 0 test (red, Fl(1) 4s, spd iala-red, glare wave-optics)" "$r/report.html" &&
+  grep -q "frame 0 reference (white, F, spd d65, glare none)" "$r/report.html" ||
   { echo "the snapshot's caption does not name both lights"; fail=1; }
 grep -q '"colour": "red"' "$r/summary.json" || { echo "summary.json does not name the red test"; fail=1; }
 # fits.csv quotes fields that hold commas (reasons, methods): read it with a CSV reader.

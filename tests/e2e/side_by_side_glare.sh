@@ -43,8 +43,8 @@ fi
 if ! grep -q "enhancement by glare" "$outdir/report/report.html"; then
   echo "report.html does not call a glare-only difference an enhancement by glare"; fail=1
 fi
-if ! grep -q "frame 0 test (white, F, glare wave-optics)" "$outdir/report/report.html" ||
-   ! grep -q "frame 0 reference (white, F, glare none)" "$outdir/report/report.html"; then
+if ! grep -q "frame 0 test (white, F, spd d65, glare wave-optics)" "$outdir/report/report.html" ||
+   ! grep -q "frame 0 reference (white, F, spd d65, glare none)" "$outdir/report/report.html"; then
   echo "the snapshot's caption does not name both lights"; fail=1
 fi
 blocks=$(tail -n +2 "$outdir/report/trials.csv" | cut -d, -f"$(col block)" | sort -u)

@@ -7,7 +7,8 @@
 // pixel of the 41 × 41 window around the light shows at least its displayed luminance
 // (decoded through the display model), to within one code step of each channel (a channel
 // whose drive falls as the chroma turns may round down alone: see the CPU test), the
-// window's sum is at least the sky's, and the sum does not fall as the light brightens.
+// window's sum is at least the sky's and does not fall as the light brightens (to within
+// half a code step in all).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -137,11 +138,18 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                             const ToneMapSettings& s = settings[k];
                             for (const Window* reference : {&without[k], static_cast<const Window*>(&previous[k])}) {
                                 ++checks;
-                                bool ok = with[k].sum_cd_m2 >= reference->sum_cd_m2 * (1.0 - 1e-9);
+                                double largest_step = 0.0;
+                                bool ok = true;
                                 for (std::size_t i = 0; i < with[k].pixel_cd_m2.size(); ++i) {
                                     const double step = std::max(with[k].step_cd_m2[i], reference->step_cd_m2[i]);
+                                    largest_step = std::max(largest_step, step);
                                     ok = ok && reference->pixel_cd_m2[i] - with[k].pixel_cd_m2[i] <= step * (1.0 + 1e-9);
                                 }
+                                // The sum: to within half the largest code step (a light that turns a
+                                // pixel's chroma may round one channel down by a step while the
+                                // others' rise is still below one; the reported failure was 4-6
+                                // codes in every channel of the core).
+                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * largest_step;
                                 if (!ok && failures++ < 8) {
                                     ADD_FAILURE() << colour << " light, glare " << glare << ", L_wa " << adaptation
                                                   << ", sky " << sky << ", core x" << core_factor << ", "
