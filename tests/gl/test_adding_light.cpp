@@ -8,7 +8,7 @@
 // (decoded through the display model), to within one code step of each channel (a channel
 // whose drive falls as the chroma turns may round down alone: see the CPU test), the
 // window's sum is at least the sky's and does not fall as the light brightens (to within
-// half a code step in all).
+// half a code step of each pixel the light changes).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -138,18 +138,19 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                             const ToneMapSettings& s = settings[k];
                             for (const Window* reference : {&without[k], static_cast<const Window*>(&previous[k])}) {
                                 ++checks;
-                                double largest_step = 0.0;
+                                double changed_steps = 0.0;
                                 bool ok = true;
                                 for (std::size_t i = 0; i < with[k].pixel_cd_m2.size(); ++i) {
                                     const double step = std::max(with[k].step_cd_m2[i], reference->step_cd_m2[i]);
-                                    largest_step = std::max(largest_step, step);
+                                    if (with[k].pixel_cd_m2[i] != reference->pixel_cd_m2[i]) changed_steps += step;
                                     ok = ok && reference->pixel_cd_m2[i] - with[k].pixel_cd_m2[i] <= step * (1.0 + 1e-9);
                                 }
-                                // The sum: to within half the largest code step (a light that turns a
-                                // pixel's chroma may round one channel down by a step while the
-                                // others' rise is still below one; the reported failure was 4-6
-                                // codes in every channel of the core).
-                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * largest_step;
+                                // The sum: to within half a code step of each pixel the light changes (a
+                                // light that turns a pixel's chroma may round one channel down by a step
+                                // while the others' rise is still below one, in each of the few pixels
+                                // a faint light touches; the reported failure was 4-6 codes in every
+                                // channel of the core).
+                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * changed_steps;
                                 if (!ok && failures++ < 8) {
                                     ADD_FAILURE() << colour << " light, glare " << glare << ", L_wa " << adaptation
                                                   << ", sky " << sky << ", core x" << core_factor << ", "

@@ -115,11 +115,11 @@ TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
     };
     const auto decoded_y = [](const float* rgb_codes_or_linear, bool codes) {
         double y = 0.0;
-        const double w[3] = {0.2126, 0.7152, 0.0722};
+        const double weight[3] = {0.2126, 0.7152, 0.0722};
         for (int c = 0; c < 3; ++c) {
             const double v = codes ? rgb_codes_or_linear[c] : std::clamp(static_cast<double>(rgb_codes_or_linear[c]), 0.0, 1.0);
             const double linear = codes ? (v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) : v;
-            y += w[c] * linear;
+            y += weight[c] * linear;
         }
         return y;
     };
