@@ -26,6 +26,7 @@
 #include "atonlab/display/colour.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/display/tonemap.h"
+#include "tonemap_sweep.h"
 
 namespace atonlab::display {
 namespace {
@@ -131,24 +132,6 @@ void sweep(const ToneMapSettings& s, const DisplayModel& d, int bits, Counts& n)
     }
 }
 
-std::vector<ToneMapSettings> every_setting() {
-    std::vector<ToneMapSettings> out;
-    for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual, ToneOperator::reinhard,
-                                  ToneOperator::kakimoto, ToneOperator::linear, ToneOperator::clamp}) {
-        for (const HuePreservation hue : {HuePreservation::none, HuePreservation::xyY, HuePreservation::rgb}) {
-            for (int blue = 0; blue < 3; ++blue) {
-                ToneMapSettings s;
-                s.tone_operator = op;
-                s.hue_preservation = hue;
-                s.blueshift = blue != 0;
-                s.blueshift_luminance = blue == 2 ? BlueshiftLuminance::adaptation : BlueshiftLuminance::pixel;
-                out.push_back(s);
-            }
-        }
-    }
-    return out;
-}
-
 // 54 settings × 9 adaptations × 5 backgrounds × 2 skies × 10 colours × 7 levels × 16
 // dither positions on each display.
 TEST(AddingLight, NeverLowersTheDisplayedLuminanceOnEveryOperatorAndDisplay) {
@@ -156,7 +139,7 @@ TEST(AddingLight, NeverLowersTheDisplayedLuminanceOnEveryOperatorAndDisplay) {
     const DisplayModel pq = DisplayModel::pq(1000.0, 0.005);
     for (const auto& [display, bits] : {std::pair{&srgb, 8}, std::pair{&srgb, 10}, std::pair{&pq, 10}}) {
         Counts n;
-        for (const ToneMapSettings& s : every_setting()) sweep(s, *display, bits, n);
+        for (const ToneMapSettings& s : atonlab::test::every_tonemap_setting()) sweep(s, *display, bits, n);
         std::printf("%s %d-bit: %ld pixels, %ld checks, %ld failures; the largest drop per pixel %.3f code steps, "
                     "of the mean %.4f mean steps\n",
                     display->name.c_str(), bits, n.pixels, n.checks, n.failures, n.worst_drop_steps,

@@ -21,6 +21,7 @@
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "gl_test_support.h"
+#include "tonemap_sweep.h"
 
 namespace atonlab::test {
 namespace {
@@ -29,31 +30,6 @@ using namespace atonlab::stimuli;
 using namespace atonlab::display;
 
 constexpr int kHalf = 20;  // the window: 41 × 41 px around the light's centre
-
-// 160 × 90 px on 0.05 m at 0.9 m: 50 px/deg. The light sits at the centre.
-std::string scene_text(const std::string& glare, double adaptation, double sky, const std::string& colour,
-                       double intensity_cd) {
-    std::string s = R"(
-[display]
-width_px = 160
-height_px = 90
-width_m = 0.05
-viewing_distance_m = 0.9
-
-[camera]
-position_m = [0.0, 2.0, 0.0]
-
-[environment]
-background = "uniform"
-)";
-    s += "luminance_cd_m2 = " + std::to_string(sky) + "\n\n[eye]\nadaptation = \"fixed\"\n";
-    s += "adaptation_cd_m2 = " + std::to_string(adaptation) + "\nglare = \"" + glare + "\"\n\n[glare]\npsf_size = 256\n";
-    if (intensity_cd > 0.0) {
-        s += "\n[[light]]\nname = \"light\"\nposition_m = [0.0, 2.0, -500.0]\ncolour = \"" + colour + "\"\n";
-        s += "intensity_cd = " + std::to_string(intensity_cd) + "\n";
-    }
-    return s;
-}
 
 struct Window {
     std::vector<double> pixel_cd_m2, step_cd_m2;
@@ -80,30 +56,12 @@ Window window_of(const EncodedImage& codes, const DisplayModel& d) {
     return w;
 }
 
-std::vector<ToneMapSettings> every_setting() {
-    std::vector<ToneMapSettings> out;
-    for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual, ToneOperator::reinhard,
-                                  ToneOperator::kakimoto, ToneOperator::linear, ToneOperator::clamp}) {
-        for (const HuePreservation hue : {HuePreservation::none, HuePreservation::xyY, HuePreservation::rgb}) {
-            for (int blue = 0; blue < 3; ++blue) {
-                ToneMapSettings s;
-                s.tone_operator = op;
-                s.hue_preservation = hue;
-                s.blueshift = blue != 0;
-                s.blueshift_luminance = blue == 2 ? BlueshiftLuminance::adaptation : BlueshiftLuminance::pixel;
-                out.push_back(s);
-            }
-        }
-    }
-    return out;
-}
-
 using AddingLight = GLTest;
 
 TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
     FrameRenderer frame;
     DisplayPipeline display;
-    const std::vector<ToneMapSettings> settings = every_setting();
+    const std::vector<ToneMapSettings> settings = every_tonemap_setting();
     long checks = 0, failures = 0;
     for (const std::string glare : {"none", "wave-optics"}) {
         for (const double adaptation : {0.001, 0.1, 10.0, 1000.0}) {
@@ -125,7 +83,7 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                     }
                     return out;
                 };
-                const std::vector<Window> without = codes_of(scene_text(glare, adaptation, sky, "white", 0.0));
+                const std::vector<Window> without = codes_of(one_light_scene(glare, adaptation, sky, "white", 0.0));
                 for (const std::string colour : {"red", "green", "white"}) {
                     // 1 cd at 500 m puts 4e-6 lx into a pixel of (1/50)° squared, 1.22e-7 sr:
                     // 32.8 cd/m². Intensities put the core at about 0.1, 10 and 1000 times the
@@ -133,7 +91,7 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                     std::vector<Window> previous = without;
                     for (const double core_factor : {0.1, 10.0, 1000.0}) {
                         const double intensity = core_factor * adaptation / 32.8;
-                        const std::vector<Window> with = codes_of(scene_text(glare, adaptation, sky, colour, intensity));
+                        const std::vector<Window> with = codes_of(one_light_scene(glare, adaptation, sky, colour, intensity));
                         for (std::size_t k = 0; k < settings.size(); ++k) {
                             const ToneMapSettings& s = settings[k];
                             for (const Window* reference : {&without[k], static_cast<const Window*>(&previous[k])}) {

@@ -34,6 +34,7 @@
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "gl_test_support.h"
+#include "tonemap_sweep.h"
 
 namespace atonlab::test {
 namespace {
@@ -63,29 +64,6 @@ bool explained(const std::string& op, const std::string& colour, double level) {
     if (level == 0.01 || level == 0.1) return c == "red" || c == "green";
     if (level == 1.0) return c == "blue";
     return false;
-}
-
-std::string scene_text(const std::string& glare, double level, const std::string& colour, double intensity_cd) {
-    std::string s = R"(
-[display]
-width_px = 160
-height_px = 90
-width_m = 0.05
-viewing_distance_m = 0.9
-
-[camera]
-position_m = [0.0, 2.0, 0.0]
-
-[environment]
-background = "uniform"
-)";
-    s += "luminance_cd_m2 = " + std::to_string(level) + "\n\n[eye]\nadaptation = \"fixed\"\n";
-    s += "adaptation_cd_m2 = " + std::to_string(level) + "\nglare = \"" + glare + "\"\n\n[glare]\npsf_size = 256\n";
-    if (intensity_cd > 0.0) {
-        s += "\n[[light]]\nname = \"light\"\nposition_m = [0.0, 2.0, -500.0]\ncolour = \"" + colour + "\"\n";
-        s += "intensity_cd = " + std::to_string(intensity_cd) + "\n";
-    }
-    return s;
 }
 
 double frame_sum_cd_m2(const EncodedImage& codes, const DisplayModel& d) {
@@ -130,7 +108,7 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
             const double intensity = 3.0 * level / 32.8;
             std::map<std::string, std::map<std::string, double>> added;  // op -> colour -> cd/m² summed
             for (const std::string colour : {"", "white", "red", "green", "yellow", "blue"}) {
-                const Scene scene = parse_scene(scene_text(glare, level, colour, colour.empty() ? 0.0 : intensity),
+                const Scene scene = parse_scene(one_light_scene(glare, level, level, colour, colour.empty() ? 0.0 : intensity),
                                                 "mesopic.toml", {});
                 frame.render(scene, 0.0);
                 for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual}) {
