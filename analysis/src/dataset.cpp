@@ -14,7 +14,7 @@
 #include "atonlab/analysis/study_analysis.h"
 #include "atonlab/common/atomic_file.h"
 #include "atonlab/common/input_text.h"
-#include "atonlab/protocols/procedure.h"
+#include "atonlab/protocols/procedures.h"
 #include "csv.h"
 
 namespace atonlab::analysis {
@@ -254,12 +254,12 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     if (const auto v = row.integer("block_index", 0)) t.block = static_cast<int>(*v);
     if (const auto s = row.text("track")) t.track = *s;
     if (const auto s = row.text("procedure")) {
-        static const std::set<std::string, std::less<>> kinds{"staircase", "weighted-staircase", "quest",
-                                                              "constant-stimuli", "adjustment"};
-        if (!kinds.count(*s))
-            row.fail("procedure", fmt::format("'{}' is not a procedure (staircase, weighted-staircase, quest, "
-                                              "constant-stimuli, adjustment)",
-                                              *s));
+        if (!p::find_procedure_type(*s)) {
+            std::string names;
+            for (const p::ProcedureType* type : p::procedure_types())
+                names += fmt::format("{}{}", names.empty() ? "" : ", ", type->name);
+            row.fail("procedure", fmt::format("'{}' is not a procedure ({})", *s, names));
+        }
         t.procedure = *s;
     }
     t.response_value = row.number("response_value");

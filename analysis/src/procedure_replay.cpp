@@ -5,15 +5,9 @@
 #include <charconv>
 #include <cmath>
 #include <memory>
-#include <type_traits>
-#include <variant>
 
-#include "atonlab/protocols/forced_choice.h"
-#include "atonlab/protocols/procedure.h"
+#include "atonlab/protocols/procedures.h"
 #include "atonlab/protocols/protocol_file.h"
-#include "atonlab/protocols/quest.h"
-#include "atonlab/protocols/staircase.h"
-#include "atonlab/protocols/weighted_staircase.h"
 
 namespace atonlab::analysis::detail {
 
@@ -24,7 +18,8 @@ namespace {
 ConditionDesign condition_design(const p::Condition& c) {
     ConditionDesign d;
     d.condition = &c;
-    d.procedure = std::string(p::to_string(c.procedure.kind));
+    const p::ProcedureType& type = c.procedure.type();
+    d.procedure = std::string(type.name);
     // The outcome is "chose the level stimulus" (2AFC) or "yes" (yes-no); the
     // procedure's Yes is the protocol's `choice`. They agree when the choice
     // names the stimulus the level is on.
@@ -32,18 +27,16 @@ ConditionDesign condition_design(const p::Condition& c) {
     const std::optional<double> p_yes = c.procedure.target_p_yes();
     if (p_yes) {
         d.target_p = yes_is_outcome ? *p_yes : 1.0 - *p_yes;
-    } else if (const auto* s = std::get_if<p::StaircaseParams>(&c.procedure.params)) {
-        d.note = fmt::format(
-            "condition \"{}\": a {}-up/{}-down staircase with up_step_ratio {} has no simple target probability; "
-            "its thresholds are given at P = 0.5",
-            c.name, s->n_up, s->n_down, s->up_step_ratio);
+    } else {
+        d.note = fmt::format("condition \"{}\": {} has no simple target probability; its thresholds are given at P = 0.5",
+                             c.name, type.describe(c.procedure.params));
     }
     // Guess rate of the outcome: QUEST states its own; a 2AFC scored as "chose
     // the test" with the level on the test and a target above 0.5 is a
     // detection or discrimination (correct / incorrect, gamma = 0.5); every
     // comparison whose target is 0.5 (a PSE) runs from 0 to 1.
-    if (const auto* q = std::get_if<p::QuestParams>(&c.procedure.params); q && yes_is_outcome) {
-        d.guess_rate = q->gamma;
+    if (const std::optional<double> own = type.guess_rate(c.procedure.params); own && yes_is_outcome) {
+        d.guess_rate = *own;
     } else if (c.task == p::Task::TwoAfc && c.level_on == p::Role::Test && c.choice == p::ChoiceMapping::ChoseTest &&
                d.target_p > 0.5 + 1e-9) {
         d.guess_rate = 0.5;
@@ -82,10 +75,8 @@ std::optional<std::size_t> track_number(std::string_view procedure_id) {
 
 std::string replay_track(const ConditionDesign& design, std::size_t track, const std::vector<Trial*>& trials) {
     const p::Condition& c = *design.condition;
-    const p::ProcedureKind kind = c.procedure.kind;
-    if (kind != p::ProcedureKind::Staircase && kind != p::ProcedureKind::WeightedStaircase &&
-        kind != p::ProcedureKind::Quest)
-        return {};
+    const p::ProcedureType& type = c.procedure.type();
+    if (!type.adaptive()) return {};
     if (track >= c.procedure.tracks()) return fmt::format("the protocol's condition has no track {}", track);
     // The inner procedure alone (a yes-no copy of the condition is not wrapped
     // in a ForcedChoice); the 2AFC answers are mapped as ForcedChoice maps them.
@@ -97,8 +88,7 @@ std::string replay_track(const ConditionDesign& design, std::size_t track, const
     } catch (const std::exception& e) {
         return fmt::format("its procedure could not be built: {}", e.what());
     }
-    const auto* quest = dynamic_cast<const p::Quest*>(proc.get());
-    const auto* stair = dynamic_cast<const p::Staircase*>(proc.get());  // WeightedStaircase is one too
+    p::TrackState state;
     for (std::size_t i = 0; i < trials.size(); ++i) {
         Trial& t = *trials[i];
         const std::optional<p::Proposal> next = proc->next();
@@ -124,18 +114,19 @@ std::string replay_track(const ConditionDesign& design, std::size_t track, const
         } catch (const std::exception& e) {
             return fmt::format("trial {} could not be replayed: {}", t.trial_index, e.what());
         }
-        if (quest) {
-            // QuestDemo's final estimate (mean +- sd) and the 95% credible
-            // interval by QuestQuantile (thresholds.h summarize_quest reads them back).
-            t.quest_mean = quest->mean();
-            t.quest_sd = quest->sd();
-            t.quest_lower = quest->quantile(0.025);
-            t.quest_upper = quest->quantile(0.975);
+        // The procedure's own state after the answer (procedures.h TrackState):
+        // a posterior per trial; the reversals are marked once the track is done.
+        state = type.track_state(*proc);
+        if (type.track_estimate == p::TrackEstimate::Posterior) {
+            t.quest_mean = state.mean;
+            t.quest_sd = state.sd;
+            t.quest_lower = state.lower;
+            t.quest_upper = state.upper;
         }
     }
-    if (stair) {
+    if (type.track_estimate == p::TrackEstimate::Reversals) {
         for (Trial* t : trials) t->reversal = false;
-        for (const std::size_t r : stair->reversal_trials())
+        for (const std::size_t r : state.reversal_trials)
             if (r < trials.size()) trials[r]->reversal = true;
     }
     return {};

@@ -11,13 +11,20 @@
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <string_view>
+
+#include "atonlab/protocols/procedures.h"
 
 namespace atonlab::analysis {
 
 namespace {
 
-bool is_adaptive(const std::string& procedure) {
-    return procedure == "staircase" || procedure == "weighted-staircase" || procedure == "quest";
+namespace p = atonlab::protocols;
+
+/// What analysis follows in a track of the procedure `name` (procedures.h); None for an unknown one.
+p::TrackEstimate track_estimate(std::string_view name) {
+    const p::ProcedureType* type = p::find_procedure_type(name);
+    return type ? type->track_estimate : p::TrackEstimate::None;
 }
 
 /// std::vector<bool> is not contiguous; the statistics take std::span<const bool>.
@@ -119,7 +126,7 @@ std::vector<TrackResult> tracks_of(const std::vector<const Trial*>& trials, cons
     std::map<std::pair<std::string, std::string>, std::vector<const Trial*>> by_track;
     std::vector<std::pair<std::string, std::string>> order;
     for (const Trial* t : trials) {
-        if (!is_adaptive(t->procedure)) continue;
+        if (track_estimate(t->procedure) == p::TrackEstimate::None) continue;
         const auto key = std::make_pair(t->session, t->track.empty() ? t->condition : t->track);
         auto [it, fresh] = by_track.try_emplace(key);
         if (fresh) order.push_back(key);
@@ -141,7 +148,7 @@ std::vector<TrackResult> tracks_of(const std::vector<const Trial*>& trials, cons
             r.outcomes.push_back(t->outcome);
             all_flags = all_flags && t->reversal.has_value();
         }
-        if (r.procedure != "quest") {
+        if (track_estimate(r.procedure) == p::TrackEstimate::Reversals) {
             if (all_flags) {
                 for (const Trial* t : ts) r.reversal.push_back(*t->reversal);
                 const std::unique_ptr<bool[]> flags = as_bools(r.reversal);

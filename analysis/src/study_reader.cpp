@@ -180,10 +180,10 @@ std::optional<bool> outcome_of(const Trial& t) {
 /// The procedure kind named in the schedule state line (a fallback when the
 /// protocol text cannot be read): "[i: 2afc mapping=... [staircase trials=...".
 std::string kind_from_state(const std::string& state_json) {
-    for (const char* kind : {"weighted-staircase", "staircase", "quest", "constant-stimuli", "adjustment"}) {
-        if (state_json.find(fmt::format("[{} ", kind)) != std::string::npos ||
-            state_json.find(fmt::format(": {} ", kind)) != std::string::npos)
-            return kind;
+    for (const protocols::ProcedureType* type : protocols::procedure_types()) {
+        if (state_json.find(fmt::format("[{} ", type->name)) != std::string::npos ||
+            state_json.find(fmt::format(": {} ", type->name)) != std::string::npos)
+            return std::string(type->name);
     }
     return {};
 }

@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
-#include <variant>
 
 namespace atonlab::protocols {
 
@@ -37,12 +35,6 @@ constexpr std::pair<std::string_view, Presentation> kPresentations[] = {{"single
 constexpr std::pair<std::string_view, LevelScale> kScales[] = {{"log10", LevelScale::Log10},
                                                                {"linear", LevelScale::Linear}};
 constexpr std::pair<std::string_view, Role> kRoles[] = {{"test", Role::Test}, {"reference", Role::Reference}};
-constexpr std::pair<std::string_view, ProcedureKind> kKinds[] = {
-    {"staircase", ProcedureKind::Staircase},
-    {"weighted-staircase", ProcedureKind::WeightedStaircase},
-    {"quest", ProcedureKind::Quest},
-    {"adjustment", ProcedureKind::Adjustment},
-    {"constant-stimuli", ProcedureKind::ConstantStimuli}};
 constexpr std::pair<std::string_view, Action> kActions[] = {{"left", Action::Left},
                                                             {"right", Action::Right},
                                                             {"yes", Action::Yes},
@@ -111,10 +103,11 @@ std::optional<Role> parse_role(std::string_view text) noexcept {
     return lookup(kRoles, text);
 }
 std::string_view to_string(ProcedureKind k) noexcept {
-    return name_of(kKinds, k);
+    return procedure_type(k).name;
 }
 std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcept {
-    return lookup(kKinds, text);
+    const ProcedureType* t = find_procedure_type(text);
+    return t ? std::optional<ProcedureKind>(t->kind) : std::nullopt;
 }
 std::string_view to_string(Action a) noexcept {
     return name_of(kActions, a);
@@ -190,45 +183,11 @@ std::optional<Action> ResponseMap::screen_key_action(std::string_view key) const
 }
 
 std::optional<double> ProcedureSpec::target_p_yes() const {
-    return std::visit(
-        [](const auto& p) -> std::optional<double> {
-            using T = std::decay_t<decltype(p)>;
-            if constexpr (std::is_same_v<T, WeightedStaircaseParams>) {
-                return p.target;  // Kaernbach 1991
-            } else if constexpr (std::is_same_v<T, StaircaseParams>) {
-                if (p.up_step_ratio != 1.0) return std::nullopt;
-                // Levitt 1971: 1-up/n-down converges on p^n = 0.5, n-up/1-down on (1 - p)^n = 0.5.
-                if (p.n_up == 1) return std::pow(0.5, 1.0 / static_cast<double>(p.n_down));
-                if (p.n_down == 1) return 1.0 - std::pow(0.5, 1.0 / static_cast<double>(p.n_up));
-                return std::nullopt;
-            } else if constexpr (std::is_same_v<T, QuestParams>) {
-                return p.p_threshold;
-            } else if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
-                return p.criterion;
-            } else {
-                return 0.5;  // adjustment: a match
-            }
-        },
-        params);
+    return type().target_p_yes(params);
 }
 
 std::vector<double> ProcedureSpec::level_bounds() const {
-    return std::visit(
-        [](const auto& p) -> std::vector<double> {
-            using T = std::decay_t<decltype(p)>;
-            std::vector<double> out;
-            if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
-                if (!p.levels.empty()) {
-                    const auto [lo, hi] = std::minmax_element(p.levels.begin(), p.levels.end());
-                    out = {*lo, *hi};
-                }
-            } else {
-                if (p.min_level) out.push_back(*p.min_level);
-                if (p.max_level) out.push_back(*p.max_level);
-            }
-            return out;
-        },
-        params);
+    return type().level_bounds(params);
 }
 
 std::pair<double, double> ProcedureSpec::level_range() const {
@@ -238,48 +197,11 @@ std::pair<double, double> ProcedureSpec::level_range() const {
 }
 
 std::pair<double, double> ProcedureSpec::search_range() const {
-    return std::visit(
-        [&](const auto& p) -> std::pair<double, double> {
-            using T = std::decay_t<decltype(p)>;
-            if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
-                if (p.levels.empty()) return {-1.0, 1.0};
-                const auto [lo, hi] = std::minmax_element(p.levels.begin(), p.levels.end());
-                return {*lo - 1.0, *hi + 1.0};
-            } else if constexpr (std::is_same_v<T, AdjustmentParams>) {
-                return {p.min_level.value_or(p.start_min - 2.0), p.max_level.value_or(p.start_max + 2.0)};
-            } else {
-                double first = 0.0;
-                if constexpr (std::is_same_v<T, QuestParams>)
-                    first = p.t_guess;
-                else
-                    first = p.start;
-                double lo = first, hi = first;
-                for (const double v : track_starts) {
-                    lo = std::min(lo, v);
-                    hi = std::max(hi, v);
-                }
-                return {p.min_level.value_or(lo - 3.0), p.max_level.value_or(hi + 3.0)};
-            }
-        },
-        params);
+    return type().search_range(params, track_starts);
 }
 
 std::optional<std::size_t> ProcedureSpec::max_trials_per_track() const {
-    return std::visit(
-        [](const auto& p) -> std::optional<std::size_t> {
-            using T = std::decay_t<decltype(p)>;
-            if constexpr (std::is_same_v<T, StaircaseParams> || std::is_same_v<T, WeightedStaircaseParams>) {
-                if (p.max_trials) return static_cast<std::size_t>(*p.max_trials);
-                return std::nullopt;
-            } else if constexpr (std::is_same_v<T, QuestParams>) {
-                return static_cast<std::size_t>(p.n_trials);
-            } else if constexpr (std::is_same_v<T, ConstantStimuliParams>) {
-                return p.levels.size() * static_cast<std::size_t>(p.repetitions);
-            } else {
-                return std::nullopt;
-            }
-        },
-        params);
+    return type().max_trials_per_track(params);
 }
 
 bool Condition::yes_means_level() const noexcept {
@@ -329,26 +251,7 @@ std::unique_ptr<Procedure> make_track(const Condition& condition, std::size_t tr
     const std::optional<double> start =
         spec.track_starts.empty() ? std::nullopt : std::optional<double>(spec.track_starts[track]);
     const std::uint64_t procedure_seed = derive_seed(seed, 0);
-    std::unique_ptr<Procedure> p = std::visit(
-        [&](const auto& params) -> std::unique_ptr<Procedure> {
-            using P = std::decay_t<decltype(params)>;
-            P q = params;
-            if constexpr (std::is_same_v<P, StaircaseParams>) {
-                if (start) q.start = *start;
-                return std::make_unique<Staircase>(std::move(q), procedure_seed);
-            } else if constexpr (std::is_same_v<P, WeightedStaircaseParams>) {
-                if (start) q.start = *start;
-                return std::make_unique<WeightedStaircase>(q, procedure_seed);
-            } else if constexpr (std::is_same_v<P, QuestParams>) {
-                if (start) q.t_guess = *start;
-                return std::make_unique<Quest>(std::move(q), procedure_seed);
-            } else if constexpr (std::is_same_v<P, AdjustmentParams>) {
-                return std::make_unique<Adjustment>(std::move(q), procedure_seed);
-            } else {
-                return std::make_unique<ConstantStimuli>(std::move(q), procedure_seed);
-            }
-        },
-        spec.params);
+    std::unique_ptr<Procedure> p = spec.type().make(spec.params, start, procedure_seed);
     if (condition.task == Task::TwoAfc)
         return std::make_unique<ForcedChoice>(std::move(p), condition.choice, derive_seed(seed, 1));
     return p;

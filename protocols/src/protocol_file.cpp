@@ -338,26 +338,23 @@ private:
         const std::vector<Found> tables = r.find_all("procedure");
         if (tables.empty())
             r.missing("procedure",
-                      "a table with kind = \"staircase\", \"weighted-staircase\", \"quest\", "
-                      "\"adjustment\" or \"constant-stimuli\" and its parameters");
+                      fmt::format("a table with kind = {} and its parameters", quoted_procedure_names(", ", " or ")));
         ProcedureReader pr(doc_, r);
         pr.merge(tables);
         if (!pr.kind())
             doc_.fail(pr.table()->node, pr.table()->key + ".kind",
                       r.context() + fmt::format("the procedure has no kind: give kind = one of {}.",
-                                                toml_reader::join_quoted(kKindNames)));
-        const bool adjustment = *pr.kind() == ProcedureKind::Adjustment;
-        if (adjustment != (c.task == Task::Adjust))
-            r.fail(
-                *pr.kind_at(),
-                adjustment
-                    ? fmt::format("the adjustment procedure needs task = \"adjust\", not \"{}\".", to_string(c.task))
-                    : fmt::format("task = \"adjust\" needs kind = \"adjustment\", not \"{}\".", to_string(*pr.kind())));
-        if (*pr.kind() == ProcedureKind::Quest && c.level_scale != LevelScale::Log10) {
+                                                toml_reader::join_quoted(procedure_kind_names())));
+        const ProcedureType& type = procedure_type(*pr.kind());
+        if (type.adjusts != (c.task == Task::Adjust))
+            r.fail(*pr.kind_at(),
+                   type.adjusts ? fmt::format("the {} procedure needs task = \"{}\", not \"{}\".", type.name,
+                                              to_string(Task::Adjust), to_string(c.task))
+                                : fmt::format("task = \"{}\" needs kind = {}, not \"{}\".", to_string(Task::Adjust),
+                                              adjusting_kinds(), type.name));
+        if (!type.needs_log10.empty() && c.level_scale != LevelScale::Log10) {
             const auto f = r.find("level_scale");
-            r.fail(*f,
-                   "QUEST works in log10 units (its Weibull is a function of log intensity): level_scale must be "
-                   "\"log10\".");
+            r.fail(*f, fmt::format("{}: level_scale must be \"{}\".", type.needs_log10, to_string(LevelScale::Log10)));
         }
         try {
             c.procedure = read_procedure(pr);

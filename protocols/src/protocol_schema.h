@@ -44,21 +44,6 @@ inline constexpr std::string_view kConditionKeys[] = {
 inline constexpr std::string_view kBlockOwnKeys[] = {"name",         "adaptation_s", "repetitions",    "interleave",
                                               "instructions", "condition",    "conditions_file"};
 
-inline constexpr std::string_view kStaircaseKeys[] = {
-    "kind",        "start",    "step_sizes", "step_type", "n_up",      "n_down",        "apply_initial_rule",
-    "n_reversals", "n_trials", "max_trials", "min_level", "max_level", "up_step_ratio", "estimate_reversals"};
-inline constexpr std::string_view kWeightedKeys[] = {
-    "kind",     "start",      "target",    "step_sizes", "step_type",         "n_reversals",
-    "n_trials", "max_trials", "min_level", "max_level",  "estimate_reversals"};
-inline constexpr std::string_view kQuestKeys[] = {
-    "kind",  "t_guess", "t_guess_sd",     "p_threshold", "beta",          "delta",     "gamma",     "grain",
-    "range", "method",  "quantile_order", "n_trials",    "stop_interval", "min_level", "max_level", "first_at_guess"};
-inline constexpr std::string_view kAdjustmentKeys[] = {"kind",      "start_min", "start_max", "coarse_step",
-                                                "fine_step", "min_level", "max_level", "n_trials"};
-inline constexpr std::string_view kConstantKeys[] = {"kind", "levels", "repetitions", "order", "criterion"};
-inline constexpr std::string_view kKindNames[] = {"staircase", "weighted-staircase", "quest", "adjustment",
-                                           "constant-stimuli"};
-
 // Key names (GLFW's key names, lower case with underscores) and gamepad buttons
 // (GLFW_GAMEPAD_BUTTON_*).
 const std::vector<std::string>& key_names();
@@ -155,6 +140,10 @@ private:
 KeyList keys_of(ProcedureKind k);
 /// Every key of any procedure kind.
 const std::vector<std::string_view>& all_procedure_keys();
+/// The registered kinds' names (procedures.h).
+const std::vector<std::string_view>& procedure_kind_names();
+/// The kinds that take the adjustment actions, quoted ("\"adjustment\"").
+std::string adjusting_kinds();
 
 class ProcedureReader {
 public:
@@ -167,7 +156,8 @@ public:
             if (!f.node->is_table())
                 doc_.fail(f.node, f.key,
                           cond_.context() + fmt::format("expected a procedure table (procedure = {{ kind = "
-                                                        "\"staircase\", ... }}), got {}.",
+                                                        "\"{}\", ... }}), got {}.",
+                                                        procedure_kind_names().front(),
                                                         text::type_phrase(f.node->type())));
             const toml::table& t = *f.node->as_table();
             table_ = f;
@@ -177,7 +167,7 @@ public:
                 if (!parsed)
                     doc_.fail(k, f.key + ".kind",
                               cond_.context() + fmt::format("kind must be one of {}, got \"{}\".",
-                                                            toml_reader::join_quoted(kKindNames), text));
+                                                            toml_reader::join_quoted(procedure_kind_names()), text));
                 if (kind_ && *kind_ != *parsed) entries_.clear();
                 kind_ = parsed;
                 kind_at_ = Found{k, f.key + ".kind"};

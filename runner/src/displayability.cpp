@@ -79,9 +79,7 @@ std::optional<double> interpolate_level(const p::Condition& c, double lo_level, 
 
 /// The name of the bound at the low or high end of a condition's range.
 std::string bound_name(const p::Condition& c, bool high) {
-    if (c.procedure.kind == p::ProcedureKind::ConstantStimuli)
-        return high ? "the highest of its levels" : "the lowest of its levels";
-    return high ? "max_level" : "min_level";
+    return std::string(c.procedure.type().bound_names[high ? 1 : 0]);
 }
 
 /// R1 for one light: it adds less than the display's resolution.

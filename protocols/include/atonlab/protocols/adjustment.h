@@ -34,7 +34,12 @@ class Adjustment : public Procedure {
 public:
     Adjustment(AdjustmentParams params, std::uint64_t seed);
 
-    std::string_view kind() const noexcept override { return "adjustment"; }
+    /// Its name in protocol files, the store and analysis (procedures.h).
+    static constexpr std::string_view kName = "adjustment";
+    /// What protocols and analysis know of the kind (procedures.h; protocols/src/procedure_types/).
+    static const ProcedureType& type();
+
+    std::string_view kind() const noexcept override { return kName; }
     bool finished() const override { return static_cast<int>(matches_.size()) >= params_.n_trials; }
     /// The level to show now; `trial` is the match being made.
     std::optional<Proposal> next() const override;

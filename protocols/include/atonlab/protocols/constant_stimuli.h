@@ -33,7 +33,12 @@ class ConstantStimuli : public Procedure {
 public:
     ConstantStimuli(ConstantStimuliParams params, std::uint64_t seed);
 
-    std::string_view kind() const noexcept override { return "constant-stimuli"; }
+    /// Its name in protocol files, the store and analysis (procedures.h).
+    static constexpr std::string_view kName = "constant-stimuli";
+    /// What protocols and analysis know of the kind (procedures.h; protocols/src/procedure_types/).
+    static const ProcedureType& type();
+
+    std::string_view kind() const noexcept override { return kName; }
     bool finished() const override { return answered_ >= schedule_.size(); }
     std::optional<Proposal> next() const override;
     /// The first crossing of `criterion` by the proportion of Yes, going up the

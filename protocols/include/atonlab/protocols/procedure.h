@@ -26,6 +26,8 @@
 
 namespace atonlab::protocols {
 
+struct ProcedureType;  // what protocols and analysis know of a procedure kind (procedures.h)
+
 /// A bad procedure parameter (or a response the procedure cannot take). Carries
 /// the parameter's name as the protocol file spells it ("step_sizes",
 /// "p_threshold"); the protocol-file parser catches it and adds file and line.

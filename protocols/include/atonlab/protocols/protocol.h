@@ -62,8 +62,7 @@ enum class Role : std::uint8_t { Test, Reference };
 std::string_view to_string(Role r) noexcept;
 std::optional<Role> parse_role(std::string_view text) noexcept;
 
-enum class ProcedureKind : std::uint8_t { Staircase, WeightedStaircase, Quest, Adjustment, ConstantStimuli };
-/// "staircase", "weighted-staircase", "quest", "adjustment", "constant-stimuli".
+/// The registered kind's name (procedures.h).
 std::string_view to_string(ProcedureKind k) noexcept;
 std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcept;
 
@@ -71,10 +70,6 @@ std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcep
 /// wrote it (origin: the file, line and key path "block[0].condition[1].set[0]",
 /// or a conditions file's row and column).
 using Override = ::atonlab::SceneOverride;
-
-/// A procedure and its parameters, 1:1 the procedures' parameter structs.
-using ProcedureParams =
-    std::variant<StaircaseParams, WeightedStaircaseParams, QuestParams, AdjustmentParams, ConstantStimuliParams>;
 
 struct ProcedureSpec {
     ProcedureKind kind = ProcedureKind::Staircase;
@@ -84,6 +79,8 @@ struct ProcedureSpec {
     std::vector<double> track_starts;
 
     std::size_t tracks() const noexcept { return track_starts.empty() ? 1 : track_starts.size(); }
+    /// What protocols and analysis know of its kind (procedures.h).
+    const ProcedureType& type() const noexcept { return procedure_type(kind); }
 
     /// The P(Yes) the procedure converges on, where it has one: a weighted
     /// staircase's target (Kaernbach 1991); a 1-up/n-down staircase 0.5^(1/n)

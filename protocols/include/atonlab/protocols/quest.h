@@ -66,7 +66,12 @@ class Quest : public Procedure {
 public:
     explicit Quest(QuestParams params, std::uint64_t seed = 0);
 
-    std::string_view kind() const noexcept override { return "quest"; }
+    /// Its name in protocol files, the store and analysis (procedures.h).
+    static constexpr std::string_view kName = "quest";
+    /// What protocols and analysis know of the kind (procedures.h; protocols/src/procedure_types/).
+    static const ProcedureType& type();
+
+    std::string_view kind() const noexcept override { return kName; }
     bool finished() const override { return finished_; }
     std::optional<Proposal> next() const override;
     /// QuestMean +- QuestSd.

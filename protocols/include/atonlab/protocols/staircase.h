@@ -67,7 +67,12 @@ class Staircase : public Procedure {
 public:
     explicit Staircase(StaircaseParams params, std::uint64_t seed = 0);
 
-    std::string_view kind() const noexcept override { return "staircase"; }
+    /// Its name in protocol files, the store and analysis (procedures.h).
+    static constexpr std::string_view kName = "staircase";
+    /// What protocols and analysis know of the kind (procedures.h; protocols/src/procedure_types/).
+    static const ProcedureType& type();
+
+    std::string_view kind() const noexcept override { return kName; }
     bool finished() const override { return finished_; }
     std::optional<Proposal> next() const override;
     /// Mean (and sample sd) of the last estimate_reversals reversal levels (all

@@ -36,7 +36,12 @@ class WeightedStaircase : public Staircase {
 public:
     explicit WeightedStaircase(const WeightedStaircaseParams& params, std::uint64_t seed = 0);
 
-    std::string_view kind() const noexcept override { return "weighted-staircase"; }
+    /// Its name in protocol files, the store and analysis (procedures.h).
+    static constexpr std::string_view kName = "weighted-staircase";
+    /// What protocols and analysis know of the kind (procedures.h; protocols/src/procedure_types/).
+    static const ProcedureType& type();
+
+    std::string_view kind() const noexcept override { return kName; }
     std::unique_ptr<Procedure> clone() const override { return std::make_unique<WeightedStaircase>(*this); }
 
     double target() const noexcept { return target_; }
