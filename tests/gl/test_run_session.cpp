@@ -6,7 +6,7 @@
 //  - the stored trials are the schedule's, step by step (Schedule replayed
 //    with the stored answers), every override in the stimulus JSON, a
 //    snapshot per condition;
-//  - SIGKILL at random moments, 20 times: after each kill integrity_check is
+//  - SIGKILL at random moments, 8 times (20 with ATONLAB_LONG_TESTS=1): after each kill integrity_check is
 //    ok, the trials are a prefix of an uninterrupted run's and cover every
 //    trial the child reported committed; --resume-last continues and the
 //    finished sessions equal the uninterrupted run, trial for trial;
@@ -34,6 +34,7 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
+#include "../support/long_tests.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/store/store.h"
@@ -233,16 +234,18 @@ TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
     for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
 }
 
-TEST_F(run, KilledTwentyTimesEachResumeContinuesTheUninterruptedSequence) {
+TEST_F(run, KilledRepeatedlyEachResumeContinuesTheUninterruptedSequence) {
     // Kills between 0.3 and 0.9 of the time a whole run takes, so that most
     // land while a run is going on (a run first checks the protocol's
     // displayability, rendering frames before the study file is created: a
     // fixed 0.3-1.5 s killed every run before it on llvmpipe).
     std::mt19937 rng(20240611);
     std::uniform_int_distribution<int> delay_ms(static_cast<int>(0.3 * ref_ms_), static_cast<int>(0.9 * ref_ms_));
+    // 8 kills in the suite's bounded form, 20 in the long form (tests/support/long_tests.h).
+    const int wanted_kills = test::long_tests() ? 20 : 8;
     int kills = 0, runs = 0, mid_session = 0;
     std::size_t stored_before = 0;
-    while (kills < 20) {
+    while (kills < wanted_kills) {
         ASSERT_LT(++runs, 400) << "the runs finish before they can be killed";
         // Continue the unfinished session if there is one, else begin one.
         bool unfinished = false;

@@ -135,7 +135,7 @@ TEST(StoreDamage, FileCutToHalfIsRefused) {
 // -wal's pages into the file in page order, page 1 (the header with the new,
 // larger page count) first, so the file is shorter than its header says until
 // SQLite completes the checkpoint from the -wal on the next open. (Seen once in
-// GL.run.KilledTwentyTimes..., which kills a session at random moments.) The
+// GL.run.KilledRepeatedly..., which kills a session at random moments.) The
 // state is made here exactly: a writer killed with its frames in the -wal,
 // then the -wal's newest page 1 copied over the file's, as the checkpoint's
 // first write would.
