@@ -4,8 +4,10 @@
 // sentences; the numpy helpers of bindings.h.
 #include <fmt/format.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -105,7 +107,7 @@ py::array glare(const py::array& hdr, double deg_per_px, const std::optional<std
     return rgb_view(std::move(g.image.image));
 }
 
-py::tuple read_exr(const std::string& path) {
+py::tuple read_exr(const std::filesystem::path& path) {
     stimuli::ExrImage in;
     {
         py::gil_scoped_release release;
@@ -115,7 +117,7 @@ py::tuple read_exr(const std::string& path) {
     return py::make_tuple(rgb_view(std::move(in.image)), meta);
 }
 
-void write_exr(const std::string& path, const py::array& hdr, const std::optional<double>& deg_per_px,
+void write_exr(const std::filesystem::path& path, const py::array& hdr, const std::optional<double>& deg_per_px,
                const std::optional<double>& adaptation_cd_m2, const std::string& units,
                const std::optional<std::map<std::string, std::string>>& strings) {
     stimuli::ExrMetadata meta;

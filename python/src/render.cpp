@@ -4,9 +4,12 @@
 // of the frame's memory and its display codes as the display gets them.
 #include <epoxy/egl.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -65,20 +68,29 @@ public:
         const auto started = std::chrono::steady_clock::now();
         auto frame = std::make_unique<runner::RenderedFrame>();
         stimuli::EncodedImage codes;
+        std::vector<std::uint8_t> codes8;
+        double render_s = 0.0;
         {
             py::gil_scoped_release release;
-            GlUse gl;
-            if (!pipeline_) pipeline_ = std::make_unique<stimuli::Pipeline>();
-            *frame = runner::render_frame(*pipeline_, scene_, path_, time_s);
-            codes = pipeline_->display().read_codes();
+            {
+                GlUse gl;
+                if (!pipeline_) pipeline_ = std::make_unique<stimuli::Pipeline>();
+                *frame = runner::render_frame(*pipeline_, scene_, path_, time_s);
+                codes = pipeline_->display().read_codes();
+            }
+            // An 8-bit display's codes as bytes (the library reads them back as
+            // 16-bit values; `atonlab render --png` converts them likewise).
+            if (codes.bits <= 8) codes8.assign(codes.rgb.begin(), codes.rgb.end());
+            render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         }
         PyFrame out;
-        out.render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        out.render_s = render_s;
         out.deg_per_px = frame->meta.degrees_per_pixel;
         out.time_s = time_s;
         out.metadata = metadata_dict(frame->meta);
         out.bits = codes.bits;
-        out.codes = codes_array(std::move(codes));
+        out.codes = codes.bits <= 8 ? owned_array(std::move(codes8), codes.height, codes.width)
+                                    : owned_array(std::move(codes.rgb), codes.height, codes.width);
         out.hdr = rgb_view(std::move(frame->hdr));
         // The RGBA array over the same buffer (hdr's base owns it).
         const py::ssize_t h = out.hdr.shape(0), w = out.hdr.shape(1);
@@ -90,19 +102,12 @@ public:
     }
 
 private:
-    /// The display's codes: uint8 for an 8-bit display (a copy: the library
-    /// holds them as 16-bit), else uint16 without a copy.
-    static py::object codes_array(stimuli::EncodedImage&& codes) {
-        const py::ssize_t h = codes.height, w = codes.width;
-        if (codes.bits <= 8) {
-            py::array_t<std::uint8_t> a({h, w, py::ssize_t{3}});
-            std::uint8_t* q = a.mutable_data();
-            for (std::size_t i = 0; i < codes.rgb.size(); ++i) q[i] = static_cast<std::uint8_t>(codes.rgb[i]);
-            return a;
-        }
-        auto* owned = new std::vector<std::uint16_t>(std::move(codes.rgb));
-        py::capsule base(owned, [](void* p) { delete static_cast<std::vector<std::uint16_t>*>(p); });
-        return py::array_t<std::uint16_t>({h, w, py::ssize_t{3}}, owned->data(), base);
+    /// H×W×3 codes as a numpy array owning `values` (no copy).
+    template <typename T>
+    static py::object owned_array(std::vector<T>&& values, int height, int width) {
+        auto* owned = new std::vector<T>(std::move(values));
+        py::capsule base(owned, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+        return py::array_t<T>({py::ssize_t{height}, py::ssize_t{width}, py::ssize_t{3}}, owned->data(), base);
     }
 
     std::string path_;
@@ -110,7 +115,8 @@ private:
     std::unique_ptr<stimuli::Pipeline> pipeline_;
 };
 
-std::unique_ptr<PyScene> load(const std::string& path, const std::optional<py::dict>& overrides) {
+std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::optional<py::dict>& overrides) {
+    const std::string path = file.string();
     std::vector<SceneOverride> list;
     if (overrides)
         for (const auto& [k, v] : *overrides) {
@@ -168,7 +174,8 @@ void bind_render(py::module_& m) {
         .def_readonly("deg_per_px", &PyFrame::deg_per_px, "Degrees of visual angle per pixel at the image centre.")
         .def_readonly("time_s", &PyFrame::time_s, "The scene time (s) the frame was rendered at.")
         .def_readonly("render_s", &PyFrame::render_s,
-                      "Wall-clock seconds spent in the library (render and read-back), without the Python call.")
+                      "Wall-clock seconds spent in the library: the render, the read-back of the image and the codes "
+                      "(an 8-bit display's as bytes), without the Python call around it.")
         .def_readonly("metadata", &PyFrame::metadata,
                       "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
                       "camera, scene, time_s, software, glare, tonemap, ...")
