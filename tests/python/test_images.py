@@ -121,3 +121,28 @@ def test_a_bad_array_is_an_input_error():
     with pytest.raises(atonlab.InputError) as e:
         atonlab.tonemap(np.zeros((4, 4)))
     assert e.value.option == "hdr"
+
+
+def test_no_gl_context_raises_no_context_error(tmp_path):
+    # glvnd without a vendor library: no EGL display, as on a machine without
+    # GL (`atonlab render` exits 3 with the same sentence). In a child process:
+    # this one may hold a context already.
+    import os
+    import subprocess
+    import sys
+    code = ("import atonlab, sys\n"
+            "try:\n"
+            "    atonlab.Scene.load(sys.argv[1], {'display.width_px': 64, 'display.height_px': 36}).render()\n"
+            "except atonlab.NoContextError as e:\n"
+            "    assert isinstance(e, RuntimeError)\n"
+            "    print('NoContextError:', e)\n")
+    from conftest import QUICKSTART_SCENE
+    env = {**os.environ, "__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "none.json")}
+    r = subprocess.run([sys.executable, "-c", code, str(QUICKSTART_SCENE)], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    from conftest import BINARY
+    c = subprocess.run([BINARY, "render", str(QUICKSTART_SCENE), "-o", str(tmp_path / "x.exr")], capture_output=True,
+                       text=True, env=env)
+    if c.returncode != 3:
+        pytest.skip("not applicable: this machine's EGL does not honour __EGL_VENDOR_LIBRARY_FILENAMES")
+    assert r.stdout.strip() == "NoContextError: " + c.stderr.strip().removeprefix("atonlab: ")
