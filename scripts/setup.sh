@@ -24,6 +24,9 @@ packages=(
   python3 sqlite3  # tests only: the README quick-start walk, the fake spotread's transcripts, reading study files from shell tests
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
   chromium  # the report's layout test renders report.html headless (tests/e2e/report_chromium.sh)
+  pybind11-dev python3-dev python3-numpy  # the Python module atonlab (python/, docs/python.md): pybind11, the headers, numpy arrays
+  python3-pandas  # the Python module's studies as DataFrames (atonlab.read_study, analyze, check's table)
+  python3-pytest python3-matplotlib  # the Python module's tests, and examples/python/glare_matching.py's figures (Agg)
 )
 
 missing=()

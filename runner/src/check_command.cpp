@@ -7,6 +7,8 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <functional>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -78,7 +80,7 @@ void add_check_command(CLI::App& app, CheckOptions& o) {
                     "`atonlab run --db` would (read only)");
 }
 
-int run_check(const CheckOptions& o) {
+Displayability check_protocol(const CheckOptions& o, const std::function<void()>& make_context) {
     p::Protocol protocol = p::load_protocol(o.protocol);
     for (const std::string& set : o.sets) apply_display_set(protocol.display, set);
     stimuli::SceneTemplate scene =
@@ -86,21 +88,27 @@ int run_check(const CheckOptions& o) {
 
     std::optional<display::DisplayModel> model;
     if (!o.db.empty()) {
-        try {
-            const store::Store study = store::Store::open_read_only(o.db);
-            const SessionCalibration cal = session_calibration(&study, protocol.display, std::nullopt, utc_today(), o.db);
-            for (const std::string& w : cal.warnings) std::fprintf(stderr, "atonlab: warning: %s\n", w.c_str());
-            model = cal.display;
-        } catch (const store::StoreError& e) {
-            std::fprintf(stderr, "atonlab: %s\n", e.what());
-            return 4;
-        }
+        const store::Store study = store::Store::open_read_only(o.db);
+        const SessionCalibration cal = session_calibration(&study, protocol.display, std::nullopt, utc_today(), o.db);
+        for (const std::string& w : cal.warnings) std::fprintf(stderr, "atonlab: warning: %s\n", w.c_str());
+        model = cal.display;
     }
-    auto context = gl::create_headless_context();
+    make_context();
     const p::ModelObserverParams params{};
     StimulusRenderer renderer(std::move(scene), params.window_radius_deg, protocol.timing.stimulus_s);
     if (model) renderer.use_display_model(*model);
-    const Displayability d = check_displayability(renderer, protocol);
+    return check_displayability(renderer, protocol);
+}
+
+int run_check(const CheckOptions& o) {
+    std::unique_ptr<gl::Context> context;
+    Displayability d;
+    try {
+        d = check_protocol(o, [&context] { context = gl::create_headless_context(); });
+    } catch (const store::StoreError& e) {
+        std::fprintf(stderr, "atonlab: %s\n", e.what());
+        return 4;
+    }
     std::printf("%s", displayability_table(d).c_str());
     if (d.displayable()) {
         std::printf("every condition can produce a match on this display\n");

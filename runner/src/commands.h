@@ -1,8 +1,13 @@
 #pragma once
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "atonlab/stimuli/image_io.h"
 
 namespace CLI {
 class App;
@@ -43,6 +48,17 @@ struct PsfOptions {
 void add_psf_command(CLI::App& app, PsfOptions& options);
 int run_psf(const PsfOptions& options);
 
+/// What `atonlab psf` writes, computed (the Python module's atonlab.psf): the
+/// RGB PSF first, then the monochromatic one, then any area layers.
+struct PsfImages {
+    std::vector<std::pair<std::filesystem::path, stimuli::ImageRGBA32F>> files;  ///< named after options.exr
+    std::vector<stimuli::ExrMetadata> metas;                                    ///< one per file
+    std::string summary;  ///< the line `atonlab psf` prints
+};
+/// The options checked, then make_context() called (a GL 4.5 context must be
+/// current after it), then the PSFs computed. Throws InputError as the command does.
+PsfImages psf_images(const PsfOptions& options, const std::function<void()>& make_context);
+
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
 /// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
 /// 6 the observer ended the session (quit key, confirmed), 128 + N stopped by signal N.
@@ -64,6 +80,13 @@ struct RunOptions {
     bool true_pse = true;           ///< model observer: compute the true PSE / threshold for the summary
     std::int64_t db_max_bytes = 0;  ///< > 0: the study file may not grow past this (StoreOptions::max_size_bytes)
     bool allow_undisplayable = false;  ///< run a protocol the displayability check refuses (recorded with the session)
+    /// Headless: a GL 4.5 context is already current (the Python module's one
+    /// context) and is used instead of a new one.
+    bool gl_context_current = false;
+    /// Called after each trial is committed with the session's stored trials
+    /// and the schedule's bound (the Python module's progress callback and its
+    /// Ctrl-C check); it may call request_stop() (session/stop_signals.h).
+    std::function<void(std::size_t stored, std::optional<std::size_t> bound)> after_trial;
 
     // On screen (without --headless; docs/running.md "On screen").
     int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary

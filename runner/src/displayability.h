@@ -34,6 +34,7 @@
 // created) unless --allow-undisplayable; `atonlab check` prints the same table
 // and exits 0 or 2.
 #include <glm/vec3.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -97,6 +98,13 @@ struct Displayability {
 /// search range) on `renderer` (set up as the session's: display model and
 /// window radius) and applies R1-R4. Throws InputError (a scene refused).
 Displayability check_displayability(StimulusRenderer& renderer, const protocols::Protocol& protocol);
+
+/// `atonlab check`'s work without its output (the Python module's
+/// atonlab.check): the protocol loaded, its display set, the study file's
+/// calibration read, then make_context() called (a GL 4.5 context must be
+/// current after it) and every condition rendered. Throws InputError and
+/// store::StoreError.
+Displayability check_protocol(const CheckOptions& options, const std::function<void()>& make_context);
 
 /// The table printed in the run header and by `atonlab check`: one line per
 /// condition and end of its range.

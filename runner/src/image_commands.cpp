@@ -11,7 +11,10 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include "atonlab/display/display_model.h"
@@ -105,7 +108,7 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--white-cd-m2", o.white_cd_m2, "linear and clamp: the luminance (cd/m²) shown as display white");
 }
 
-int run_tonemap(const TonemapOptions& o) {
+ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::ExrImage()>& read_input) {
     // Settings first (every check before reading pixels or writing).
     stimuli::OutputSettings out;
     std::optional<double> scene_adaptation;
@@ -174,9 +177,12 @@ int run_tonemap(const TonemapOptions& o) {
         o.epsilon_cd_m2 ? positive(o.epsilon_cd_m2, "--epsilon-cd-m2", "ε") : out.adaptation.epsilon_cd_m2;
     stimuli::validate_output_settings(out);
 
-    stimuli::ExrImage in = stimuli::read_exr(o.input);
-    const std::string units = to_cd_m2(in, o.input, o.scale);
+    stimuli::ExrImage in = read_input();
+    ToneMapped result;
+    result.units = to_cd_m2(in, o.input, o.scale);
     const stimuli::ImageRGBA32F& hdr = in.image;
+    result.width = hdr.width;
+    result.height = hdr.height;
     const double log_average = stimuli::log_average_luminance(hdr, epsilon);  // K2012 eq 4.15
     const double adaptation = o.adaptation_cd_m2 ? *o.adaptation_cd_m2 : scene_adaptation.value_or(log_average);
     if (white_is_max) {
@@ -188,7 +194,8 @@ int run_tonemap(const TonemapOptions& o) {
     }
     display::validate_tonemap_settings(tm);
 
-    std::vector<float> codes(static_cast<std::size_t>(hdr.width) * hdr.height * 3);
+    std::vector<std::uint8_t>& codes = result.codes;
+    codes.resize(static_cast<std::size_t>(hdr.width) * hdr.height * 3);
     std::size_t clipped = 0;
     for (int y = 0; y < hdr.height; ++y)
         for (int x = 0; x < hdr.width; ++x) {
@@ -197,26 +204,38 @@ int run_tonemap(const TonemapOptions& o) {
             if (rel.r > 1 || rel.g > 1 || rel.b > 1) ++clipped;
             // The dither pattern's rows count from the bottom, as on the GPU (frame 0).
             const glm::ivec3 c = display::encode_pixel(out.display, rel, {x, hdr.height - 1 - y}, 0, out.encode);
-            float* q = &codes[(static_cast<std::size_t>(y) * hdr.width + x) * 3];
-            for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(c[k] / 255.0);
+            std::uint8_t* q = &codes[(static_cast<std::size_t>(y) * hdr.width + x) * 3];
+            for (int k = 0; k < 3; ++k) q[k] = static_cast<std::uint8_t>(c[k]);
         }
-    stimuli::write_png_rgb8(o.png, hdr.width, hdr.height, codes);
-
-    std::printf("%s: %dx%d, %s, log-average %.6g cd/m2 -> %s\n", o.input.c_str(), hdr.width, hdr.height, units.c_str(),
-                log_average, o.png.c_str());
-    std::printf("  adaptation_cd_m2=%.6g (%s) operator=%s%s hue_preservation=%s blueshift=%s\n", adaptation,
-                o.adaptation_cd_m2 ? "given"
-                : scene_adaptation ? "the scene's fixed level"
-                                   : "log-average, K2012 eq 4.15",
-                std::string(display::tone_operator_name(tm.tone_operator)).c_str(),
-                tm.tone_operator == display::ToneOperator::reinhard
-                    ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative).c_str()
-                    : "",
-                std::string(display::hue_preservation_name(tm.hue_preservation)).c_str(), tm.blueshift ? "on" : "off");
-    std::printf(
-        "  display=%s peak_cd_m2=%g black_cd_m2=%g bits=8 dither=%s; %zu pixels above display white (clipped)\n",
-        out.display.name.c_str(), out.display.peak_cd_m2, out.display.black_cd_m2,
+    result.log_average_cd_m2 = log_average;
+    result.adaptation_cd_m2 = adaptation;
+    result.clipped = clipped;
+    // What was applied, as `atonlab tonemap` prints it (two lines).
+    result.settings = fmt::format(
+        "  adaptation_cd_m2={:.6g} ({}) operator={}{} hue_preservation={} blueshift={}\n", adaptation,
+        o.adaptation_cd_m2 ? "given"
+        : scene_adaptation ? "the scene's fixed level"
+                           : "log-average, K2012 eq 4.15",
+        display::tone_operator_name(tm.tone_operator),
+        tm.tone_operator == display::ToneOperator::reinhard
+            ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative)
+            : std::string(),
+        display::hue_preservation_name(tm.hue_preservation), tm.blueshift ? "on" : "off");
+    result.settings += fmt::format(
+        "  display={} peak_cd_m2={:g} black_cd_m2={:g} bits=8 dither={}; {} pixels above display white (clipped)\n",
+        out.display.name, out.display.peak_cd_m2, out.display.black_cd_m2,
         out.encode.dither == display::Dither::none ? "off" : "on", clipped);
+    return result;
+}
+
+int run_tonemap(const TonemapOptions& o) {
+    const ToneMapped t = tonemap_image(o, [&o] { return stimuli::read_exr(o.input); });
+    std::vector<float> codes(t.codes.size());
+    for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = static_cast<float>(t.codes[i] / 255.0);
+    stimuli::write_png_rgb8(o.png, t.width, t.height, codes);
+    std::printf("%s: %dx%d, %s, log-average %.6g cd/m2 -> %s\n", o.input.c_str(), t.width, t.height, t.units.c_str(),
+                t.log_average_cd_m2, o.png.c_str());
+    std::fputs(t.settings.c_str(), stdout);
     return 0;
 }
 
@@ -244,7 +263,7 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     cmd->add_option("--psf-size", o.psf_size, "wave-optics: the PSF size N (a power of two; default 512)");
 }
 
-int run_glare(const GlareImageOptions& o) {
+ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli::ExrImage()>& read_input) {
     stimuli::GlareSettings gs;
     gs.model = stimuli::GlareModel::spencer;
     std::optional<double> scene_adaptation;
@@ -279,7 +298,7 @@ int run_glare(const GlareImageOptions& o) {
     if (o.adaptation_cd_m2) positive(o.adaptation_cd_m2, "--adaptation-cd-m2", "the adaptation luminance");
     if (o.degrees_per_pixel) positive(o.degrees_per_pixel, "--deg-per-px", "the degrees per pixel");
 
-    stimuli::ExrImage in = stimuli::read_exr(o.input);
+    stimuli::ExrImage in = read_input();
     const double dpp = o.degrees_per_pixel.value_or(in.meta.degrees_per_pixel);
     if (!(dpp > 0))
         throw InputError(option("--deg-per-px"),
@@ -303,7 +322,7 @@ int run_glare(const GlareImageOptions& o) {
                                                                                       : "--model";
         throw InputError(option(name), e.message());
     }
-    const stimuli::ImageGlareResult r = stimuli::convolve_image_glare(in.image, kernel);
+    stimuli::ImageGlareResult r = stimuli::convolve_image_glare(in.image, kernel);
 
     constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
     const double omega_sr = (dpp * kDegToRad) * (dpp * kDegToRad);
@@ -318,14 +337,24 @@ int run_glare(const GlareImageOptions& o) {
         kernel.radius_px / kernel.pixels_per_degree, stimuli::glare_window_name(gs.window), kernel.window_cut.r,
         kernel.window_cut.g, kernel.window_cut.b, r.edge_cut.r, r.edge_cut.g, r.edge_cut.b);
     meta.strings["image_glare"] = line;
-    stimuli::write_exr(o.output, r.image, meta, stimuli::ExrPixelType::float32);
+    ImageGlared out;
+    out.sums = fmt::format(
+        "  sum L*Omega (cd/m2 sr x pixel Omega {:.6g} sr): in [{:.6g}, {:.6g}, {:.6g}], out [{:.6g}, {:.6g}, {:.6g}]\n",
+        omega_sr, r.input_sum.r * omega_sr, r.input_sum.g * omega_sr, r.input_sum.b * omega_sr,
+        r.output_sum.r * omega_sr, r.output_sum.g * omega_sr, r.output_sum.b * omega_sr);
+    out.image = stimuli::ExrImage{std::move(r.image), std::move(meta)};
+    out.line = line;
+    return out;
+}
 
-    std::printf("%s: %dx%d, %.6g deg/px%s -> %s\n", o.input.c_str(), in.image.width, in.image.height, dpp,
-                o.degrees_per_pixel ? " (given)" : " (degreesPerPixel attribute)", o.output.c_str());
-    std::printf("  %s\n", line.c_str());
-    std::printf("  sum L*Omega (cd/m2 sr x pixel Omega %.6g sr): in [%.6g, %.6g, %.6g], out [%.6g, %.6g, %.6g]\n",
-                omega_sr, r.input_sum.r * omega_sr, r.input_sum.g * omega_sr, r.input_sum.b * omega_sr,
-                r.output_sum.r * omega_sr, r.output_sum.g * omega_sr, r.output_sum.b * omega_sr);
+int run_glare(const GlareImageOptions& o) {
+    const ImageGlared g = glare_image(o, [&o] { return stimuli::read_exr(o.input); });
+    stimuli::write_exr(o.output, g.image.image, g.image.meta, stimuli::ExrPixelType::float32);
+    std::printf("%s: %dx%d, %.6g deg/px%s -> %s\n", o.input.c_str(), g.image.image.width, g.image.image.height,
+                g.image.meta.degrees_per_pixel, o.degrees_per_pixel ? " (given)" : " (degreesPerPixel attribute)",
+                o.output.c_str());
+    std::printf("  %s\n", g.line.c_str());
+    std::fputs(g.sums.c_str(), stdout);
     return 0;
 }
 

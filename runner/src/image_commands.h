@@ -1,8 +1,14 @@
 #pragma once
 // `atonlab tonemap` and `atonlab glare`: HDR images atonlab did not render, in
 // and out (docs/tone-mapping.md "HDR images in and out").
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include "atonlab/stimuli/image_io.h"
 
 namespace CLI {
 class App;
@@ -32,6 +38,23 @@ struct TonemapOptions {
 void add_tonemap_command(CLI::App& app, TonemapOptions& options);
 int run_tonemap(const TonemapOptions& options);
 
+/// What tonemap_image() made: the display's 8-bit codes and what was applied.
+struct ToneMapped {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> codes;  ///< RGB, row 0 at the top, width * height * 3
+    std::string units;                ///< how the input was taken as cd/m²
+    double log_average_cd_m2 = 0.0;   ///< K2012 eq 4.15
+    double adaptation_cd_m2 = 0.0;    ///< the L_wa used
+    std::size_t clipped = 0;          ///< pixels above display white
+    std::string settings;             ///< the two lines `atonlab tonemap` prints after its first
+};
+
+/// `atonlab tonemap`'s work without its files (the Python module's
+/// atonlab.tonemap): the options checked first, then read_input() called for
+/// the scene-referred image (o.input names it in messages), tone-mapped and
+/// encoded on the CPU. Throws InputError as the command does.
+ToneMapped tonemap_image(const TonemapOptions& options, const std::function<stimuli::ExrImage()>& read_input);
+
 struct GlareImageOptions {
     std::string input;   ///< scene-referred EXR
     std::string output;  ///< EXR with the glare added
@@ -48,5 +71,18 @@ struct GlareImageOptions {
 
 void add_glare_command(CLI::App& app, GlareImageOptions& options);
 int run_glare(const GlareImageOptions& options);
+
+/// What glare_image() made: the image with the glare and the EXR attributes
+/// `atonlab glare` writes, and its report lines.
+struct ImageGlared {
+    stimuli::ExrImage image;
+    std::string line;  ///< model, pupil, kernel and cuts (the image_glare attribute)
+    std::string sums;  ///< the energy line `atonlab glare` prints
+};
+
+/// `atonlab glare`'s work without its files (the Python module's
+/// atonlab.glare): the options checked first, then read_input() called for
+/// the image. Throws InputError as the command does.
+ImageGlared glare_image(const GlareImageOptions& options, const std::function<stimuli::ExrImage()>& read_input);
 
 }  // namespace atonlab::runner

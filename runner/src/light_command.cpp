@@ -42,7 +42,7 @@ bool positive_finite(double v) {
 
 }  // namespace
 
-int run_light(const LightOptions& o) {
+LightAnswer light_answer(const LightOptions& o) {
     // Every check before any output.
     if (o.intensity_cd.has_value() == o.range_nmi.has_value())
         throw InputError(SourceLocation::command_line("--intensity-cd"),
@@ -99,6 +99,19 @@ int run_light(const LightOptions& o) {
     const double range_nmi =
         o.range_nmi ? *o.range_nmi
                     : stimuli::allard_range_nmi(intensity_cd, threshold_lux, visibility_nmi, background_factor);
+    LightAnswer a;
+    a.intensity_cd = intensity_cd;
+    a.range_nmi = range_nmi;
+    a.threshold_lux = threshold_lux;
+    a.background_factor = background_factor;
+    a.visibility_nmi = visibility_nmi;
+    return a;
+}
+
+int run_light(const LightOptions& o) {
+    const LightAnswer a = light_answer(o);
+    const double intensity_cd = a.intensity_cd, range_nmi = a.range_nmi, visibility_nmi = a.visibility_nmi;
+    const double threshold_lux = a.threshold_lux, background_factor = a.background_factor;
     const double threshold_eff_lux = threshold_lux * background_factor;
     constexpr double km_per_nmi = stimuli::metres_per_nautical_mile / 1000.0;
 

@@ -25,4 +25,15 @@ struct LightOptions {
 void add_light_command(CLI::App& app, LightOptions& options);
 int run_light(const LightOptions& options);
 
+/// Allard's law's answer (K2012 eq 2.1) for the options, checked as `atonlab light` checks them.
+struct LightAnswer {
+    double intensity_cd = 0.0;       ///< given, or from the range
+    double range_nmi = 0.0;          ///< given, or from the intensity
+    double threshold_lux = 0.0;      ///< E_t of the period (lx), before the background factor
+    double background_factor = 1.0;  ///< 1, 10 or 100
+    double visibility_nmi = 10.0;    ///< V (nmi)
+};
+/// Throws InputError naming the option, as the command does.
+LightAnswer light_answer(const LightOptions& options);
+
 }  // namespace atonlab::runner

@@ -74,7 +74,7 @@ std::filesystem::path sibling(const std::filesystem::path& out, const std::strin
 
 }  // namespace
 
-int run_psf(const PsfOptions& o) {
+PsfImages psf_images(const PsfOptions& o, const std::function<void()>& make_context) {
     // Validate everything before touching the GPU or the output paths.
     stimuli::EyeModel eye;
     if (!o.scene.empty()) eye = stimuli::load_scene(o.scene, {}).glare.eye;
@@ -137,7 +137,7 @@ int run_psf(const PsfOptions& o) {
                          "the display's pixels per degree must be a positive number.");
     const stimuli::SpectralSamples samples = stimuli::spectral_samples(*spd, o.samples);
 
-    auto context = gl::create_headless_context();
+    make_context();
     stimuli::GpuPsfGenerator gen(o.size);
     const double dpt = stimuli::psf_degrees_per_texel(eye);
     gen.generate(eye, samples, o.time_s);
@@ -146,10 +146,9 @@ int run_psf(const PsfOptions& o) {
     const int anchors = stimuli::GlareSettings{}.spectral_anchors;
     const stimuli::RgbPsf rgb = stimuli::spectral_psf_anchored(eye, o.size, samples, anchors, o.time_s);
 
-    // Everything is computed before the first file is written; files are written
-    // atomically, and a failure removes the ones already written.
-    std::vector<std::pair<std::filesystem::path, stimuli::ImageRGBA32F>> files;
-    std::vector<stimuli::ExrMetadata> metas;
+    PsfImages out;
+    auto& files = out.files;
+    auto& metas = out.metas;
     stimuli::ExrMetadata meta;
     meta.units = "relative";
     meta.degrees_per_pixel = dpt;
@@ -188,21 +187,31 @@ int run_psf(const PsfOptions& o) {
             metas.push_back(m);
         }
     }
+    const auto t = gen.timings();
+    out.summary = fmt::format(
+        "psf: N={}, pupil {:.3f} mm, {:.5f} deg/texel (field ±{:.2f} deg), {} samples of {}; GPU {:.1f} ms "
+        "(FFT {:.1f}, mono {:.1f}, spectral {:.1f}); luminance sum {:.6f}\n",
+        o.size, pupil, dpt, o.size / 2 * dpt, o.samples, o.spd,
+        t.upload_ms + t.fft_ms + t.mono_ms + t.spectral_ms, t.fft_ms, t.mono_ms, t.spectral_ms, rgb.luminance_sum());
+    return out;
+}
+
+int run_psf(const PsfOptions& o) {
+    std::unique_ptr<gl::Context> context;
+    PsfImages images = psf_images(o, [&context] { context = gl::create_headless_context(); });
+    const auto& files = images.files;
+    // Everything is computed before the first file is written; files are written
+    // atomically, and a failure removes the ones already written.
     std::size_t written = 0;
     try {
         for (; written < files.size(); ++written)
-            stimuli::write_exr(files[written].first, files[written].second, metas[written]);
+            stimuli::write_exr(files[written].first, files[written].second, images.metas[written]);
     } catch (...) {
         std::error_code ec;
         for (std::size_t i = 0; i < written; ++i) std::filesystem::remove(files[i].first, ec);
         throw;
     }
-    const auto t = gen.timings();
-    std::printf(
-        "psf: N=%d, pupil %.3f mm, %.5f deg/texel (field ±%.2f deg), %d samples of %s; GPU %.1f ms "
-        "(FFT %.1f, mono %.1f, spectral %.1f); luminance sum %.6f\n",
-        o.size, pupil, dpt, o.size / 2 * dpt, o.samples, o.spd.c_str(),
-        t.upload_ms + t.fft_ms + t.mono_ms + t.spectral_ms, t.fft_ms, t.mono_ms, t.spectral_ms, rgb.luminance_sum());
+    std::fputs(images.summary.c_str(), stdout);
     for (const auto& f : files) std::printf("  wrote %s\n", f.first.string().c_str());
     return 0;
 }

@@ -19,6 +19,7 @@
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "commands.h"
+#include "render_frame.h"
 
 namespace atonlab::runner {
 
@@ -64,72 +65,10 @@ int run_render(const RenderOptions& o) {
 
     auto context = gl::create_headless_context();
     stimuli::Pipeline pipeline;
-    // One frame: dynamic adaptation adopts the frame's log-average at once.
-    pipeline.render(scene, o.time_s, 0.0);
-    const stimuli::FrameRenderer& renderer = pipeline.frame();
-    const stimuli::ImageRGBA32F hdr = renderer.read_hdr();
-
-    stimuli::ExrMetadata meta;
-    meta.units = "cd/m2";
-    meta.degrees_per_pixel = renderer.projection().degrees_per_pixel_at_centre();
-    meta.adaptation_cd_m2 = scene.adaptation_cd_m2;
-    const auto& cam = scene.camera;
-    meta.strings["camera"] = fmt::format("position_m=[{}, {}, {}] yaw_deg={} pitch_deg={} roll_deg={} focal_px={:.3f}",
-                                         cam.position_m.x, cam.position_m.y, cam.position_m.z, cam.yaw_deg,
-                                         cam.pitch_deg, cam.roll_deg, renderer.projection().focal_px);
-    meta.strings["scene"] = o.scene;
-    meta.strings["time_s"] = fmt::format("{}", o.time_s);
-    meta.strings["software"] = "atonlab " ATONLAB_VERSION;
-    meta.strings["glare"] = std::string(stimuli::glare_model_name(scene.glare.model));
-    {
-        // Lights with a glare model of their own ([[light]] glare).
-        std::string own;
-        for (const auto& l : scene.lights)
-            if (l.glare.has_value())
-                own += fmt::format("{}{}={}", own.empty() ? "" : " ", l.name,
-                                   stimuli::glare_model_name(stimuli::light_glare_model(scene, l)));
-        if (!own.empty()) meta.strings["glare_lights"] = own;
-        // Every light's glare spectrum (docs/glare.md "The light's spectrum"): its spd, or its colour's.
-        std::string spectra;
-        for (const auto& l : scene.lights)
-            spectra += fmt::format("{}{}={}", spectra.empty() ? "" : " ", l.name, l.spd.empty() ? "d65" : l.spd);
-        if (!spectra.empty()) meta.strings["spd_lights"] = spectra;
-    }
-    const double adapted = pipeline.display().adaptation_cd_m2();
-    meta.strings["tonemap"] = fmt::format(
-        "operator={} adaptation={} adapted_cd_m2={:.6g} blueshift={} hue_preservation={} display={} peak_cd_m2={} "
-        "black_cd_m2={} bits={}{}",
-        display::tone_operator_name(scene.output.tonemap.tone_operator),
-        scene.output.adaptation.mode == stimuli::AdaptationMode::dynamic ? "dynamic" : "fixed", adapted,
-        scene.output.tonemap.blueshift
-            ? std::string(display::blueshift_luminance_name(scene.output.tonemap.blueshift_luminance))
-            : std::string("off"),
-        display::hue_preservation_name(scene.output.tonemap.hue_preservation), scene.output.display.name,
-        scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2, scene.output.encode.bits,
-        scene.output.ldr_glare ? " ldr_glare" : "");
-    std::string glare_note;
-    for (const auto& g : renderer.glare().report()) {
-        const std::string line = fmt::format(
-            "spd={} pupil_mm={:.3f} kernel_px={} radius_deg={:.3f} window={} window_cut_rgb=[{:.4f}, {:.4f}, {:.4f}] "
-            "area_layers={} area_max_radius_px={:.1f}",
-            g.spd.empty() ? "d65" : g.spd, g.pupil_mm, g.kernel_size_px, g.radius_deg,
-            stimuli::glare_window_name(scene.glare.window), g.window_cut.r, g.window_cut.g, g.window_cut.b,
-            g.area_layers, g.area_max_radius_px);
-        const std::string spd = g.spd.empty() ? "d65" : g.spd;
-        meta.strings[g.model == scene.glare.model
-                         ? fmt::format("glare_{}", spd)
-                         : fmt::format("glare_{}_{}", stimuli::glare_model_name(g.model), spd)] = line;
-        glare_note += fmt::format("  glare ({}): {}\n", stimuli::glare_model_name(g.model), line);
-    }
-    if (const stimuli::VeilReport& v = renderer.veil_report(); v.applied) {
-        // The `cie` model: what the frame-sized convolution carried beyond the frame.
-        const std::string line = fmt::format(
-            "cie_age_years={} cie_pigmentation={} outside_frame_rgb=[{:.4f}, {:.4f}, {:.4f}] convolution_ms={:.0f}",
-            v.observer.age_years, v.observer.pigmentation, v.outside_frame.r, v.outside_frame.g, v.outside_frame.b,
-            v.cpu_ms);
-        meta.strings["glare_cie"] = line;
-        glare_note += fmt::format("  glare (cie): {}\n", line);
-    }
+    RenderedFrame frame = render_frame(pipeline, scene, o.scene, o.time_s);
+    const stimuli::ImageRGBA32F& hdr = frame.hdr;
+    stimuli::ExrMetadata& meta = frame.meta;
+    const std::string& glare_note = frame.glare_note;
     if (o.half) {
         // Half floats end at 65504; the core of a bright light is far above that
         // (a 250 cd, 0.1 m light is ~8000 cd/m² ... 1e9 cd/m² sub-pixel). Clamp rather
@@ -165,7 +104,7 @@ int run_render(const RenderOptions& o) {
             throw;
         }
     }
-    const auto st = renderer.stats();
+    const auto& st = frame.stats;
     std::printf("%s: %dx%d, %d of %d lights drawn, %.4f deg/px -> %s%s%s\n", o.scene.c_str(), hdr.width, hdr.height,
                 st.drawn, st.lights, meta.degrees_per_pixel, o.exr.c_str(), o.png.empty() ? "" : ", ", o.png.c_str());
     if (auto it = meta.strings.find("spd_lights"); it != meta.strings.end())

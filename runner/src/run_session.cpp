@@ -188,7 +188,7 @@ int run_session(const RunOptions& o) {
     std::unique_ptr<Presenter> presenter;
     ScreenPresenter* screen = nullptr;
     if (o.headless) {
-        context = gl::create_headless_context();
+        if (!o.gl_context_current) context = gl::create_headless_context();
         presenter = std::make_unique<VirtualPresenter>(protocol.timing.refresh_hz.value_or(60.0),
                                                        protocol.display.width_px, protocol.display.height_px);
     } else {

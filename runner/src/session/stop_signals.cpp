@@ -16,6 +16,10 @@ int stop_signal() noexcept {
     return g_stop_signal;
 }
 
+void request_stop(int signal_number) noexcept {
+    g_stop_signal = signal_number;
+}
+
 StopSignals::StopSignals() {
     g_stop_signal = 0;
     struct sigaction sa {};

@@ -8,6 +8,10 @@ namespace atonlab::runner {
 
 /// The signal that asked the session to stop, 0 while none has.
 int stop_signal() noexcept;
+/// Asks the session to stop as signal `signal_number` would (the Python
+/// module's KeyboardInterrupt, RunOptions::after_trial): the trial being shown
+/// is finished and committed first.
+void request_stop(int signal_number) noexcept;
 
 /// Installs the handlers for its lifetime (the flag is cleared first).
 class StopSignals {

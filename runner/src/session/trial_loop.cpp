@@ -145,6 +145,7 @@ TrialLoopResult run_trials(const SessionParts& s, p::Schedule& schedule, std::si
         ++out.rows;
         previous_ended_trial = !counted || t.task != p::Task::Adjust || *shown.response == p::Response::Confirm;
         s.progress.trial(s.protocol, t, out.rows);
+        if (o.after_trial) o.after_trial(out.rows, schedule.max_trials());
     }
     s.progress.end_line();
     return out;

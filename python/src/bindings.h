@@ -1,0 +1,53 @@
+#pragma once
+// What the binding's files share (docs/python.md): the one GL context of the
+// process, numpy views of the libraries' images, EXR metadata as a dict.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <mutex>
+#include <string>
+
+#include "atonlab/stimuli/image_io.h"
+
+namespace atonlab::python {
+
+namespace py = pybind11;
+
+/// The module's one headless GL 4.5 context, made on first use and kept for
+/// the life of the process, current on the calling thread while a GlUse
+/// lives: the use is serialised (the GIL is released while rendering, so two
+/// Python threads could otherwise share it) and the context is released from
+/// the thread afterwards, so any thread may render next. Nested uses on one
+/// thread (a run's progress callback that renders) share the outer one. Throws
+/// gl::ContextUnavailable (atonlab.NoContextError) where none can be made.
+class GlUse {
+public:
+    GlUse();
+    ~GlUse();
+    GlUse(const GlUse&) = delete;
+    GlUse& operator=(const GlUse&) = delete;
+
+private:
+    std::unique_lock<std::recursive_mutex> lock_;
+};
+
+/// image's R, G, B as an H×W×3 float32 array that borrows the image's memory
+/// (strides skip A): the array owns the image through a capsule, no copy.
+py::array rgb_view(stimuli::ImageRGBA32F&& image);
+/// An H×W×3 or H×W×4 array (any real dtype; C order) as RGBA (A = 1 when absent).
+/// `name` is the argument named in an InputError.
+stimuli::ImageRGBA32F image_from_array(const py::array& array, const char* name);
+/// The EXR header's attributes as a dict: "units", "degreesPerPixel",
+/// "adaptationLuminance", "wavelength" (when present) and every string attribute.
+py::dict metadata_dict(const stimuli::ExrMetadata& meta);
+
+/// A Python value (bool, int, float, str, list, tuple, dict) as TOML value
+/// text, for a scene override. `key` names it in an InputError.
+std::string toml_value(const py::handle& value, const std::string& key);
+
+void bind_exceptions(py::module_& m);
+void bind_render(py::module_& m);
+void bind_images(py::module_& m);
+void bind_study(py::module_& m);
+
+}  // namespace atonlab::python
