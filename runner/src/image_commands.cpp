@@ -223,6 +223,17 @@ int run_tonemap(const TonemapOptions& o) {
 // ---------------------------------------------------------------------------
 // glare
 
+namespace {
+
+constexpr stimuli::GlareModel kDefaultImageModel = stimuli::GlareModel::spencer;
+
+// The models `atonlab glare` takes (those with a CPU kernel), as "a, b or c".
+std::string image_models(std::string_view quote) {
+    return stimuli::glare_model_choices(quote, [](const stimuli::GlareModelType& m) { return m.on_images(); });
+}
+
+}  // namespace
+
 void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "glare",
@@ -231,22 +242,29 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     cmd->add_option("-o,--output", o.output, "Output EXR (32-bit float, the input's header attributes kept)")
         ->required();
     cmd->add_option("--scene", o.scene, "Take [glare] (and the adaptation) from this scene file; options override");
-    cmd->add_option("--model", o.model, "wave-optics, gaussian-bloom, spencer (default) or cie");
+    // The models' names from their registry (glare_models/glare_model_list.h).
+    const auto name = [](stimuli::GlareModel m) { return std::string(stimuli::glare_model_name(m)); };
+    cmd->add_option("--model", o.model, fmt::format("{} (default {})", image_models(""), name(kDefaultImageModel)));
     cmd->add_option("--deg-per-px", o.degrees_per_pixel,
                     "Degrees of visual angle per pixel (default: the EXR's degreesPerPixel attribute)");
     cmd->add_option("--adaptation-cd-m2", o.adaptation_cd_m2,
                     "Adaptation luminance (cd/m²): the pupil (K2012 eq 3.15) and Spencer's vision class (default: "
                     "the EXR's adaptationLuminance attribute, else the image's log-average)");
-    cmd->add_option("--pupil-mm", o.pupil_mm, "wave-optics: the pupil diameter (mm) instead of the adaptation's");
-    cmd->add_option("--radius-deg", o.radius_deg, "The kernel's radius (degrees; default per model, cie 20)");
-    cmd->add_option("--bloom-sigma-deg", o.bloom_sigma_deg, "gaussian-bloom: the standard deviation (degrees)");
+    cmd->add_option("--pupil-mm", o.pupil_mm,
+                    name(stimuli::GlareModel::wave_optics) + ": the pupil diameter (mm) instead of the adaptation's");
+    cmd->add_option("--radius-deg", o.radius_deg,
+                    fmt::format("The kernel's radius (degrees; default per model, {} {})", name(stimuli::GlareModel::cie),
+                                stimuli::glare_model_type(stimuli::GlareModel::cie).default_radius_deg({}, 0.0)));
+    cmd->add_option("--bloom-sigma-deg", o.bloom_sigma_deg,
+                    name(stimuli::GlareModel::gaussian_bloom) + ": the standard deviation (degrees)");
     cmd->add_option("--window", o.window, "The kernel's radial window: silverman (default), epanechnikov or none");
-    cmd->add_option("--psf-size", o.psf_size, "wave-optics: the PSF size N (a power of two; default 512)");
+    cmd->add_option("--psf-size", o.psf_size,
+                    name(stimuli::GlareModel::wave_optics) + ": the PSF size N (a power of two; default 512)");
 }
 
 int run_glare(const GlareImageOptions& o) {
     stimuli::GlareSettings gs;
-    gs.model = stimuli::GlareModel::spencer;
+    gs.model = kDefaultImageModel;
     std::optional<double> scene_adaptation;
     if (!o.scene.empty()) {
         const stimuli::Scene scene = stimuli::load_scene(o.scene, {});
@@ -256,15 +274,13 @@ int run_glare(const GlareImageOptions& o) {
     if (o.model) {
         const auto m = stimuli::glare_model_from_name(*o.model);
         if (!m)
-            throw InputError(
-                option("--model"),
-                fmt::format("unknown glare model '{}'; one of wave-optics, gaussian-bloom, spencer, cie", *o.model));
+            throw InputError(option("--model"),
+                             fmt::format("unknown glare model '{}'; one of {}", *o.model, image_models("")));
         gs.model = *m;
     }
-    if (gs.model == stimuli::GlareModel::none || gs.model == stimuli::GlareModel::aperture)
-        throw InputError(option("--model"),
-                         fmt::format("an image's glare can be wave-optics, gaussian-bloom, spencer or cie, not {}",
-                                     stimuli::glare_model_name(gs.model)));
+    if (!stimuli::glare_model_type(gs.model).on_images())
+        throw InputError(option("--model"), fmt::format("an image's glare can be {}, not {}", image_models(""),
+                                                        stimuli::glare_model_name(gs.model)));
     if (o.pupil_mm) gs.pupil_mm = positive(o.pupil_mm, "--pupil-mm", "the pupil diameter");
     if (o.radius_deg) gs.radius_deg = positive(o.radius_deg, "--radius-deg", "the radius");
     if (o.bloom_sigma_deg) gs.bloom_sigma_deg = positive(o.bloom_sigma_deg, "--bloom-sigma-deg", "the sigma");
