@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
@@ -91,7 +92,9 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--epsilon-cd-m2", o.epsilon_cd_m2, "ε of the log-average (cd/m²; default 1e-6)");
     cmd->add_option("--operator", o.tone_operator,
                     "Tone curve: empirical (default), perceptual, reinhard, kakimoto, linear, clamp");
-    cmd->add_option("--display", o.display, "Display transfer: srgb (default) or pq");
+    cmd->add_option("--display", o.display,
+                    fmt::format("Display transfer: {} (default {})", display::display_encoding_choices(""),
+                                display::display_encoding(display::TransferKind::srgb).name));
     cmd->add_option("--peak-cd-m2", o.peak_cd_m2, "The display's peak white (cd/m²; default 100)");
     cmd->add_option("--black-cd-m2", o.black_cd_m2, "The display's black (cd/m²; default 0.1)");
     cmd->add_option("--dither", o.dither, "on (default: the pipeline's spatio-temporal dither) or off (round)");
@@ -129,13 +132,16 @@ int run_tonemap(const TonemapOptions& o) {
         const double black = o.black_cd_m2 ? *o.black_cd_m2 : out.display.black_cd_m2;
         if (!(black >= 0 && black < peak))
             throw InputError(option("--black-cd-m2"), "the black must be at least 0 and below the peak (cd/m²)");
-        const std::string transfer = o.display.value_or(out.display.name == "PQ" ? "pq" : "srgb");
-        if (transfer == "srgb")
-            out.display = display::DisplayModel::srgb(peak, black);
-        else if (transfer == "pq")
-            out.display = display::DisplayModel::pq(peak, black);
+        // The scene's law when a name alone makes it (display_encodings.h), else sRGB.
+        const display::DisplayEncoding* own = display::display_encoding_of(out.display);
+        const std::string transfer = o.display.value_or(std::string(
+            own != nullptr && own->from_peak_black != nullptr ? own->name
+                                                              : display::display_encoding(display::TransferKind::srgb).name));
+        if (auto d = display::display_from_transfer(transfer, peak, black))
+            out.display = std::move(*d);
         else
-            throw InputError(option("--display"), fmt::format("must be srgb or pq, not '{}'", transfer));
+            throw InputError(option("--display"), fmt::format("must be {}, not '{}'",
+                                                              display::display_encoding_choices(""), transfer));
         tm.display_peak_cd_m2 = peak;
     }
     out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == display::Dither::spatiotemporal)

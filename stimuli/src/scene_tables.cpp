@@ -1,6 +1,8 @@
 // The scene file's single tables: [display], [camera], [environment], [eye], [glare], [tonemap] (scene_reader.h).
 #include "scene_reader.h"
 
+#include "atonlab/display/display_encodings.h"
+
 namespace atonlab::stimuli::scene_reader {
 
 // ---------------------------------------------------------------------------
@@ -200,15 +202,15 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
             s.fail(s.has("black_cd_m2") ? s.get("black_cd_m2") : s.get("peak_cd_m2"), "black_cd_m2",
                    fmt::format("the display's black ({} cd/m²) must be below its peak ({} cd/m²).", number_text(black),
                                number_text(peak)));
-        const std::string transfer = s.string("transfer").value_or("srgb");
-        if (transfer == "srgb")
-            out.display = DisplayModel::srgb(peak, black);
-        else if (transfer == "pq")
-            out.display = DisplayModel::pq(peak, black);
+        // The laws a name alone makes (display_encodings.h); sRGB unless the file says otherwise.
+        const std::string transfer =
+            s.string("transfer").value_or(std::string(display_encoding(TransferKind::srgb).name));
+        if (auto d = display_from_transfer(transfer, peak, black))
+            out.display = std::move(*d);
         else
             s.fail(s.get("transfer"), "transfer",
-                   fmt::format("unknown transfer \"{}\"; it must be \"srgb\" or \"pq\" (or give a calibration file).",
-                               transfer));
+                   fmt::format("unknown transfer \"{}\"; it must be {} (or give a calibration file).", transfer,
+                               display_encoding_choices("\"")));
         if (auto cal = s.string("calibration")) {
             std::filesystem::path p(*cal);
             if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;

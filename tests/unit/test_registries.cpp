@@ -1,4 +1,5 @@
-// The registries (docs/architecture.md "How to add a glare model"): each one's names are unique and read back through every
+// The registries (docs/architecture.md "How to add a glare model", "How to add a
+// display encoding"): each one's names are unique and read back through every
 // reader, and no name is spelled in a string literal outside its registry's
 // files, so that adding one touches only the files the doc names.
 #include <gtest/gtest.h>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "atonlab/common/scene_override.h"
+#include "atonlab/display/display_encodings.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/image_glare.h"
 #include "atonlab/stimuli/scene.h"
@@ -22,6 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace atonlab::stimuli;
+namespace display = atonlab::display;
 
 std::string read_text(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -53,6 +57,12 @@ std::vector<Registry> registries() {
         if (m->id() != GlareModel::none) glare.words.emplace_back(m->name());
     out.push_back(glare);
 
+    Registry encodings{"display encodings", {}, {}, {"display/include/atonlab/display/display_encodings.h",
+                                                     "display/src/display_encodings.cpp"}};
+    for (const display::DisplayEncoding& e : display::display_encodings())
+        // "gog" and "lut" are also the JSON fields holding those laws' parameters (fit_json): not scanned.
+        if (e.from_peak_black != nullptr) encodings.words.emplace_back(e.name);
+    out.push_back(encodings);
     return out;
 }
 
@@ -265,6 +275,46 @@ TEST(Registries, EveryImageGlareKernelConservesEnergy) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], 1.0, 1e-5) << m->name() << " channel " << c;
     }
     EXPECT_GE(models, 1);
+}
+
+// ---------------------------------------------------------------------------
+// Display encodings.
+
+TEST(Registries, DisplayEncodingsAreUniqueAndPairedWithTheirGlsl) {
+    const std::string glsl = read_text(fs::path(ATONLAB_SOURCE_DIR) / "stimuli/shaders/display_encode.glsl");
+    const std::string dispatch = display::display_encodings_glsl();
+    std::set<std::string_view> names, display_names, functions;
+    std::size_t i = 0;
+    for (const display::DisplayEncoding& e : display::display_encodings()) {
+        EXPECT_EQ(static_cast<std::size_t>(e.kind), i++) << e.name;
+        EXPECT_TRUE(names.insert(e.name).second) << e.name;
+        EXPECT_TRUE(display_names.insert(e.display_name).second) << e.display_name;
+        EXPECT_TRUE(functions.insert(e.glsl_drive_function).second) << e.glsl_drive_function;
+        EXPECT_EQ(display::display_encoding_named(e.name), &e);
+        EXPECT_NE(glsl.find("double " + std::string(e.glsl_drive_function) + "(DisplayChannel c, double L)"),
+                  std::string::npos)
+            << e.name << ": display_encode.glsl has no " << e.glsl_drive_function;
+        EXPECT_NE(dispatch.find(std::string(e.glsl_drive_function) + "(c, L)"), std::string::npos) << e.name;
+    }
+    EXPECT_EQ(display::display_encoding_named("PQ"), nullptr);
+}
+
+TEST(Registries, EveryNamedDisplayReadsBackFromASceneAndItsFitJson) {
+    for (const display::DisplayEncoding& e : display::display_encodings()) {
+        if (e.from_peak_black == nullptr) continue;
+        const std::string name(e.name);
+        const Scene s = parse_scene(kScene, "registry.toml",
+                                    {atonlab::SceneOverride::parse("display.transfer=\"" + name + "\"")});
+        EXPECT_EQ(display::display_encoding_of(s.output.display), &e) << name;
+        EXPECT_EQ(s.output.display.name, e.display_name) << name;
+        const display::DisplayModel d = *display::display_from_transfer(name, 200.0, 0.1);
+        for (const display::ChannelTransfer& ch : d.channels) {
+            EXPECT_EQ(ch.kind, e.kind);
+            // The law and its inverse agree (the registry pairs them): L(V(L)) = L.
+            const double L = 0.5 * (ch.min_cd_m2() + ch.max_cd_m2());
+            EXPECT_NEAR(ch.luminance_cd_m2(ch.drive_for(L)), L, 1e-9 * ch.max_cd_m2()) << name;
+        }
+    }
 }
 
 }  // namespace
