@@ -8,6 +8,8 @@
 #include <span>
 
 #include "atonlab/display/colour.h"
+#include "atonlab/display/display_encodings.h"
+#include "transfer_laws.h"
 
 namespace atonlab::display {
 namespace {
@@ -200,21 +202,49 @@ double pq_inverse_eotf(double L_cd_m2) {
 // ---------------------------------------------------------------------------
 // One channel.
 
+// The laws (display_encodings.h pairs each with its GLSL twin).
+
+namespace transfer_law {
+
+double srgb_luminance(const ChannelTransfer& ch, double v) {
+    return ch.black_cd_m2 + (ch.white_cd_m2 - ch.black_cd_m2) * srgb_decode(v);
+}
+double srgb_drive(const ChannelTransfer& ch, double L) {
+    return srgb_encode_exact((L - ch.black_cd_m2) / (ch.white_cd_m2 - ch.black_cd_m2));
+}
+
+double gog_luminance(const ChannelTransfer& ch, double v) {
+    const double base = ch.gog.b + ch.gog.k * v;
+    return base > 0.0 ? ch.gog.a + std::pow(base, ch.gog.gamma) : ch.gog.a;
+}
+double gog_drive(const ChannelTransfer& ch, double L) {
+    // L > L(0) >= a here, so the base is positive.
+    return (std::pow(L - ch.gog.a, 1.0 / ch.gog.gamma) - ch.gog.b) / ch.gog.k;
+}
+
+double lut_luminance(const ChannelTransfer& ch, double v) {
+    return display::lut_luminance(ch.lut, v);
+}
+double lut_drive(const ChannelTransfer& ch, double L) {
+    return L >= ch.max_cd_m2() ? 1.0 : display::lut_drive(ch.lut, L);
+}
+
+double pq_luminance(const ChannelTransfer& ch, double v) {
+    return std::clamp(ch.pq_weight * pq_eotf_cd_m2(v), ch.black_cd_m2, ch.white_cd_m2);
+}
+double pq_drive(const ChannelTransfer& ch, double L) {
+    const double ym1 = std::pow((L / ch.pq_weight) / kPqPeak, kPqM1);
+    return std::pow((kPqC1 + kPqC2 * ym1) / (1.0 + kPqC3 * ym1), kPqM2);
+}
+
+}  // namespace transfer_law
+
+// ---------------------------------------------------------------------------
+// One channel.
+
 double ChannelTransfer::luminance_cd_m2(double drive) const {
     const double v = std::isnan(drive) ? 0.0 : std::clamp(drive, 0.0, 1.0);
-    switch (kind) {
-        case TransferKind::srgb:
-            return black_cd_m2 + (white_cd_m2 - black_cd_m2) * srgb_decode(v);
-        case TransferKind::gog: {
-            const double base = gog.b + gog.k * v;
-            return base > 0.0 ? gog.a + std::pow(base, gog.gamma) : gog.a;
-        }
-        case TransferKind::lut:
-            return lut_luminance(lut, v);
-        case TransferKind::pq:
-            return std::clamp(pq_weight * pq_eotf_cd_m2(v), black_cd_m2, white_cd_m2);
-    }
-    return 0.0;
+    return display_encoding(kind).luminance_cd_m2(*this, v);
 }
 
 double ChannelTransfer::min_cd_m2() const {
@@ -229,25 +259,7 @@ double ChannelTransfer::drive_for(double L_cd_m2) const {
     // Below (or at) black, and NaN: drive 0, the smallest drive that gives L(0).
     if (!(L_cd_m2 > lmin)) return 0.0;
     const double L = std::min(L_cd_m2, lmax);
-    double v = 0.0;
-    switch (kind) {
-        case TransferKind::srgb:
-            v = srgb_encode_exact((L - black_cd_m2) / (white_cd_m2 - black_cd_m2));
-            break;
-        case TransferKind::gog:
-            // L > lmin >= a here, so the base is positive.
-            v = (std::pow(L - gog.a, 1.0 / gog.gamma) - gog.b) / gog.k;
-            break;
-        case TransferKind::lut:
-            v = L >= lmax ? 1.0 : lut_drive(lut, L);
-            break;
-        case TransferKind::pq: {
-            const double ym1 = std::pow((L / pq_weight) / kPqPeak, kPqM1);
-            v = std::pow((kPqC1 + kPqC2 * ym1) / (1.0 + kPqC3 * ym1), kPqM2);
-            break;
-        }
-    }
-    return std::clamp(v, 0.0, 1.0);
+    return std::clamp(display_encoding(kind).drive_for(*this, L), 0.0, 1.0);
 }
 
 // ---------------------------------------------------------------------------
@@ -332,9 +344,8 @@ void DisplayModel::validate(const SourceLocation& where) const {
         const auto& ch = channels[static_cast<std::size_t>(c)];
         const std::string cn = channel_name(c);
         switch (ch.kind) {
-            case TransferKind::srgb:
-            case TransferKind::pq:
-                break;  // their black and white are checked against the display's below
+            default:
+                break;  // the laws made from a black and a white: checked against the display's below
             case TransferKind::gog: {
                 const auto& g = ch.gog;
                 const std::string key = cn + ".gog.";
@@ -416,30 +427,22 @@ void DisplayModel::validate(const SourceLocation& where) const {
         fail("black_cd_m2",
              fmt::format("the black luminance ({} cd/m²) must be below the peak ({} cd/m²)", black_cd_m2, peak_cd_m2));
 
-    // sRGB and PQ channels: their share of black and peak.
+    // The channels of the laws made from a black and a white alone (sRGB, PQ;
+    // display_encodings.h): their share of black and peak.
     for (int c = 0; c < 3; ++c) {
         const auto& ch = channels[static_cast<std::size_t>(c)];
         const std::string cn = channel_name(c);
-        switch (ch.kind) {
-            case TransferKind::srgb:
-            case TransferKind::pq: {
-                if (!finite(ch.black_cd_m2) || ch.black_cd_m2 < 0.0)
-                    fail(cn + ".black_cd_m2", fmt::format("the {} channel's black must be zero or more cd/m²", cn));
-                if (!finite(ch.white_cd_m2) || ch.white_cd_m2 <= ch.black_cd_m2)
-                    fail(cn + ".white_cd_m2",
-                         fmt::format("the {} channel's white ({} cd/m²) must be above its black ({} cd/m²)", cn,
-                                     ch.white_cd_m2, ch.black_cd_m2));
-                if (ch.kind == TransferKind::pq) {
-                    if (!finite(ch.pq_weight) || ch.pq_weight <= 0.0)
-                        fail(cn + ".pq_weight", fmt::format("the {} channel's PQ weight must be positive", cn));
-                    if (ch.white_cd_m2 > ch.pq_weight * kPqPeak * (1.0 + 1e-12))
-                        fail("peak_cd_m2", fmt::format("a PQ display cannot show more than {} cd/m²", kPqPeak));
-                }
-                break;
-            }
-            case TransferKind::gog:
-            case TransferKind::lut:
-                break;
+        if (display_encoding(ch.kind).from_peak_black == nullptr) continue;
+        if (!finite(ch.black_cd_m2) || ch.black_cd_m2 < 0.0)
+            fail(cn + ".black_cd_m2", fmt::format("the {} channel's black must be zero or more cd/m²", cn));
+        if (!finite(ch.white_cd_m2) || ch.white_cd_m2 <= ch.black_cd_m2)
+            fail(cn + ".white_cd_m2", fmt::format("the {} channel's white ({} cd/m²) must be above its black ({} cd/m²)",
+                                                  cn, ch.white_cd_m2, ch.black_cd_m2));
+        if (ch.kind == TransferKind::pq) {
+            if (!finite(ch.pq_weight) || ch.pq_weight <= 0.0)
+                fail(cn + ".pq_weight", fmt::format("the {} channel's PQ weight must be positive", cn));
+            if (ch.white_cd_m2 > ch.pq_weight * kPqPeak * (1.0 + 1e-12))
+                fail("peak_cd_m2", fmt::format("a PQ display cannot show more than {} cd/m²", kPqPeak));
         }
     }
 

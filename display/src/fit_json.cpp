@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/display_encodings.h"
 
 namespace atonlab::display {
 namespace {
@@ -12,20 +13,6 @@ namespace {
 using Json = nlohmann::ordered_json;  // keys in the order written (docs/calibration.md)
 
 const char* const kChannelNames[3] = {"red", "green", "blue"};
-
-const char* transfer_name(TransferKind k) {
-    switch (k) {
-        case TransferKind::srgb:
-            return "srgb";
-        case TransferKind::gog:
-            return "gog";
-        case TransferKind::lut:
-            return "lut";
-        case TransferKind::pq:
-            return "pq";
-    }
-    return "?";
-}
 
 Json gog_json(const GogParams& p) {
     return Json{{"a", p.a}, {"b", p.b}, {"k", p.k}, {"gamma", p.gamma}};
@@ -41,27 +28,22 @@ Json channels_json(const DisplayModel& model) {
     Json channels = Json::array();
     for (int c = 0; c < 3; ++c) {
         const ChannelTransfer& ch = model.channels[static_cast<std::size_t>(c)];
-        // srgb and pq are defined by their black and white; gog and lut carry them for the reader's eye.
-        const bool own = ch.kind == TransferKind::srgb || ch.kind == TransferKind::pq;
+        // The laws made from a black and a white (sRGB, PQ) are defined by them; the fitted ones carry
+        // them for the reader's eye.
+        const bool own = display_encoding(ch.kind).from_peak_black != nullptr;
         Json j{{"channel", kChannelNames[c]},
-               {"transfer", transfer_name(ch.kind)},
+               {"transfer", std::string(display_encoding(ch.kind).name)},
                {"black_cd_m2", own ? ch.black_cd_m2 : ch.min_cd_m2()},
                {"white_cd_m2", own ? ch.white_cd_m2 : ch.max_cd_m2()}};
-        switch (ch.kind) {
-            case TransferKind::srgb:
-                break;
-            case TransferKind::gog:
-                j.update(gog_json(ch.gog));
-                break;
-            case TransferKind::pq:
-                j["pq_weight"] = ch.pq_weight;
-                break;
-            case TransferKind::lut: {
-                Json points = Json::array();
-                for (const LutPoint& p : ch.lut) points.push_back(Json::array({p.drive, p.cd_m2}));
-                j["lut"] = std::move(points);
-                break;
-            }
+        // Each law's own parameters (display_model.h ChannelTransfer).
+        if (ch.kind == TransferKind::gog) {
+            j.update(gog_json(ch.gog));
+        } else if (ch.kind == TransferKind::pq) {
+            j["pq_weight"] = ch.pq_weight;
+        } else if (ch.kind == TransferKind::lut) {
+            Json points = Json::array();
+            for (const LutPoint& p : ch.lut) points.push_back(Json::array({p.drive, p.cd_m2}));
+            j["lut"] = std::move(points);
         }
         channels.push_back(std::move(j));
     }
@@ -152,22 +134,25 @@ DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string 
         const std::string cat = fmt::format("{}channels[{}].", at, c);
         if (!cj.is_object()) missing(fmt::format("has no object {}", cat));
         const auto transfer = cj.find("transfer");
-        const std::string kind = transfer != cj.end() && transfer->is_string() ? transfer->get<std::string>() : "";
+        const std::string law = transfer != cj.end() && transfer->is_string() ? transfer->get<std::string>() : "";
+        const DisplayEncoding* encoding = display_encoding_named(law);
+        if (encoding == nullptr)
+            missing(fmt::format("has no known transfer {}transfer ({})", cat, display_encoding_choices("", true)));
         ChannelTransfer& ch = model.channels[c];
-        if (kind == "srgb" || kind == "pq") {
-            ch.kind = kind == "srgb" ? TransferKind::srgb : TransferKind::pq;
+        ch.kind = encoding->kind;
+        // Each law's parameters (display_model.h ChannelTransfer).
+        const TransferKind kind = encoding->kind;
+        if (encoding->from_peak_black != nullptr) {  // sRGB, PQ: their black and white
             ch.black_cd_m2 = number(cj, cat, "black_cd_m2");
             ch.white_cd_m2 = number(cj, cat, "white_cd_m2");
             // Rows written before the weight was stored: a PQ channel's weight is its share of the peak.
             if (ch.kind == TransferKind::pq)
                 ch.pq_weight =
                     cj.contains("pq_weight") ? number(cj, cat, "pq_weight") : ch.white_cd_m2 / model.peak_cd_m2;
-        } else if (kind == "gog") {
-            ch.kind = TransferKind::gog;
+        } else if (kind == TransferKind::gog) {
             ch.gog =
                 GogParams{number(cj, cat, "a"), number(cj, cat, "b"), number(cj, cat, "k"), number(cj, cat, "gamma")};
-        } else if (kind == "lut") {
-            ch.kind = TransferKind::lut;
+        } else if (kind == TransferKind::lut) {
             const auto lut = cj.find("lut");
             if (lut == cj.end() || !lut->is_array() || lut->empty()) missing(fmt::format("has no points {}lut", cat));
             for (std::size_t i = 0; i < lut->size(); ++i) {
@@ -176,8 +161,6 @@ DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string 
                     missing(fmt::format("has no [drive, cd_m2] pair {}lut[{}]", cat, i));
                 ch.lut.push_back(LutPoint{p[0].get<double>(), p[1].get<double>()});
             }
-        } else {
-            missing(fmt::format("has no known transfer {}transfer (srgb, gog, lut or pq)", cat));
         }
     }
     return model;

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
@@ -94,7 +95,9 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--epsilon-cd-m2", o.epsilon_cd_m2, "ε of the log-average (cd/m²; default 1e-6)");
     cmd->add_option("--operator", o.tone_operator,
                     "Tone curve: empirical (default), perceptual, reinhard, kakimoto, linear, clamp");
-    cmd->add_option("--display", o.display, "Display transfer: srgb (default) or pq");
+    cmd->add_option("--display", o.display,
+                    fmt::format("Display transfer: {} (default {})", display::display_encoding_choices(""),
+                                display::display_encoding(display::TransferKind::srgb).name));
     cmd->add_option("--peak-cd-m2", o.peak_cd_m2, "The display's peak white (cd/m²; default 100)");
     cmd->add_option("--black-cd-m2", o.black_cd_m2, "The display's black (cd/m²; default 0.1)");
     cmd->add_option("--dither", o.dither, "on (default: the pipeline's spatio-temporal dither) or off (round)");
@@ -132,13 +135,16 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
         const double black = o.black_cd_m2 ? *o.black_cd_m2 : out.display.black_cd_m2;
         if (!(black >= 0 && black < peak))
             throw InputError(option("--black-cd-m2"), "the black must be at least 0 and below the peak (cd/m²)");
-        const std::string transfer = o.display.value_or(out.display.name == "PQ" ? "pq" : "srgb");
-        if (transfer == "srgb")
-            out.display = display::DisplayModel::srgb(peak, black);
-        else if (transfer == "pq")
-            out.display = display::DisplayModel::pq(peak, black);
+        // The scene's law when a name alone makes it (display_encodings.h), else sRGB.
+        const display::DisplayEncoding* own = display::display_encoding_of(out.display);
+        const std::string transfer = o.display.value_or(std::string(
+            own != nullptr && own->from_peak_black != nullptr ? own->name
+                                                              : display::display_encoding(display::TransferKind::srgb).name));
+        if (auto d = display::display_from_transfer(transfer, peak, black))
+            out.display = std::move(*d);
         else
-            throw InputError(option("--display"), fmt::format("must be srgb or pq, not '{}'", transfer));
+            throw InputError(option("--display"), fmt::format("must be {}, not '{}'",
+                                                              display::display_encoding_choices(""), transfer));
         tm.display_peak_cd_m2 = peak;
     }
     out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == display::Dither::spatiotemporal)
@@ -242,6 +248,17 @@ int run_tonemap(const TonemapOptions& o) {
 // ---------------------------------------------------------------------------
 // glare
 
+namespace {
+
+constexpr stimuli::GlareModel kDefaultImageModel = stimuli::GlareModel::spencer;
+
+// The models `atonlab glare` takes (those with a CPU kernel), as "a, b or c".
+std::string image_models(std::string_view quote) {
+    return stimuli::glare_model_choices(quote, [](const stimuli::GlareModelType& m) { return m.on_images(); });
+}
+
+}  // namespace
+
 void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "glare",
@@ -250,22 +267,29 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     cmd->add_option("-o,--output", o.output, "Output EXR (32-bit float, the input's header attributes kept)")
         ->required();
     cmd->add_option("--scene", o.scene, "Take [glare] (and the adaptation) from this scene file; options override");
-    cmd->add_option("--model", o.model, "wave-optics, gaussian-bloom, spencer (default) or cie");
+    // The models' names from their registry (glare_models/glare_model_list.h).
+    const auto name = [](stimuli::GlareModel m) { return std::string(stimuli::glare_model_name(m)); };
+    cmd->add_option("--model", o.model, fmt::format("{} (default {})", image_models(""), name(kDefaultImageModel)));
     cmd->add_option("--deg-per-px", o.degrees_per_pixel,
                     "Degrees of visual angle per pixel (default: the EXR's degreesPerPixel attribute)");
     cmd->add_option("--adaptation-cd-m2", o.adaptation_cd_m2,
                     "Adaptation luminance (cd/m²): the pupil (K2012 eq 3.15) and Spencer's vision class (default: "
                     "the EXR's adaptationLuminance attribute, else the image's log-average)");
-    cmd->add_option("--pupil-mm", o.pupil_mm, "wave-optics: the pupil diameter (mm) instead of the adaptation's");
-    cmd->add_option("--radius-deg", o.radius_deg, "The kernel's radius (degrees; default per model, cie 20)");
-    cmd->add_option("--bloom-sigma-deg", o.bloom_sigma_deg, "gaussian-bloom: the standard deviation (degrees)");
+    cmd->add_option("--pupil-mm", o.pupil_mm,
+                    name(stimuli::GlareModel::wave_optics) + ": the pupil diameter (mm) instead of the adaptation's");
+    cmd->add_option("--radius-deg", o.radius_deg,
+                    fmt::format("The kernel's radius (degrees; default per model, {} {})", name(stimuli::GlareModel::cie),
+                                stimuli::glare_model_type(stimuli::GlareModel::cie).default_radius_deg({}, 0.0)));
+    cmd->add_option("--bloom-sigma-deg", o.bloom_sigma_deg,
+                    name(stimuli::GlareModel::gaussian_bloom) + ": the standard deviation (degrees)");
     cmd->add_option("--window", o.window, "The kernel's radial window: silverman (default), epanechnikov or none");
-    cmd->add_option("--psf-size", o.psf_size, "wave-optics: the PSF size N (a power of two; default 512)");
+    cmd->add_option("--psf-size", o.psf_size,
+                    name(stimuli::GlareModel::wave_optics) + ": the PSF size N (a power of two; default 512)");
 }
 
 ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli::ExrImage()>& read_input) {
     stimuli::GlareSettings gs;
-    gs.model = stimuli::GlareModel::spencer;
+    gs.model = kDefaultImageModel;
     std::optional<double> scene_adaptation;
     if (!o.scene.empty()) {
         const stimuli::Scene scene = stimuli::load_scene(o.scene, {});
@@ -275,15 +299,13 @@ ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli:
     if (o.model) {
         const auto m = stimuli::glare_model_from_name(*o.model);
         if (!m)
-            throw InputError(
-                option("--model"),
-                fmt::format("unknown glare model '{}'; one of wave-optics, gaussian-bloom, spencer, cie", *o.model));
+            throw InputError(option("--model"),
+                             fmt::format("unknown glare model '{}'; one of {}", *o.model, image_models("")));
         gs.model = *m;
     }
-    if (gs.model == stimuli::GlareModel::none || gs.model == stimuli::GlareModel::aperture)
-        throw InputError(option("--model"),
-                         fmt::format("an image's glare can be wave-optics, gaussian-bloom, spencer or cie, not {}",
-                                     stimuli::glare_model_name(gs.model)));
+    if (!stimuli::glare_model_type(gs.model).on_images())
+        throw InputError(option("--model"), fmt::format("an image's glare can be {}, not {}", image_models(""),
+                                                        stimuli::glare_model_name(gs.model)));
     if (o.pupil_mm) gs.pupil_mm = positive(o.pupil_mm, "--pupil-mm", "the pupil diameter");
     if (o.radius_deg) gs.radius_deg = positive(o.radius_deg, "--radius-deg", "the radius");
     if (o.bloom_sigma_deg) gs.bloom_sigma_deg = positive(o.bloom_sigma_deg, "--bloom-sigma-deg", "the sigma");

@@ -75,8 +75,9 @@ RenderedFrame render_frame(stimuli::Pipeline& pipeline, const stimuli::Scene& sc
             "cie_age_years={} cie_pigmentation={} outside_frame_rgb=[{:.4f}, {:.4f}, {:.4f}] convolution_ms={:.0f}",
             v.observer.age_years, v.observer.pigmentation, v.outside_frame.r, v.outside_frame.g, v.outside_frame.b,
             v.cpu_ms);
-        meta.strings["glare_cie"] = line;
-        glare_note += fmt::format("  glare (cie): {}\n", line);
+        const std::string_view cie = stimuli::glare_model_name(stimuli::GlareModel::cie);
+        meta.strings[fmt::format("glare_{}", cie)] = line;
+        glare_note += fmt::format("  glare ({}): {}\n", cie, line);
     }
     out.stats = renderer.stats();
     return out;

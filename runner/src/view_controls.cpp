@@ -107,10 +107,10 @@ std::string ViewControls::press(ViewKey key, double adapted_cd_m2) {
             }
             return fmt::format("glare {}", stimuli::glare_model_name(s.glare.model));
         case ViewKey::glare_cycle: {
-            std::vector<stimuli::GlareModel> models = {
-                stimuli::GlareModel::wave_optics, stimuli::GlareModel::gaussian_bloom, stimuli::GlareModel::spencer};
-            if (!s.glare.aperture_image.empty()) models.push_back(stimuli::GlareModel::aperture);
-            models.push_back(stimuli::GlareModel::cie);  // CIE veil over the whole frame (docs/glare.md)
+            // Every model that draws glare and can with these settings (the aperture needs its image).
+            std::vector<stimuli::GlareModel> models;
+            for (const stimuli::GlareModelType* m : stimuli::glare_models())
+                if (m->available(s.glare)) models.push_back(m->id());
             const auto it = std::find(models.begin(), models.end(), s.glare.model);
             s.glare.model = it == models.end() || it + 1 == models.end() ? models.front() : *(it + 1);
             last_glare_ = s.glare.model;

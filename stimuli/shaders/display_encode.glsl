@@ -15,10 +15,6 @@
 #define DISPLAY_LUT_BINDING 7
 #endif
 
-const int DISPLAY_SRGB = 0;  // TransferKind::srgb
-const int DISPLAY_GOG = 1;   // TransferKind::gog
-const int DISPLAY_LUT = 2;   // TransferKind::lut
-const int DISPLAY_PQ = 3;    // TransferKind::pq
 const int DISPLAY_DITHER_NONE = 0;
 
 struct DisplayChannel {
@@ -169,24 +165,35 @@ double display_lut_drive(DisplayChannel c, double L) {
     return v0 + t * h;
 }
 
+// One function per encoding, each the twin of its CPU law's inverse (display_encodings.h
+// names them), for black < L <= white.
+double display_drive_srgb(DisplayChannel c, double L) {
+    double t = (L - c.black_cd_m2) / (c.white_cd_m2 - c.black_cd_m2);
+    // max(): the power branch dips 3e-8 below the break just above it (display_model.cpp).
+    return t <= 0.0031308049535603713LF ? 12.92LF * t
+                                        : max(1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF, 0.04045LF);
+}
+
+double display_drive_gog(DisplayChannel c, double L) {
+    return (display_pow(L - c.a, c.inv_gamma) - c.b) / c.k;
+}
+
+double display_drive_lut(DisplayChannel c, double L) {
+    return L >= c.white_cd_m2 ? 1.0LF : display_lut_drive(c, L);
+}
+
+double display_drive_pq(DisplayChannel c, double L) {  // SMPTE ST 2084 inverse EOTF of L / weight
+    double ym1 = display_pow((L / c.pq_weight) / 10000.0LF, 0.1593017578125LF);
+    return display_pow((0.8359375LF + 18.8515625LF * ym1) / (1.0LF + 18.6875LF * ym1), 78.84375LF);
+}
+
+// display_drive_by_kind(c, L): the function of c's kind, generated from the registry.
+#include "display_encodings.glsl"
+
 double display_drive_for(DisplayChannel c, double L) {
     if (!(L > c.black_cd_m2)) return 0.0LF;
     L = min(L, c.white_cd_m2);
-    double v = 0.0LF;
-    if (c.kind == DISPLAY_SRGB) {
-        double t = (L - c.black_cd_m2) / (c.white_cd_m2 - c.black_cd_m2);
-        // max(): the power branch dips 3e-8 below the break just above it (display_model.cpp).
-        v = t <= 0.0031308049535603713LF ? 12.92LF * t
-                                          : max(1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF, 0.04045LF);
-    } else if (c.kind == DISPLAY_GOG) {
-        v = (display_pow(L - c.a, c.inv_gamma) - c.b) / c.k;
-    } else if (c.kind == DISPLAY_LUT) {
-        v = L >= c.white_cd_m2 ? 1.0LF : display_lut_drive(c, L);
-    } else {  // PQ: SMPTE ST 2084 inverse EOTF of L / weight
-        double ym1 = display_pow((L / c.pq_weight) / 10000.0LF, 0.1593017578125LF);
-        v = display_pow((0.8359375LF + 18.8515625LF * ym1) / (1.0LF + 18.6875LF * ym1), 78.84375LF);
-    }
-    return clamp(v, 0.0LF, 1.0LF);
+    return clamp(display_drive_by_kind(c, L), 0.0LF, 1.0LF);
 }
 
 // ---------------------------------------------------------------------------

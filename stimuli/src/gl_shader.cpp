@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/gl/objects.h"
 #include "gl_enums.h"
@@ -31,6 +32,11 @@ void add_shader_table(std::span<const std::pair<std::string_view, std::string_vi
 }
 
 std::string_view shader_source(std::string_view name) {
+    // Made from a registry rather than written: the GPU's dispatch over the display encodings.
+    if (name == "display_encodings.glsl") {
+        static const std::string generated = display::display_encodings_glsl();
+        return generated;
+    }
     for (std::size_t i = 0; i < detail::embedded_shaders_count; ++i)
         if (detail::embedded_shaders[i].first == name) return detail::embedded_shaders[i].second;
     for (const auto& table : extra_tables())

@@ -12,51 +12,10 @@
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/objects.h"
-#include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/spectral_path.h"
 
 namespace atonlab::stimuli {
-
-std::string_view glare_model_name(GlareModel m) {
-    switch (m) {
-        case GlareModel::none:
-            return "none";
-        case GlareModel::wave_optics:
-            return "wave-optics";
-        case GlareModel::gaussian_bloom:
-            return "gaussian-bloom";
-        case GlareModel::spencer:
-            return "spencer";
-        case GlareModel::aperture:
-            return "aperture";
-        case GlareModel::cie:
-            return "cie";
-    }
-    return "none";
-}
-
-std::optional<GlareModel> glare_model_from_name(std::string_view name) {
-    for (GlareModel m : {GlareModel::none, GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer,
-                         GlareModel::aperture, GlareModel::cie})
-        if (glare_model_name(m) == name) return m;
-    return std::nullopt;
-}
-
-GlarePath glare_path(GlareModel m) {
-    switch (m) {
-        case GlareModel::none:
-            return GlarePath::direct;
-        case GlareModel::cie:
-            return GlarePath::veil;
-        case GlareModel::wave_optics:
-        case GlareModel::gaussian_bloom:
-        case GlareModel::spencer:
-        case GlareModel::aperture:
-            break;
-    }
-    return GlarePath::billboard;
-}
 
 GlareModel light_glare_model(const Scene& scene, const Light& light) {
     return light.glare.value_or(scene.glare.model);
@@ -110,44 +69,17 @@ SpencerVision spencer_vision_for(const Scene& scene) {
 }
 
 double glare_billboard_radius_deg(const GlareSettings& glare) {
-    switch (glare.model) {
-        case GlareModel::none:
-        case GlareModel::cie:  // the whole frame, no billboard
-            return 0.0;
-        case GlareModel::wave_optics:
-        case GlareModel::aperture:
-        case GlareModel::gaussian_bloom:
-        case GlareModel::spencer:
-            break;
-    }
+    if (glare_path(glare.model) != GlarePath::billboard) return 0.0;  // none; cie: the whole frame
     return default_glare_radius_deg(glare, glare_psf_degrees_per_texel(glare));
 }
 
 double default_glare_radius_deg(const GlareSettings& glare, double psf_degrees_per_texel) {
     if (glare.radius_deg) return *glare.radius_deg;
-    switch (glare.model) {
-        case GlareModel::gaussian_bloom:
-            return 4.0 * glare.bloom_sigma_deg;
-        case GlareModel::spencer:
-            return 6.0;
-        // The FFT models: the part of the field every wavelength covers. Eq 4.9
-        // shrinks the λ0 grid by λ/λ0 for the shortest wavelength, so beyond
-        // (N/2)·(380/575) texels the blue end of the spectrum is missing.
-        default:
-            return (glare.psf_size / 2 - 1) * psf_degrees_per_texel * SpectralSamples::kFirstNm /
-                   kReferenceWavelengthNm;
-    }
+    return glare_model_type(glare.model).default_radius_deg(glare, psf_degrees_per_texel);
 }
 
 double glare_psf_degrees_per_texel(const GlareSettings& glare) {
-    switch (glare.model) {
-        case GlareModel::wave_optics:
-            return psf_degrees_per_texel(glare.eye);
-        case GlareModel::aperture:
-            return kReferenceWavelengthNm * 1e-6 / glare.aperture_width_mm * 180.0 / std::numbers::pi;
-        default:
-            return 0.0;
-    }
+    return glare_model_type(glare.model).psf_degrees_per_texel(glare);
 }
 
 
@@ -157,58 +89,6 @@ display::Spectrum spd_for(const std::string& name) {
     if (name.empty() || name == "d65") return display::d65_spectrum();
     if (auto s = display::named_spectrum(name)) return *s;
     throw InputError(SourceLocation{"", 0, 0, "spd"}, fmt::format("unknown spectrum \"{}\".", name));
-}
-
-// The obstacle image as a pupil-plane field at λ0: transmittance = the image's
-// linear luminance, resampled bilinearly over the plane (image row 0 at the top).
-ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_mm) {
-    const std::filesystem::path path = g.aperture_image;
-    int w = 0, h = 0;
-    std::vector<double> lum;
-    try {
-        const auto ext = path.extension().string();
-        if (ext == ".exr" || ext == ".EXR") {
-            const ExrImage img = read_exr(path);
-            w = img.image.width;
-            h = img.image.height;
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x) {
-                    const float* p = img.image.pixel(x, y);
-                    lum.push_back(display::luminance_of_linear_rgb({p[0], p[1], p[2]}));
-                }
-        } else {
-            const std::vector<float> rgb = read_png_rgb(path, w, h);
-            for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
-                lum.push_back(
-                    display::luminance_of_linear_rgb({display::srgb_decode(rgb[i]), display::srgb_decode(rgb[i + 1]), display::srgb_decode(rgb[i + 2])}));
-        }
-    } catch (const InputError& e) {
-        throw InputError(SourceLocation{"", 0, 0, "aperture_image"},
-                         fmt::format("cannot read the aperture image: {}", e.what()));
-    }
-    if (w < 2 || h < 2)
-        throw InputError(SourceLocation{"", 0, 0, "aperture_image"},
-                         fmt::format("the aperture image {} must be at least 2×2 pixels.", path.string()));
-    ComplexImage<double> field(n);
-    const double texel_mm = g.aperture_width_mm / n;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            // Plane texel centre → image coordinates (the image spans the whole plane).
-            const double u = (i + 0.5) / n * w - 0.5, v = (1.0 - (j + 0.5) / n) * h - 0.5;
-            const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, w - 1);
-            const int y0 = std::clamp(static_cast<int>(std::floor(v)), 0, h - 1);
-            const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-            const double tx = std::clamp(u - x0, 0.0, 1.0), ty = std::clamp(v - y0, 0.0, 1.0);
-            auto L = [&](int x, int y) { return std::clamp(lum[static_cast<std::size_t>(y) * w + x], 0.0, 1.0); };
-            double t =
-                (1 - ty) * ((1 - tx) * L(x0, y0) + tx * L(x1, y0)) + ty * ((1 - tx) * L(x0, y1) + tx * L(x1, y1));
-            if (g.aperture_with_pupil) {
-                const double x = (i + 0.5 - n / 2.0) * texel_mm, y = (j + 0.5 - n / 2.0) * texel_mm;
-                if (std::hypot(x, y) > 0.5 * pupil_mm) t = 0;
-            }
-            field.at(i, j) = t;
-        }
-    return field;
 }
 
 }  // namespace
@@ -253,60 +133,12 @@ struct GlareStage::Impl {
         g.report.model = g.model;
         g.report.spd = g.spd;
         g.report.pupil_mm = pupil_mm;
-        switch (gs.model) {
-            case GlareModel::wave_optics: {
-                EyeModel eye = gs.eye;
-                eye.pupil_diameter_mm = pupil_mm;
-                // pupil_mm already holds the hippus of time_s (prepare()); applied once.
-                eye.hippus.enabled = false;
-                eye.validate(gs.psf_size);
-                switch (gs.spectral_path) {
-                    case SpectralPath::anchored:  // docs/glare.md "The spectral path": FFTW on the CPU
-                        g.psf = spectral_psf_anchored(eye, gs.psf_size, samples, gs.spectral_anchors, time_s);
-                        break;
-                    case SpectralPath::exact:
-                        g.psf = spectral_psf_exact(eye, gs.psf_size, samples, time_s);
-                        break;
-                    case SpectralPath::rescaled: {  // K2012 eq 4.9 (on the GPU for a single-scale eye)
-                        GpuPsfGenerator& gen = generator_for(gs.psf_size);
-                        gen.generate(eye, samples, time_s);
-                        g.psf = gen.read_rgb();
-                        break;
-                    }
-                }
-                break;
-            }
-            case GlareModel::aperture: {
-                if (!is_power_of_two(gs.psf_size))
-                    throw InputError(SourceLocation{"", 0, 0, "psf_size"},
-                                     fmt::format("the PSF size must be a power of two, not {}.", gs.psf_size));
-                const double dpt = glare_psf_degrees_per_texel(gs);
-                GpuPsfGenerator& gen = generator_for(gs.psf_size);
-                gen.generate(aperture_field(gs, gs.psf_size, pupil_mm), dpt, samples);
-                g.psf = gen.read_rgb();
-                break;
-            }
-            default:
-                break;
-        }
-        const double radius = default_glare_radius_deg(gs, g.psf ? g.psf->degrees_per_texel : 0.0);
-        if (g.psf) {
-            g.kernel = glare_kernel_from_psf(*g.psf, ppd, radius, gs.window);
-            g.report.degrees_per_texel = g.psf->degrees_per_texel;
-        } else if (gs.model == GlareModel::gaussian_bloom) {
-            const double s = gs.bloom_sigma_deg;
-            if (!(s > 0))
-                throw InputError(SourceLocation{"", 0, 0, "bloom_sigma_deg"},
-                                 fmt::format("the bloom's standard deviation must be positive, not {} degrees.", s));
-            g.kernel =
-                glare_kernel_from_radial([s](double theta, double) { return std::exp(-0.5 * theta * theta / (s * s)); },
-                                         samples, ppd, radius, gs.window);
-        } else {
-            const SpencerVision vision = spencer_vision_for(scene);
-            g.kernel = glare_kernel_from_radial(
-                [vision](double theta, double lambda) { return spencer_psf(theta, lambda, vision); }, samples, ppd,
-                radius, gs.window);
-        }
+        GlareModelKernel k = glare_model_type(g.model).billboard_kernel(
+            {gs, scene, samples, ppd, pupil_mm, time_s, [this](int n) -> GpuPsfGenerator& { return generator_for(n); }});
+        g.psf = std::move(k.psf);
+        g.kernel = std::move(k.kernel);
+        const double radius = k.radius_deg;
+        if (g.psf) g.report.degrees_per_texel = g.psf->degrees_per_texel;
         g.report.kernel_size_px = g.kernel.size;
         g.report.radius_deg = radius;
         g.report.window_cut = g.kernel.window_cut;
@@ -399,11 +231,7 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     const double ppd = scene.display.pixels_per_degree_at_centre();
     const double pupil = glare_pupil_mm(scene);
     auto pupil_for = [&](GlareModel model) {
-        return cached_pupil_mm(model == GlareModel::wave_optics ? [&] {
-            EyeModel eye = gs.eye;
-            eye.pupil_diameter_mm = pupil;
-            return pupil_diameter_mm_at(eye, time_s);
-        }() : pupil, gs.pupil_tolerance_mm);
+        return cached_pupil_mm(glare_model_type(model).kernel_pupil_mm(gs, pupil, time_s), gs.pupil_tolerance_mm);
     };
     const EyeModel& e = gs.eye;
     std::string common;

@@ -21,7 +21,6 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr double kDefaultCieRadiusDeg = 20.0;
 constexpr int kMaxTransformPx = 8192;
 
 // The smallest n' >= n whose only prime factors are 2, 3, 5 and 7 (fast FFTW sizes).
@@ -49,44 +48,8 @@ GlareKernel image_glare_kernel(const GlareSettings& glare, double adaptation_cd_
     Scene scene;  // the pupil (eq 3.15) and Spencer's vision class follow the adaptation
     scene.adaptation_cd_m2 = adaptation_cd_m2;
     scene.glare = glare;
-    switch (glare.model) {
-        case GlareModel::wave_optics: {
-            EyeModel eye = glare.eye;
-            eye.pupil_diameter_mm = glare_pupil_mm(scene);
-            eye.validate(glare.psf_size);
-            const RgbPsf psf = glare.spectral_path == SpectralPath::exact
-                                   ? spectral_psf_exact(eye, glare.psf_size, samples)
-                                   : spectral_psf_anchored(eye, glare.psf_size, samples, glare.spectral_anchors);
-            return glare_kernel_from_psf(psf, ppd, default_glare_radius_deg(glare, psf.degrees_per_texel),
-                                         glare.window);
-        }
-        case GlareModel::gaussian_bloom: {
-            const double s = glare.bloom_sigma_deg;
-            if (!(s > 0))
-                throw InputError(SourceLocation{"", 0, 0, "bloom_sigma_deg"},
-                                 fmt::format("the bloom's standard deviation must be positive, not {} degrees.", s));
-            return glare_kernel_from_radial(
-                [s](double theta, double) { return std::exp(-0.5 * theta * theta / (s * s)); }, samples, ppd,
-                default_glare_radius_deg(glare, 0.0), glare.window);
-        }
-        case GlareModel::spencer: {
-            const SpencerVision vision = spencer_vision_for(scene);
-            return glare_kernel_from_radial(
-                [vision](double theta, double lambda) { return spencer_psf(theta, lambda, vision); }, samples, ppd,
-                default_glare_radius_deg(glare, 0.0), glare.window);
-        }
-        case GlareModel::cie: {
-            const CieGlareSpread gsf = cie_glare_spread(glare.cie);
-            return glare_kernel_from_radial([gsf](double theta, double) { return gsf.density_sr(theta); }, samples, ppd,
-                                            glare.radius_deg.value_or(kDefaultCieRadiusDeg), glare.window);
-        }
-        case GlareModel::none:
-        case GlareModel::aperture:
-            break;
-    }
-    throw InputError(SourceLocation{"", 0, 0, "model"},
-                     fmt::format("an image's glare can be wave-optics, gaussian-bloom, spencer or cie, not {}.",
-                                 glare_model_name(glare.model)));
+    // A model that cannot (none, aperture) says which can (key "model").
+    return glare_model_type(glare.model).image_kernel({glare, scene, samples, ppd, glare_pupil_mm(scene), 0.0, {}});
 }
 
 ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel& kernel) {

@@ -272,7 +272,7 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
             ? fmt::format("glare.radius_deg = {}{}", number_text(radius_deg), at("glare", "radius_deg"))
             : fmt::format("{:.4g}°, the {} model's default radius{}", radius_deg,
                           glare_model_name(widest.model),
-                          widest.model == GlareModel::wave_optics || widest.model == GlareModel::aperture
+                          glare_psf_degrees_per_texel(widest) > 0.0  // the FFT models
                               ? " for its psf_size"
                               : "");
     const std::string message = fmt::format(

@@ -236,9 +236,9 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o, Tr
         const KeyList allowed = section == "display"       ? KeyList(kDisplayKeys)
                                 : section == "camera"      ? KeyList(kCameraKeys)
                                 : section == "environment" ? KeyList(kEnvironmentKeys)
-                                : section == "glare"       ? KeyList(kGlareKeys)
+                                : section == "glare"       ? glare_keys()
                                 : section == "tonemap"     ? KeyList(kTonemapKeys)
-                                                           : KeyList(kEyeKeys);
+                                                           : eye_keys();
         if (!contains(allowed, key)) unknown(section, allowed, key);
         target = &table_for_override(doc, edits, root, section, o, section);
         schema_key = k;

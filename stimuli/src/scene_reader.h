@@ -59,20 +59,19 @@ inline constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",  
 inline constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 inline constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};
-inline constexpr std::string_view kEyeKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm", "adaptation_stride",
-                                         "cie_age_years", "cie_pigmentation"};
+/// [eye]'s own keys; eye_keys() adds the glare models' (glare_model.h).
+inline constexpr std::string_view kEyeOwnKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm",
+                                                   "adaptation_stride"};
 inline constexpr std::string_view kTonemapKeys[] = {
     "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
     "ldr_glare"};
-inline constexpr std::string_view kGlareKeys[] = {
-    "psf_size", "spectral_samples", "spectral_path", "spectral_anchors", "window", "radius_deg", "area_layers",
-    "bloom_sigma_deg", "spencer_vision", "aperture_image", "aperture_width_mm", "aperture_with_pupil", "eye_preset",
-    "seed", "halo_radius_deg", "plane_width_mm", "defocus_diopters", "supersampling", "clear_pupil", "hippus",
-    "hippus_amplitude", "gratings", "grating_count", "grating_inner_radius_mm", "grating_width_um", "grating_opacity",
-    "lens_particles", "lens_particle_count", "lens_particle_diameter_um", "vitreous_particles",
-    "vitreous_particle_count", "vitreous_particle_diameter_um", "eyelashes", "eyelash_count", "eyelash_width_um",
-    "eyelid", "eyelid_edge_mm"};
+/// The [glare] keys every model shares (the glare stage's); glare_keys() adds each model's own.
+inline constexpr std::string_view kSharedGlareKeys[] = {"psf_size", "spectral_samples", "window", "radius_deg",
+                                                        "area_layers"};
+/// The keys [eye] and [glare] take: their own, then each glare model's in the registry's order.
+KeyList eye_keys();
+KeyList glare_keys();
 inline constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
 inline constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
 inline constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};

@@ -1,6 +1,8 @@
 // The scene file's single tables: [display], [camera], [environment], [eye], [glare], [tonemap] (scene_reader.h).
 #include "scene_reader.h"
 
+#include "atonlab/display/display_encodings.h"
+
 namespace atonlab::stimuli::scene_reader {
 
 // ---------------------------------------------------------------------------
@@ -89,6 +91,28 @@ Environment read_environment(const Document& doc, const Section& root) {
     return e;
 }
 
+namespace {
+
+std::vector<std::string_view> with_models_keys(KeyList own,
+                                               std::span<const std::string_view> (GlareModelType::*keys)() const) {
+    std::vector<std::string_view> all(own.begin(), own.end());
+    for (const GlareModelType* m : glare_models())
+        for (std::string_view k : (m->*keys)()) all.push_back(k);
+    return all;
+}
+
+}  // namespace
+
+KeyList eye_keys() {
+    static const std::vector<std::string_view> keys = with_models_keys(kEyeOwnKeys, &GlareModelType::eye_keys);
+    return keys;
+}
+
+KeyList glare_keys() {
+    static const std::vector<std::string_view> keys = with_models_keys(kSharedGlareKeys, &GlareModelType::glare_keys);
+    return keys;
+}
+
 /// The glare key of [eye] or of a [[light]]: one of the models' names.
 std::optional<GlareModel> read_glare_model(const Section& s) {
     const auto g = s.string("glare");
@@ -96,9 +120,7 @@ std::optional<GlareModel> read_glare_model(const Section& s) {
     auto model = glare_model_from_name(*g);
     if (!model)
         s.fail(s.get("glare"), "glare",
-               fmt::format("unknown glare model \"{}\"; it must be \"none\", \"wave-optics\", \"gaussian-bloom\", "
-                           "\"spencer\", \"aperture\" or \"cie\".",
-                           text::echo(*g)));
+               fmt::format("unknown glare model \"{}\"; it must be {}.", text::echo(*g), glare_model_choices()));
     return model;
 }
 
@@ -109,7 +131,7 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
     const toml::table* t = sub_table(root, "eye", "[eye]");
     if (t == nullptr) return fallback;
     Section s(doc, *t, "eye", "the [eye] table");
-    s.allow(kEyeKeys);
+    s.allow(eye_keys());
     if (auto a = s.string("adaptation")) {
         if (*a == "dynamic")
             adapt.mode = AdaptationMode::dynamic;
@@ -126,22 +148,8 @@ double read_eye(const Document& doc, const Section& root, const Environment& env
         s.within("pupil_mm", *p, 0.5, 12.0);
         glare.pupil_mm = *p;
     }
-    // The CIE observer (age, pigmentation) of the `cie` model (cie_glare.h).
-    if (auto a = s.number("cie_age_years")) {
-        s.within("cie_age_years", *a, 0.0, 100.0);
-        glare.cie.age_years = *a;
-    }
-    if (auto p = s.number("cie_pigmentation")) {
-        s.within("cie_pigmentation", *p, 0.0, 1.2);
-        glare.cie.pigmentation = *p;
-    }
-    try {
-        (void)cie_glare_spread(glare.cie);
-    } catch (const InputError& err) {
-        // Only a combination of the two can fail here: name the one the file gives (the age first).
-        const std::string key = s.get("cie_age_years") ? "cie_age_years" : "cie_pigmentation";
-        s.fail(s.get(key), key, err.message());
-    }
+    // The glare models' keys of [eye] (the `cie` observer's age and pigmentation).
+    for (const GlareModelType* m : glare_models()) m->read_eye_keys(s, glare);
     return adaptation;
 }
 
@@ -159,35 +167,12 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
                "fresnel_distance_mm is no longer read: the eye's defocus is now 'defocus_diopters' (0 = in focus, "
                "the default; a distance d in mm is 1000/d diopters), and eye_preset = \"k2012\" draws the thesis's "
                "single-scale eye with its Fresnel term (d = 5000 mm).");
-    s.allow(kGlareKeys);
-    EyeModel& e = g.eye;
-    if (auto preset = s.string("eye_preset")) {
-        const std::optional<EyeModel> named = eye_preset(*preset);
-        if (!named)
-            s.fail(s.get("eye_preset"), "eye_preset",
-                   fmt::format("unknown eye preset \"{}\"; presets are {}.", *preset, join(eye_preset_names())));
-        e = *named;
-        // The thesis's look includes its spectral method: one FFT at λ0 and
-        // eq 4.9 lookups (docs/glare.md). Summed exactly over wavelengths, its
-        // defocus rings fill the dark centre it drew, so the preset draws with
-        // the rescaled path unless spectral_path says otherwise.
-        if (e.scale == EyeScale::k2012_single) g.spectral_path = SpectralPath::rescaled;
-    }
-    if (s.boolean("clear_pupil").value_or(false)) e = EyeModel::clear_pupil(e.pupil_diameter_mm);
+    s.allow(glare_keys());
     g.psf_size = s.integer("psf_size", 16, 2048).value_or(g.psf_size);
     if (!is_power_of_two(g.psf_size))
         s.fail(s.get("psf_size"), "psf_size",
                fmt::format("psf_size must be a power of two (the FFT needs one), got {}.", g.psf_size));
     g.spectral_samples = s.integer("spectral_samples", 1, 128).value_or(g.spectral_samples);
-    if (auto p = s.string("spectral_path")) {
-        const auto path = spectral_path_from_name(*p);
-        if (!path)
-            s.fail(s.get("spectral_path"), "spectral_path",
-                   fmt::format("unknown spectral path \"{}\"; it must be \"anchored\", \"rescaled\" or \"exact\".",
-                               *p));
-        g.spectral_path = *path;
-    }
-    g.spectral_anchors = s.integer("spectral_anchors", 1, 128).value_or(g.spectral_anchors);
     if (auto w = s.string("window")) {
         try {
             g.window = glare_window_from_name(*w);
@@ -201,70 +186,8 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
         g.radius_deg = *r;
     }
     g.area_layers = s.integer("area_layers", 2, 256).value_or(g.area_layers);
-    g.bloom_sigma_deg = s.number_or("bloom_sigma_deg", g.bloom_sigma_deg);
-    s.greater_than("bloom_sigma_deg", g.bloom_sigma_deg, 0.0);
-    if (auto v = s.string("spencer_vision")) {
-        if (*v == "photopic") g.spencer_vision = SpencerVision::photopic;
-        else if (*v == "mesopic") g.spencer_vision = SpencerVision::mesopic;
-        else if (*v == "scotopic") g.spencer_vision = SpencerVision::scotopic;
-        else if (*v != "auto")
-            s.fail(s.get("spencer_vision"), "spencer_vision",
-                   fmt::format("unknown vision \"{}\"; it must be \"photopic\", \"mesopic\", \"scotopic\" or \"auto\".",
-                               *v));
-    }
-    if (auto img = s.string("aperture_image")) {
-        // Relative to the scene file, like every path in it.
-        std::filesystem::path p(*img);
-        if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;
-        if (!std::filesystem::is_regular_file(p))
-            s.fail(s.get("aperture_image"), "aperture_image",
-                   fmt::format("the aperture image {} does not exist or is not a file.", p.string()));
-        g.aperture_image = p.string();
-    }
-    g.aperture_width_mm = s.number_or("aperture_width_mm", g.aperture_width_mm);
-    s.greater_than("aperture_width_mm", g.aperture_width_mm, 0.0);
-    g.aperture_with_pupil = s.boolean("aperture_with_pupil").value_or(g.aperture_with_pupil);
-
-    if (auto seed = s.integer("seed", 0, std::numeric_limits<int>::max())) e.seed = static_cast<std::uint64_t>(*seed);
-    if (auto h = s.number("halo_radius_deg")) {
-        s.at_least("halo_radius_deg", *h, 0.0);
-        e.halo_radius_deg = *h > 0 ? std::optional<double>(*h) : std::nullopt;  // 0: physical scale
-    }
-    e.plane_width_mm = s.number_or("plane_width_mm", e.plane_width_mm);
-    e.defocus_diopters = s.number_or("defocus_diopters", e.defocus_diopters);
-    e.supersampling = s.integer("supersampling", 1, 16).value_or(e.supersampling);
-    e.hippus.enabled = s.boolean("hippus").value_or(e.hippus.enabled);
-    e.hippus.amplitude = s.number_or("hippus_amplitude", e.hippus.amplitude);
-    e.gratings.enabled = s.boolean("gratings").value_or(e.gratings.enabled);
-    e.gratings.count = s.integer("grating_count", 0, 100000).value_or(e.gratings.count);
-    e.gratings.inner_radius_mm = s.number_or("grating_inner_radius_mm", e.gratings.inner_radius_mm);
-    e.gratings.width_um = s.number_or("grating_width_um", e.gratings.width_um);
-    e.gratings.opacity = s.number_or("grating_opacity", e.gratings.opacity);
-    e.lens_particles.enabled = s.boolean("lens_particles").value_or(e.lens_particles.enabled);
-    e.lens_particles.count = s.integer("lens_particle_count", 0, 1000000).value_or(e.lens_particles.count);
-    e.lens_particles.diameter_um = s.number_or("lens_particle_diameter_um", e.lens_particles.diameter_um);
-    e.vitreous_particles.enabled = s.boolean("vitreous_particles").value_or(e.vitreous_particles.enabled);
-    e.vitreous_particles.count = s.integer("vitreous_particle_count", 0, 1000000).value_or(e.vitreous_particles.count);
-    e.vitreous_particles.diameter_um = s.number_or("vitreous_particle_diameter_um", e.vitreous_particles.diameter_um);
-    e.eyelashes.enabled = s.boolean("eyelashes").value_or(e.eyelashes.enabled);
-    e.eyelashes.count = s.integer("eyelash_count", 0, 10000).value_or(e.eyelashes.count);
-    e.eyelashes.width_um = s.number_or("eyelash_width_um", e.eyelashes.width_um);
-    e.eyelid.enabled = s.boolean("eyelid").value_or(e.eyelid.enabled);
-    e.eyelid.edge_mm = s.number_or("eyelid_edge_mm", e.eyelid.edge_mm);
-    // The eye model's own checks (the pupil itself is checked per frame, where
-    // hippus has moved it): with the scene's pupil within half the plane, so
-    // that a defocus the frames' grid cannot sample is refused here, at its line.
-    try {
-        EyeModel probe = e;
-        probe.pupil_diameter_mm = std::min(pupil_mm, 0.5 * probe.plane_width_mm);
-        probe.hippus.enabled = false;
-        probe.validate(g.psf_size);
-    } catch (const InputError& err) {
-        const std::string key = err.where() ? err.where()->key : std::string();
-        // Keys spelt the same in the file and the model are refused at their own line.
-        if (!key.empty() && s.has(key)) s.fail(s.get(key), key, err.message());
-        s.fail_table(fmt::format("the eye model is invalid ({}): {}", key, err.message()));
-    }
+    // Each model's own keys (glare_models/): every model's, whichever the scene uses, since a light may pick its own.
+    for (const GlareModelType* m : glare_models()) m->read_glare_keys(doc, s, g, pupil_mm);
 }
 
 /// The display model ([display] photometric keys) and [tonemap] (docs/scene-file.md).
@@ -279,15 +202,15 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
             s.fail(s.has("black_cd_m2") ? s.get("black_cd_m2") : s.get("peak_cd_m2"), "black_cd_m2",
                    fmt::format("the display's black ({} cd/m²) must be below its peak ({} cd/m²).", number_text(black),
                                number_text(peak)));
-        const std::string transfer = s.string("transfer").value_or("srgb");
-        if (transfer == "srgb")
-            out.display = DisplayModel::srgb(peak, black);
-        else if (transfer == "pq")
-            out.display = DisplayModel::pq(peak, black);
+        // The laws a name alone makes (display_encodings.h); sRGB unless the file says otherwise.
+        const std::string transfer =
+            s.string("transfer").value_or(std::string(display_encoding(TransferKind::srgb).name));
+        if (auto d = display_from_transfer(transfer, peak, black))
+            out.display = std::move(*d);
         else
             s.fail(s.get("transfer"), "transfer",
-                   fmt::format("unknown transfer \"{}\"; it must be \"srgb\" or \"pq\" (or give a calibration file).",
-                               transfer));
+                   fmt::format("unknown transfer \"{}\"; it must be {} (or give a calibration file).", transfer,
+                               display_encoding_choices("\"")));
         if (auto cal = s.string("calibration")) {
             std::filesystem::path p(*cal);
             if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;

@@ -15,6 +15,7 @@
 #include "atonlab/display/geometry.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/output_settings.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -51,7 +52,6 @@ struct ProfileTables {
 /// One ATON light (K2012 §4.1): an isotropic sphere of radius radius_m shielded
 /// by its profiles, modulated by its rhythm. One colour: a sectored lighthouse is
 /// several lights sharing a position and a horizontal profile table.
-enum class GlareModel : std::uint8_t;
 
 struct Light {
     std::string name;
@@ -90,20 +90,6 @@ struct Disc {
     glm::dvec3 rgb_per_cd_m2{1.0};          ///< linear Rec.709, normalised to Y = 1 (a light's colour keys)
 };
 
-/// The glare stage (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3). Every model
-/// conserves each light's energy; all but `cie` go through the same billboards,
-/// `cie` convolves the whole frame (its veil reaches tens of degrees).
-enum class GlareModel : std::uint8_t {
-    none,            ///< each light's direct image only
-    wave_optics,     ///< the eye model's PSF by FFT (K2012 §4.2, Ritschel et al. 2009)
-    gaussian_bloom,  ///< a monochromatic Gaussian blur (K2012 §3.4.1, [Kaw05]/[KMS05])
-    spencer,         ///< the analytic PSF of Spencer et al. 1995
-    aperture,        ///< the FFT of an obstacle image (Kakimoto et al. 2005)
-    cie,             ///< the CIE glare spread function's veiling glare over the whole frame (veiling_glare.h), not a billboard
-};
-std::string_view glare_model_name(GlareModel m);
-std::optional<GlareModel> glare_model_from_name(std::string_view name);
-
 /// How the wave-optics PSF integrates over the spectrum (K2012 §4.2.4; docs/glare.md "The spectral path").
 enum class SpectralPath : std::uint8_t {
     anchored,  ///< exact FFTs at a few anchor wavelengths, each sample rescaled from its two neighbours (default)
@@ -113,12 +99,8 @@ enum class SpectralPath : std::uint8_t {
 std::string_view spectral_path_name(SpectralPath p);
 std::optional<SpectralPath> spectral_path_from_name(std::string_view name);
 
-/// How a glare model draws a light: its direct image only (`none`), a glare
-/// billboard in place of the direct image (the PSF models), or its direct
-/// image convolved with the whole-frame veil (`cie`).
-enum class GlarePath : std::uint8_t { direct = 0, billboard = 1, veil = 2 };
-GlarePath glare_path(GlareModel m);
-
+/// The glare stage's settings (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3): the
+/// models are glare_models/glare_model_list.h, each reading its own keys (glare_model.h).
 struct GlareSettings {
     GlareModel model = GlareModel::none;
     /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).

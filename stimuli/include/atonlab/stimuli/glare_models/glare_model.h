@@ -1,0 +1,122 @@
+#pragma once
+// What a glare model is (docs/architecture.md "How to add a glare model"): its
+// name (glare_model_list.h), its keys with their defaults and checks, how it
+// draws a light (GlarePath), the kernel it builds for the glare stage's
+// billboards and for `atonlab glare`, and a one-line summary for help texts.
+// Every model conserves each light's energy: a kernel's channels each sum to 1
+// (glare_kernel.h renormalises after the window), and the `cie` veil conserves
+// the frame's energy less what it carries outside the frame (veiling_glare.h).
+//
+// The registry (glare_model_type, glare_models) is the one list every reader
+// uses: the scene file's keys and `--set` checks, the glare stage, image_glare,
+// `atonlab glare` and `atonlab view`.
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/glare_models/glare_model_list.h"
+#include "atonlab/stimuli/psf.h"
+
+namespace atonlab::toml_reader {
+class Document;
+class Section;
+}  // namespace atonlab::toml_reader
+
+namespace atonlab::stimuli {
+
+struct GlareSettings;
+struct Scene;
+class GpuPsfGenerator;
+
+/// How a glare model draws a light: its direct image only (`none`), a glare
+/// billboard in place of the direct image (the PSF models), or its direct
+/// image convolved with the whole-frame veil (`cie`). The values are
+/// light_eval.comp's (the frame renderer uploads them per light).
+enum class GlarePath : std::uint8_t { direct = 0, billboard = 1, veil = 2 };
+
+/// What a model's kernel is built for.
+struct GlareKernelRequest {
+    const GlareSettings& glare;      ///< the shared settings, with glare.model = this model
+    const Scene& scene;              ///< its adaptation (Spencer's vision class) and eye
+    const SpectralSamples& samples;  ///< the light's SPD, sampled (K2012 §4.2.4)
+    double pixels_per_degree = 0;    ///< of the display (the stage) or the image (`atonlab glare`)
+    double pupil_mm = 0;             ///< the pupil the kernel is for (GlareModelType::kernel_pupil_mm)
+    double time_s = 0;               ///< the frame's time (the eye's time-varying parts)
+    /// The glare stage's GPU PSF generator of size n; empty on the CPU (`atonlab glare`).
+    std::function<GpuPsfGenerator&(int n)> gpu;
+};
+
+/// A model's kernel, with the PSF it came from (the FFT models) and its radius.
+struct GlareModelKernel {
+    std::optional<RgbPsf> psf;
+    GlareKernel kernel;
+    double radius_deg = 0;  ///< the billboard's (the window's) radius, degrees of visual angle
+};
+
+class GlareModelType {
+public:
+    explicit constexpr GlareModelType(GlareModel id) : id_(id) {}
+    virtual ~GlareModelType() = default;
+    GlareModelType(const GlareModelType&) = delete;
+    GlareModelType& operator=(const GlareModelType&) = delete;
+
+    GlareModel id() const { return id_; }
+    std::string_view name() const;  ///< as glare_model_list.h spells it
+
+    /// One line for help texts: what the model draws and its source.
+    virtual std::string_view summary() const = 0;
+    /// How it draws a light.
+    virtual GlarePath path() const { return GlarePath::billboard; }
+
+    /// The keys only this model reads, of [glare] and of [eye] (the scene
+    /// reader reads the ones the models share). docs/scene-file.md describes them.
+    virtual std::span<const std::string_view> glare_keys() const { return {}; }
+    virtual std::span<const std::string_view> eye_keys() const { return {}; }
+    /// Reads its keys of [glare] into g (absent keys keep GlareSettings'
+    /// defaults) and checks them, failing at the key's line. pupil_mm: the
+    /// pupil the scene's frames use (the darkest one for dynamic adaptation).
+    virtual void read_glare_keys(const toml_reader::Document& doc, const toml_reader::Section& s, GlareSettings& g,
+                                 double pupil_mm) const;
+    /// The same for its keys of [eye].
+    virtual void read_eye_keys(const toml_reader::Section& s, GlareSettings& g) const;
+
+    /// Whether `atonlab view`'s m key offers it with these settings (aperture needs an image).
+    virtual bool available(const GlareSettings& g) const;
+    /// Whether `atonlab glare` can convolve an image with it (image_kernel).
+    virtual bool on_images() const { return false; }
+
+    /// The PSF's texel pitch (degrees) of the FFT models; 0 for the analytic ones.
+    virtual double psf_degrees_per_texel(const GlareSettings& g) const;
+    /// Its radius (degrees) when [glare] radius_deg is not given, for a PSF of
+    /// psf_degrees_per_texel (0 for the analytic models).
+    virtual double default_radius_deg(const GlareSettings& g, double psf_degrees_per_texel) const;
+    /// The pupil (mm) its kernel is computed for at time_s, from the frame's pupil (before the cache's rounding).
+    virtual double kernel_pupil_mm(const GlareSettings& g, double pupil_mm, double time_s) const;
+
+    /// The glare stage's kernel for a billboard (path() == billboard only).
+    virtual GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const;
+    /// `atonlab glare`'s kernel, on the CPU (on_images() only).
+    virtual GlareKernel image_kernel(const GlareKernelRequest& r) const;
+
+private:
+    GlareModel id_;
+};
+
+/// The registry: the model of an enumerator, every model in glare_model_list.h's order.
+const GlareModelType& glare_model_type(GlareModel m);
+std::span<const GlareModelType* const> glare_models();
+
+std::string_view glare_model_name(GlareModel m);
+std::optional<GlareModel> glare_model_from_name(std::string_view name);
+/// The names of the models that pass `keep` (all when empty), each in `quote`,
+/// as a list ending "… or …": for error messages and help texts.
+std::string glare_model_choices(std::string_view quote = "\"",
+                                const std::function<bool(const GlareModelType&)>& keep = {});
+
+GlarePath glare_path(GlareModel m);
+
+}  // namespace atonlab::stimuli
