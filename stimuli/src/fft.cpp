@@ -10,6 +10,7 @@
 #include <cmath>
 #include <complex>
 #include <cstddef>
+#include <memory>
 #include <mutex>
 #include <new>
 #include <numbers>
@@ -21,9 +22,15 @@
 #include <vector>
 
 #include "atonlab/stimuli/error.h"
+#include "fftw_planner.h"
 #include "gl_enums.h"
 
 namespace atonlab::stimuli {
+
+std::mutex& detail::fftw_planner_mutex() {
+    static std::mutex m;
+    return m;
+}
 
 bool is_power_of_two(int n) {
     return n > 0 && (n & (n - 1)) == 0;
@@ -63,11 +70,8 @@ void check_image(const ComplexImage<T>& image) {
                                                 image.data.size(), pixel_count(std::max(image.n, 0))));
 }
 
-// FFTW's planner is not thread-safe (FFTW manual §5.4, "Thread safety"); only
-// fftw_execute is. Every plan creation and destruction goes through this lock.
 std::mutex& planner_mutex() {
-    static std::mutex m;
-    return m;
+    return detail::fftw_planner_mutex();
 }
 
 /// FFTW in one precision: the fftw_ / fftwf_ prefixes behind one name.
@@ -142,12 +146,54 @@ private:
     typename Fftw<T>::Plan plan_ = nullptr;
 };
 
+/// Plans made once and reused (issue 27 item 3): a plan and its buffer are
+/// taken from the pool for one transform and given back, so no call plans,
+/// allocates or page-faults a fresh buffer. Any thread may take one; a plan is
+/// used by one thread at a time. Every plan of a size was made alike (its own
+/// aligned buffer, FFTW_ESTIMATE), so the result does not depend on which one.
+template <class T>
+class FftwPlanPool {
+public:
+    std::unique_ptr<FftwPlan<T>> take(int n) {
+        {
+            std::lock_guard lock(mutex_);
+            for (auto it = free_.begin(); it != free_.end(); ++it)
+                if ((*it)->size() == n) {
+                    std::unique_ptr<FftwPlan<T>> p = std::move(*it);
+                    free_.erase(it);
+                    return p;
+                }
+        }
+        return std::make_unique<FftwPlan<T>>(n);
+    }
+    void give_back(std::unique_ptr<FftwPlan<T>> p) {
+        std::lock_guard lock(mutex_);
+        // The pool holds at most as many plans of a size as were in use at once
+        // (one per thread that transforms concurrently).
+        free_.push_back(std::move(p));
+    }
+
+private:
+    std::mutex mutex_;
+    std::vector<std::unique_ptr<FftwPlan<T>>> free_;
+};
+
+template <class T>
+FftwPlanPool<T>& plan_pool() {
+    // Never destroyed: plans may be given back by threads that outlive main's
+    // static destructors, and the process's end frees everything anyway.
+    static auto* pool = new FftwPlanPool<T>();
+    return *pool;
+}
+
 template <class T>
 void fftw_forward_any(ComplexImage<T>& image) {
     check_image(image);
     if (image.n == 0) return;
-    FftwPlan<T> plan(image.n);
-    plan.forward(image.data.data());
+    FftwPlanPool<T>& pool = plan_pool<T>();
+    std::unique_ptr<FftwPlan<T>> plan = pool.take(image.n);
+    plan->forward(image.data.data());
+    pool.give_back(std::move(plan));
 }
 
 }  // namespace

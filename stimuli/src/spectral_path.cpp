@@ -12,6 +12,7 @@
 
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
+#include "parallel.h"
 
 namespace atonlab::stimuli {
 
@@ -114,13 +115,17 @@ struct Sample {
     std::vector<Term> terms;
 };
 
-/// Working planes kept between calls (per thread), so a call neither allocates
-/// nor zeroes megabytes: the path is otherwise dominated by page faults.
-struct Workspace {
+/// Working planes kept between calls (per calling thread, one band space per
+/// worker), so a call neither allocates nor zeroes megabytes: the path is
+/// otherwise dominated by page faults.
+struct BandSpace {
     std::vector<float> rows;  // x pass of the source rows one band needs
     std::vector<float> acc;   // one sample's band (scalar)
     std::vector<float> xyz;   // X, Y and Z of the band (planes)
     std::vector<float> zero;  // a zero row for taps off the grid
+};
+struct Workspace {
+    std::vector<BandSpace> bands;             // one per worker thread
     std::vector<std::vector<float>> source;  // each anchor's PSF in fp32
 };
 Workspace& workspace() {
@@ -137,7 +142,7 @@ constexpr std::size_t kLanes = 4;
 
 /// acc[y − y0][x] += scale · F(c + (x − c)·ratio, c + (y − c)·ratio) for the
 /// band's rows y0 … y1 − 1: separable Lanczos-3, zero outside the grid.
-void add_term_band(Workspace& ws, int n, int y0, int y1, const Term& t, const std::vector<float>& source) {
+void add_term_band(BandSpace& ws, int n, int y0, int y1, const Term& t, const std::vector<float>& source) {
     const auto un = static_cast<std::size_t>(n);
     if (t.ratio == 1.0) {  // a sample at an anchor's own wavelength: no resampling
         for (int y = y0; y < y1; ++y) {
@@ -274,6 +279,9 @@ std::vector<double> spectral_anchor_wavelengths(const SpectralSamples& samples, 
 
 namespace {
 
+void add_bands(BandSpace& ws, const std::vector<std::vector<float>>& source, const std::vector<Sample>& terms, int n,
+               int first_band, int end_band, RgbPsf& out);
+
 /// spectral_psf_from_anchors() on the anchors' PSFs already in ws.source
 /// (fp32, unit sum, on λ0's grid) at wavelengths `anchor_nm` (ascending).
 RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::vector<double>& anchor_nm,
@@ -325,14 +333,32 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
 
     // Band by band: every sample's terms into the band's X, Y and Z, then the
     // band to linear Rec.709 (XYZ → RGB clipped at 0, as spectral_psf_exact).
-    ws.acc.resize(static_cast<std::size_t>(kBand) * un);
-    ws.xyz.resize(3 * static_cast<std::size_t>(kBand) * un);
-    ws.zero.assign(un, 0.0f);
+    // The bands are independent: they are shared among the cores (issue 27
+    // item 3), each computed as it would be alone (bit-identical results).
     RgbPsf out;
     out.n = n;
     out.degrees_per_texel = degrees_per_texel;
-    out.rgb.reserve(un * un);  // filled band by band, not zeroed first
-    for (int y0 = 0; y0 < n; y0 += kBand) {
+    out.rgb.resize(un * un);
+    const int band_count = (n + kBand - 1) / kBand;
+    ws.bands.resize(std::max<std::size_t>(ws.bands.size(), static_cast<std::size_t>(detail::worker_count(band_count))));
+    detail::parallel_chunks(band_count, [&](int first_band, int end_band, int worker) {
+        add_bands(ws.bands[static_cast<std::size_t>(worker)], ws.source, terms, n, first_band, end_band, out);
+    });
+    const double y = out.luminance_sum();
+    if (y > 0)
+        for (auto& v : out.rgb) v /= y;
+    return out;
+}
+
+/// The bands [first_band, end_band) of `out` (from_sources()).
+void add_bands(BandSpace& ws, const std::vector<std::vector<float>>& source, const std::vector<Sample>& terms, int n,
+               int first_band, int end_band, RgbPsf& out) {
+    const auto un = static_cast<std::size_t>(n);
+    ws.acc.resize(static_cast<std::size_t>(kBand) * un);
+    ws.xyz.resize(3 * static_cast<std::size_t>(kBand) * un);
+    ws.zero.assign(un, 0.0f);
+    for (int band = first_band; band < end_band; ++band) {
+        const int y0 = band * kBand;
         const int y1 = std::min(n, y0 + kBand);
         const std::size_t texels = static_cast<std::size_t>(y1 - y0) * un;
         float* bx = ws.xyz.data();
@@ -341,7 +367,7 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
         std::fill(ws.xyz.begin(), ws.xyz.begin() + static_cast<std::ptrdiff_t>(3 * texels), 0.0f);
         for (const Sample& s : terms) {
             std::fill(ws.acc.begin(), ws.acc.begin() + static_cast<std::ptrdiff_t>(texels), 0.0f);
-            for (const Term& t : s.terms) add_term_band(ws, n, y0, y1, t, ws.source[t.anchor]);
+            for (const Term& t : s.terms) add_term_band(ws, n, y0, y1, t, source[t.anchor]);
             const float* a = ws.acc.data();
             std::size_t i = 0;
             for (; i + kLanes <= texels; i += kLanes) {  // blocks of texels, as in add_term_band
@@ -369,13 +395,10 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
                 bz[i] += s.xyz.z * a[i];
             }
         }
+        glm::dvec3* dst = &out.rgb[static_cast<std::size_t>(y0) * un];
         for (std::size_t i = 0; i < texels; ++i)
-            out.rgb.push_back(glm::max(display::xyz_to_linear_rgb({bx[i], by[i], bz[i]}), glm::dvec3(0.0)));
+            dst[i] = glm::max(display::xyz_to_linear_rgb({bx[i], by[i], bz[i]}), glm::dvec3(0.0));
     }
-    const double y = out.luminance_sum();
-    if (y > 0)
-        for (auto& v : out.rgb) v /= y;
-    return out;
 }
 
 }  // namespace
@@ -395,7 +418,12 @@ RgbPsf spectral_psf_anchored(const EyeModel& eye, int n, const SpectralSamples& 
     const std::vector<double> anchor_nm = spectral_anchor_wavelengths(samples, anchors);
     Workspace& ws = workspace();
     ws.source.resize(std::max(ws.source.size(), anchor_nm.size()));
-    for (std::size_t i = 0; i < anchor_nm.size(); ++i) anchor_psf(ws.source[i], eye, n, anchor_nm[i], time_s);
+    // Each anchor's PSF is independent of the others: the anchors are shared
+    // among the cores (issue 27 item 3; each computed as it would be alone).
+    detail::parallel_items(static_cast<int>(anchor_nm.size()), [&](int i) {
+        const auto k = static_cast<std::size_t>(i);
+        anchor_psf(ws.source[k], eye, n, anchor_nm[k], time_s);
+    });
     return from_sources(ws, n, psf_degrees_per_texel(eye), anchor_nm, samples);
 }
 

@@ -3,30 +3,20 @@
 // convolution by FFTW (veiling_glare.h).
 #include "atonlab/stimuli/veiling_glare.h"
 
-#include <fftw3.h>
-
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
 
 #include "atonlab/stimuli/footprint.h"
+#include "parallel.h"
+#include "veil_convolution.h"
 
 namespace atonlab::stimuli {
 
 namespace {
 
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-/// The smallest n ≥ m whose prime factors are 2, 3, 5 and 7 (FFTW's fast sizes).
-int fftw_size_at_least(int m) {
-    for (int n = std::max(m, 1);; ++n) {
-        int r = n;
-        for (int p : {2, 3, 5, 7})
-            while (r % p == 0) r /= p;
-        if (r == 1) return n;
-    }
-}
 
 /// GSF per px² of the image plane at (x, y) px from the principal point: the
 /// density (sr⁻¹) times the pinhole's dΩ/dA = f / (f² + r²)^{3/2}.
@@ -64,7 +54,9 @@ VeilKernelQuadrant veil_kernel_quadrant(const CieGlareSpread& gsf, int width, in
     k.width = width;
     k.height = height;
     k.value.assign(static_cast<std::size_t>(width) * height, 0.0);
-    for (int dy = 0; dy < height; ++dy)
+    // Rows on every core (each pixel computed as it would be alone).
+    detail::parallel_chunks(height, [&](int dy0, int dy1, int) {
+    for (int dy = dy0; dy < dy1; ++dy)
         for (int dx = 0; dx < width; ++dx) {
             double e;
             if (dx == 0 && dy == 0) {
@@ -83,6 +75,7 @@ VeilKernelQuadrant veil_kernel_quadrant(const CieGlareSpread& gsf, int width, in
             }
             k.value[static_cast<std::size_t>(dy) * width + dx] = e;
         }
+    });
     return k;
 }
 
@@ -92,47 +85,23 @@ struct VeilingGlare::Impl {
     CieObserver observer;
     bool ready = false;
     int builds = 0;
-    int mx = 0, my = 0;  // padded sizes (≥ 2W − 1, 2H − 1)
-    std::vector<double> real;
-    std::vector<std::complex<double>> kernel_hat, work;
+    VeilMethod last = VeilMethod::automatic;
+    VeilKernelQuadrant quadrant;  // the kernel (the direct sum reads it)
+    detail::VeilFft fft;          // its spectrum and plans (built on the first FFT frame)
+    bool fft_ready = false;
     std::vector<double> omega;  // H*W pixel solid angles (sr)
-    fftw_plan forward = nullptr, inverse = nullptr;
-
-    ~Impl() { destroy_plans(); }
-    void destroy_plans() {
-        if (forward) fftw_destroy_plan(forward);
-        if (inverse) fftw_destroy_plan(inverse);
-        forward = inverse = nullptr;
-    }
-    static fftw_complex* as_fftw(std::vector<std::complex<double>>& v) {
-        // std::complex<double> is layout-compatible with fftw_complex (FFTW manual §4.1.1).
-        return reinterpret_cast<fftw_complex*>(v.data());
-    }
+    std::vector<double> plane;  // one channel's illuminances (lux), H*W
+    std::vector<double> direct[3];
 
     void build(int w, int h, double f, const CieObserver& obs) {
         const CieGlareSpread gsf = cie_glare_spread(obs);  // validates the observer first
         ready = false;
-        destroy_plans();
+        fft_ready = false;
         width = w;
         height = h;
         focal_px = f;
         observer = obs;
-        mx = fftw_size_at_least(2 * w - 1);
-        my = fftw_size_at_least(2 * h - 1);
-        const std::size_t cols = static_cast<std::size_t>(mx / 2 + 1);
-        real.assign(static_cast<std::size_t>(mx) * my, 0.0);
-        kernel_hat.assign(cols * my, {0.0, 0.0});
-        work.assign(kernel_hat.size(), {0.0, 0.0});
-        forward = fftw_plan_dft_r2c_2d(my, mx, real.data(), as_fftw(work), FFTW_ESTIMATE);
-        inverse = fftw_plan_dft_c2r_2d(my, mx, as_fftw(work), real.data(), FFTW_ESTIMATE);
-
-        const VeilKernelQuadrant q = veil_kernel_quadrant(gsf, w, h, f);
-        // The kernel with its centre at index (0, 0), negative offsets wrapped.
-        for (int dy = -(h - 1); dy <= h - 1; ++dy)
-            for (int dx = -(w - 1); dx <= w - 1; ++dx)
-                real[static_cast<std::size_t>((dy + my) % my) * mx + (dx + mx) % mx] = q.at(std::abs(dx), std::abs(dy));
-        fftw_execute_dft_r2c(forward, real.data(), as_fftw(kernel_hat));
-
+        quadrant = veil_kernel_quadrant(gsf, w, h, f);
         omega.resize(static_cast<std::size_t>(w) * h);
         for (int j = 0; j < h; ++j)
             for (int i = 0; i < w; ++i)
@@ -140,7 +109,58 @@ struct VeilingGlare::Impl {
         ready = true;
         ++builds;
     }
+
+    glm::dvec3 apply_fft(std::vector<float>& rgba);
+    glm::dvec3 apply_direct(std::vector<float>& rgba, const std::vector<detail::LitPixel>& lit, const glm::dvec3& in);
 };
+
+glm::dvec3 VeilingGlare::Impl::apply_fft(std::vector<float>& rgba) {
+    if (!fft_ready) {
+        fft.build(quadrant);
+        fft_ready = true;
+    }
+    const std::size_t pixels = omega.size();
+    plane.resize(pixels);
+    glm::dvec3 outside{0.0};
+    for (int c = 0; c < 3; ++c) {
+        const auto uc = static_cast<std::size_t>(c);
+        double in = 0;
+        for (std::size_t p = 0; p < pixels; ++p) {
+            const double e = static_cast<double>(rgba[4 * p + uc]) * omega[p];
+            plane[p] = e;
+            in += e;
+        }
+        if (!(in > 0)) continue;
+        fft.convolve(plane);
+        double out = 0;
+        for (std::size_t p = 0; p < pixels; ++p) {
+            // Rounding leaves ±1e-16 of the total where the true value is ~0: no negative light.
+            const double e = std::max(0.0, plane[p]);
+            out += e;
+            rgba[4 * p + uc] = static_cast<float>(e / omega[p]);
+        }
+        outside[c] = std::clamp(1.0 - out / in, 0.0, 1.0);
+    }
+    return outside;
+}
+
+glm::dvec3 VeilingGlare::Impl::apply_direct(std::vector<float>& rgba, const std::vector<detail::LitPixel>& lit,
+                                            const glm::dvec3& in) {
+    detail::veil_direct_sum(quadrant, lit, direct);
+    glm::dvec3 outside{0.0};
+    for (int c = 0; c < 3; ++c) {
+        if (!(in[c] > 0)) continue;  // as the FFT: a channel without energy stays as it is
+        const auto uc = static_cast<std::size_t>(c);
+        double out = 0;
+        for (std::size_t p = 0; p < omega.size(); ++p) {
+            const double e = direct[c][p];
+            out += e;
+            rgba[4 * p + uc] = static_cast<float>(e / omega[p]);
+        }
+        outside[c] = std::clamp(1.0 - out / in[c], 0.0, 1.0);
+    }
+    return outside;
+}
 
 VeilingGlare::VeilingGlare() : impl_(std::make_unique<Impl>()) {}
 VeilingGlare::~VeilingGlare() = default;
@@ -149,39 +169,36 @@ int VeilingGlare::kernel_builds() const {
     return impl_->builds;
 }
 
-glm::dvec3 VeilingGlare::apply(std::vector<float>& rgba, int w, int h, double f, const CieObserver& obs) {
+VeilMethod VeilingGlare::last_method() const {
+    return impl_->last;
+}
+
+glm::dvec3 VeilingGlare::apply(std::vector<float>& rgba, int w, int h, double f, const CieObserver& obs,
+                               VeilMethod method) {
     Impl& m = *impl_;
     if (!m.ready || m.width != w || m.height != h || m.focal_px != f || m.observer.age_years != obs.age_years ||
         m.observer.pigmentation != obs.pigmentation)
         m.build(w, h, f, obs);
-    const double norm = 1.0 / (static_cast<double>(m.mx) * m.my);  // FFTW's c2r is unnormalised
-    glm::dvec3 outside{0.0};
-    for (int c = 0; c < 3; ++c) {
-        std::fill(m.real.begin(), m.real.end(), 0.0);
-        double in = 0;
-        for (int j = 0; j < h; ++j)
-            for (int i = 0; i < w; ++i) {
-                const std::size_t p = static_cast<std::size_t>(j) * w + i;
-                const double e = static_cast<double>(rgba[4 * p + static_cast<std::size_t>(c)]) * m.omega[p];
-                m.real[static_cast<std::size_t>(j) * m.mx + i] = e;
-                in += e;
+    // The lit pixels, up to one more than the direct sum takes by default.
+    std::vector<detail::LitPixel> lit;
+    glm::dvec3 in{0.0};
+    const std::size_t limit =
+        method == VeilMethod::direct ? m.omega.size() : static_cast<std::size_t>(kVeilDirectMaxLitPixels);
+    bool few = method != VeilMethod::fft;
+    for (int j = 0; j < h && few; ++j)
+        for (int i = 0; i < w; ++i) {
+            const std::size_t p = static_cast<std::size_t>(j) * w + i;
+            const glm::dvec3 e = glm::dvec3(rgba[4 * p], rgba[4 * p + 1], rgba[4 * p + 2]) * m.omega[p];
+            if (e.r == 0 && e.g == 0 && e.b == 0) continue;
+            if (lit.size() == limit) {
+                few = false;
+                break;
             }
-        if (!(in > 0)) continue;
-        fftw_execute_dft_r2c(m.forward, m.real.data(), Impl::as_fftw(m.work));
-        for (std::size_t t = 0; t < m.work.size(); ++t) m.work[t] *= m.kernel_hat[t];
-        fftw_execute_dft_c2r(m.inverse, Impl::as_fftw(m.work), m.real.data());
-        double out = 0;
-        for (int j = 0; j < h; ++j)
-            for (int i = 0; i < w; ++i) {
-                const std::size_t p = static_cast<std::size_t>(j) * w + i;
-                // Rounding leaves ±1e-16 of the total where the true value is ~0: no negative light.
-                const double e = std::max(0.0, m.real[static_cast<std::size_t>(j) * m.mx + i] * norm);
-                out += e;
-                rgba[4 * p + static_cast<std::size_t>(c)] = static_cast<float>(e / m.omega[p]);
-            }
-        outside[c] = std::clamp(1.0 - out / in, 0.0, 1.0);
-    }
-    return outside;
+            lit.push_back({i, j, {e.r, e.g, e.b}});
+            in += e;
+        }
+    m.last = few ? VeilMethod::direct : VeilMethod::fft;
+    return few ? m.apply_direct(rgba, lit, in) : m.apply_fft(rgba);
 }
 
 }  // namespace atonlab::stimuli

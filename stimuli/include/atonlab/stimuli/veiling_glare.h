@@ -1,7 +1,8 @@
 #pragma once
 // Wide-angle veiling glare over a whole frame (the `cie` glare model): the
 // lights' direct images convolved with the CIE glare spread function (CIE 135/1-1999)
-// (cie_glare.h) by a frame-sized FFT convolution, in double precision (FFTW).
+// (cie_glare.h), in double precision: summed directly over the lit pixels when
+// few are lit, by a frame-sized FFT convolution (FFTW) otherwise.
 //
 // Energy: each pixel's light is its illuminance e = L·Ω (lux; L in cd/m², Ω the
 // pixel's exact pinhole solid angle); the kernel K(d) is the GSF integrated over
@@ -47,6 +48,22 @@ struct VeilReport {
     double cpu_ms = 0;              ///< read-back, convolution (kernel build included) and upload
 };
 
+/// How apply() convolves (issue 27 item 3). Both are the same linear
+/// convolution with the same kernel; they differ only in rounding (the FFT's
+/// ≈ 1e-16 of the frame's brightest pixel; the direct sum is exact to the
+/// sum's own rounding, which matters where the veil is 1e-9 of the light).
+enum class VeilMethod {
+    automatic,  ///< direct while at most kVeilDirectMaxLitPixels pixels are lit, the FFT beyond
+    direct,     ///< Σ over lit pixels of e(p) K(q − p): O(pixels × lit pixels), exact
+    fft,        ///< the linear FFT convolution (pruned rows, columns on every core)
+};
+
+/// The crossover of VeilMethod::automatic: a frame with at most this many lit
+/// pixels (any channel > 0) is summed directly. Measured by the `cie_veil_crossover`
+/// bench on the 2-core VM at 1920×1080 (docs/bench.md): the direct sum's time per
+/// lit pixel against the FFT's time per frame.
+constexpr int kVeilDirectMaxLitPixels = 120;
+
 class VeilingGlare {
 public:
     VeilingGlare();
@@ -60,10 +77,14 @@ public:
     /// carried outside the frame (0 for a channel without energy). The kernel's
     /// spectrum is cached for the last (size, focal length, observer).
     /// Throws InputError (cie_glare_spread()) for a bad observer.
-    glm::dvec3 apply(std::vector<float>& rgba, int width, int height, double focal_px, const CieObserver& observer);
+    /// `method` chooses the convolution (VeilMethod; automatic by default).
+    glm::dvec3 apply(std::vector<float>& rgba, int width, int height, double focal_px, const CieObserver& observer,
+                     VeilMethod method = VeilMethod::automatic);
 
     /// How often the kernel was built (since construction).
     int kernel_builds() const;
+    /// The method the last apply() used (direct or fft; automatic before any).
+    VeilMethod last_method() const;
 
 private:
     struct Impl;
