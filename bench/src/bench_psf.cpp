@@ -299,6 +299,7 @@ void bench_pupil_tolerance(Bench& b) {
     // The exact PSF of each frame, for the error.
     std::vector<RgbPsf> exact;
     {
+        scene.glare.pupil_tolerance_mm = 0.0;  // the exact pupil (not the default moving-pupil cache)
         FrameRenderer r;
         for (int i = 0; i < frames; ++i) {
             r.render(scene, i / 60.0);

@@ -12,6 +12,7 @@
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/pupil_kernel_cache.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/spectral_path.h"
 
@@ -97,7 +98,6 @@ struct GlareStage::Impl {
     struct Group {
         GlareModel model = GlareModel::none;
         std::string spd;
-        std::string key;
         std::optional<RgbPsf> psf;
         GlareKernel kernel;
         AreaLayers layers;
@@ -106,6 +106,12 @@ struct GlareStage::Impl {
         gl::Buffer layer_buffer;
         GlareGroupReport report;
         std::vector<float> envelope;  // billboard crop table (see envelope_buffer())
+        // The moving pupil (GlareSettings::pupil_tolerance_mm not given): the
+        // grid kernels, the last pupil and whether it changed at the last frame.
+        PupilKernelCache pupil_cache;
+        std::string base_key;  // everything the kernel depends on but the pupil
+        bool has_pupil = false, pupil_changed = false;
+        double pupil = 0;
     };
     std::map<std::string, Group> groups;  // by model and SPD name ("wave-optics|d65"), kept between frames
     std::vector<std::string> order;       // this frame's groups, index = group id
@@ -146,6 +152,69 @@ struct GlareStage::Impl {
         g.report.kernel_peak = g.envelope.empty() ? 0.0 : g.envelope[0];
         g.layers_radius_px = -1;  // rebuild the layers from the new kernel
         ++counts.kernels;
+    }
+
+    // The kernel of a moving pupil: interpolated between grid pupils
+    // (pupil_kernel_cache.h), their PSFs built only when first needed.
+    void interpolate_kernel(Group& g, const Scene& scene, double ppd, double time_s, double pupil_mm) {
+        GlareSettings gs = scene.glare;
+        gs.model = g.model;
+        const SpectralSamples samples = spectral_samples(spd_for(g.spd), gs.spectral_samples);
+        const GlareModelType& type = glare_model_type(g.model);
+        auto build = [&](double grid_pupil_mm) {
+            GlareModelKernel k = type.billboard_kernel({gs, scene, samples, ppd, grid_pupil_mm, time_s,
+                                                        [this](int n) -> GpuPsfGenerator& { return generator_for(n); }});
+            ++counts.kernels;
+            return std::move(k.kernel);
+        };
+        g.kernel = g.pupil_cache.kernel_at(pupil_mm, build);
+        g.psf.reset();  // no PSF at this pupil: the kernel is the grid kernels' cubic
+        g.report = {};
+        g.report.model = g.model;
+        g.report.spd = g.spd;
+        g.report.pupil_mm = pupil_mm;
+        gs.eye.pupil_diameter_mm = pupil_mm;
+        g.report.degrees_per_texel = type.psf_degrees_per_texel(gs);
+        g.report.kernel_size_px = g.kernel.size;
+        g.report.radius_deg = g.kernel.radius_px / ppd;
+        g.report.window_cut = g.kernel.window_cut;
+        g.envelope = crop_envelope(g.kernel);
+        g.report.kernel_peak = g.envelope.empty() ? 0.0 : g.envelope[0];
+        g.layers_radius_px = -1;
+        ++counts.interpolations;
+    }
+
+    // The group's kernel for this frame's pupil: kept while the pupil stays,
+    // built for it exactly when it has just changed (or was given a rounding
+    // step), interpolated while it keeps moving (hippus, or a change at each of
+    // the last two frames: a dusk-to-night sequence, not a new trial).
+    void update_kernel(Group& g, const Scene& scene, double ppd, double time_s, double pupil_mm,
+                       const std::string& base_key) {
+        if (g.base_key != base_key) {
+            g.pupil_cache.clear();
+            g.has_pupil = g.pupil_changed = false;
+            g.base_key = base_key;
+        }
+        if (g.has_pupil && pupil_mm == g.pupil) {
+            g.pupil_changed = false;
+            return;
+        }
+        const GlareSettings& gs = scene.glare;
+        const bool moving = !gs.pupil_tolerance_mm && (gs.eye.hippus.enabled || g.pupil_changed);
+        bool done = false;
+        if (moving) {
+            try {
+                interpolate_kernel(g, scene, ppd, time_s, pupil_mm);
+                done = true;
+            } catch (const InputError&) {
+                // A grid pupil the eye refuses (beyond its defocus limit, next to
+                // the largest pupil): this pupil exactly, as without the cache.
+            }
+        }
+        if (!done) build_kernel(g, scene, ppd, time_s, pupil_mm);
+        g.pupil_changed = g.has_pupil;
+        g.has_pupil = true;
+        g.pupil = pupil_mm;
     }
 
     // Largest texel (any channel) at Chebyshev distance ≥ e from the centre,
@@ -231,7 +300,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     const double ppd = scene.display.pixels_per_degree_at_centre();
     const double pupil = glare_pupil_mm(scene);
     auto pupil_for = [&](GlareModel model) {
-        return cached_pupil_mm(glare_model_type(model).kernel_pupil_mm(gs, pupil, time_s), gs.pupil_tolerance_mm);
+        return cached_pupil_mm(glare_model_type(model).kernel_pupil_mm(gs, pupil, time_s),
+                               gs.pupil_tolerance_mm.value_or(0.0));
     };
     const EyeModel& e = gs.eye;
     std::string common;
@@ -268,11 +338,8 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
         g.spd = group_spds[gi];
         // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
         const double pupil_now = pupil_for(g.model);
-        const std::string key = fmt::format("{}|{}|{}|{}", glare_model_name(g.model), common, pupil_now, g.spd);
-        if (g.key != key) {
-            m.build_kernel(g, scene, ppd, time_s, pupil_now);
-            g.key = key;
-        }
+        const std::string key = fmt::format("{}|{}|{}", glare_model_name(g.model), common, g.spd);
+        m.update_kernel(g, scene, ppd, time_s, pupil_now, key);
         // Layers only where a light covers more than a pixel; radius rounded up
         // to a power of two so a light approaching does not rebuild every frame.
         double r_build = 0;

@@ -35,8 +35,9 @@ struct GlareGroupReport {
 /// kernel (the PSF with its spectral integration, once per SPD group and
 /// pupil/eye state) and the area layers.
 struct GlareBuildCounts {
-    int kernels = 0;
+    int kernels = 0;         ///< PSFs built (exact pupils and the moving pupil's grid pupils)
     int layers = 0;
+    int interpolations = 0;  ///< kernels interpolated between grid pupils (a moving pupil; no PSF built)
 };
 
 /// Default billboard radius (degrees) of a model: for the FFT models the part

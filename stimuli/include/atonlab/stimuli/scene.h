@@ -119,11 +119,15 @@ struct GlareSettings {
     double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
     bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
     CieObserver cie;                    ///< cie: the observer's age and ocular pigmentation
-    /// The PSF cache's pupil step (mm): the kernel is computed for the pupil
-    /// diameter rounded to a multiple of this step, so a pupil that moves by
-    /// less (hippus, a drifting adaptation level) reuses the cached PSF. 0: the
-    /// exact pupil, rebuilt on any change. docs/bench.md measures the error.
-    double pupil_tolerance_mm = 0.0;
+    /// The PSF cache's pupil step (mm), when given: the kernel is computed for
+    /// the pupil diameter rounded to a multiple of this step, so a pupil that
+    /// moves by less (hippus, a drifting adaptation level) reuses the cached
+    /// PSF; 0: the exact pupil, rebuilt on any change. Not given (the default):
+    /// the exact pupil while it stays still, and while it moves (hippus, or a
+    /// pupil that changed in each of the last two frames) the kernel
+    /// interpolated between grid pupils 0.05 mm apart (pupil_kernel_cache.h,
+    /// issue 27 item 2). docs/bench.md measures the errors of both.
+    std::optional<double> pupil_tolerance_mm;
 };
 
 struct Scene {
