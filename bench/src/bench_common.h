@@ -68,6 +68,9 @@ double max_code_change(const stimuli::ImageRGBA32F& a, double adaptation_a, cons
 void bench_psf_size(Bench& b);
 void bench_spectral_samples(Bench& b);
 void bench_cie_veil(Bench& b);
+void bench_cie_veil_methods(Bench& b);  // bench_realtime.cpp (issue 27)
+void bench_psf_rebuild(Bench& b);
+void bench_moving_pupil(Bench& b);
 void bench_fft(Bench& b);
 void bench_pupil_tolerance(Bench& b);
 void bench_area_layers(Bench& b);
