@@ -34,7 +34,9 @@ namespace {
 double process_cpu_ms() {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
-    auto ms = [](const timeval& t) { return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_usec) * 1e-3; };
+    auto ms = [](const timeval& t) {
+        return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_usec) * 1e-3;
+    };
     return ms(u.ru_utime) + ms(u.ru_stime);
 }
 
@@ -228,8 +230,8 @@ void bench_moving_pupil(Bench& b) {
         return t;
     };
     std::vector<GlareKernel> exact;
-    std::vector<std::pair<std::string, std::optional<double>>> settings = {{"exact pupil every frame", 0.0},
-                                                                          {"interpolated, 0.05 mm grid (default)", {}}};
+    std::vector<std::pair<std::string, std::optional<double>>> settings = {
+        {"exact pupil every frame", 0.0}, {"interpolated, 0.05 mm grid (default)", {}}};
     for (const auto& [name, tolerance] : settings) {
         scene.glare.pupil_tolerance_mm = tolerance;
         double worst = 0, cpu = 0;
@@ -248,8 +250,8 @@ void bench_moving_pupil(Bench& b) {
             },
             TimeSpec{0, b.quick() ? 1 : 2, false}, &cpu);
         Timing per_frame = t;
-        for (double* v : {&per_frame.wall.median, &per_frame.wall.q1, &per_frame.wall.q3, &per_frame.wall.min,
-                          &per_frame.wall.max})
+        for (double* v :
+             {&per_frame.wall.median, &per_frame.wall.q1, &per_frame.wall.q3, &per_frame.wall.min, &per_frame.wall.max})
             *v /= frames;
         Row r;
         r.bench = "moving_pupil";

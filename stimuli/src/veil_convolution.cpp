@@ -69,7 +69,8 @@ void VeilFft::build(const VeilKernelQuadrant& kernel) {
         // One plan per worker over its own rows or columns, made once for this
         // frame size (FFTW_ESTIMATE: the same plan, hence the same bits, every time).
         for (int t = 0; t < workers; ++t) {
-            const int r0 = row_chunk_[static_cast<std::size_t>(t)], rn = row_chunk_[static_cast<std::size_t>(t) + 1] - r0;
+            const int r0 = row_chunk_[static_cast<std::size_t>(t)],
+                      rn = row_chunk_[static_cast<std::size_t>(t) + 1] - r0;
             const int c0 = column_chunk_[static_cast<std::size_t>(t)],
                       cn = column_chunk_[static_cast<std::size_t>(t) + 1] - c0;
             double* rows = rows_ + static_cast<std::ptrdiff_t>(r0) * mx_;
@@ -102,8 +103,7 @@ void VeilFft::build(const VeilKernelQuadrant& kernel) {
     fftw_plan p;
     {
         std::lock_guard lock(fftw_planner_mutex());
-        p = fftw_plan_dft_r2c_2d(my_, mx_, wrapped.data(), reinterpret_cast<fftw_complex*>(hat.data()),
-                                 FFTW_ESTIMATE);
+        p = fftw_plan_dft_r2c_2d(my_, mx_, wrapped.data(), reinterpret_cast<fftw_complex*>(hat.data()), FFTW_ESTIMATE);
     }
     fftw_execute(p);
     {
@@ -161,7 +161,8 @@ void VeilFft::convolve(std::vector<double>& e) {
     });
 }
 
-void veil_direct_sum(const VeilKernelQuadrant& kernel, const std::vector<LitPixel>& lit, std::vector<double> (&out)[3]) {
+void veil_direct_sum(const VeilKernelQuadrant& kernel, const std::vector<LitPixel>& lit,
+                     std::vector<double> (&out)[3]) {
     const int w = kernel.width, h = kernel.height;
     const auto uw = static_cast<std::size_t>(w);
     for (auto& o : out) o.assign(uw * static_cast<std::size_t>(h), 0.0);

@@ -31,9 +31,9 @@ public:
 private:
     void destroy();
     int w_ = 0, h_ = 0, mx_ = 0, my_ = 0, cols_ = 0;
-    double* rows_ = nullptr;           // h × mx reals (the frame's rows, padded along x)
-    fftw_complex* spec_ = nullptr;     // my × cols (cols = mx/2 + 1)
-    std::vector<double> kernel_hat_;   // my × cols: the kernel's spectrum (real: K is even in x and y)
+    double* rows_ = nullptr;          // h × mx reals (the frame's rows, padded along x)
+    fftw_complex* spec_ = nullptr;    // my × cols (cols = mx/2 + 1)
+    std::vector<double> kernel_hat_;  // my × cols: the kernel's spectrum (real: K is even in x and y)
     std::vector<fftw_plan> row_forward_, column_forward_, column_inverse_, row_inverse_;  // one per worker
     std::vector<int> row_chunk_, column_chunk_;  // worker t: [chunk[t], chunk[t + 1])
 };
@@ -46,8 +46,7 @@ struct LitPixel {
 
 /// The three channels by the direct sum: out[c] (h × w, lux) = Σ_p e_p[c] K(q − p)
 /// over the lit pixels. `kernel` is the frame's quadrant (w × h).
-void veil_direct_sum(const VeilKernelQuadrant& kernel, const std::vector<LitPixel>& lit,
-                     std::vector<double> (&out)[3]);
+void veil_direct_sum(const VeilKernelQuadrant& kernel, const std::vector<LitPixel>& lit, std::vector<double> (&out)[3]);
 
 /// The smallest n ≥ m whose prime factors are 2, 3, 5 and 7 (FFTW's fast sizes).
 int fftw_size_at_least(int m);

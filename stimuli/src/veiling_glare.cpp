@@ -1,6 +1,7 @@
 // The `cie` glare model over a whole frame: the CIE glare spread
-// function (CIE 135/1-1999) integrated over each pixel's solid angle, and the frame-sized linear
-// convolution by FFTW (veiling_glare.h).
+// function (CIE 135/1-1999) integrated over each pixel's solid angle, and the
+// frame's convolution with it, by the direct sum or the FFT
+// (veil_convolution.h; veiling_glare.h).
 #include "atonlab/stimuli/veiling_glare.h"
 
 #include <algorithm>
@@ -56,25 +57,25 @@ VeilKernelQuadrant veil_kernel_quadrant(const CieGlareSpread& gsf, int width, in
     k.value.assign(static_cast<std::size_t>(width) * height, 0.0);
     // Rows on every core (each pixel computed as it would be alone).
     detail::parallel_chunks(height, [&](int dy0, int dy1, int) {
-    for (int dy = dy0; dy < dy1; ++dy)
-        for (int dx = 0; dx < width; ++dx) {
-            double e;
-            if (dx == 0 && dy == 0) {
-                // The central pixel holds the steep core (the 0.0046° term): its
-                // inscribed disc, a cone of half-angle atan(0.5/f), exactly by the
-                // 1-D integral; the four corners by a fine midpoint rule.
-                e = cie_energy_between(gsf, 0.0, std::atan(0.5 / f) * kRadToDeg) +
-                    pixel_quadrature(gsf, 0.0, 0.0, f, 256, 0.5);
-            } else {
-                // Samples per axis: the GSF falls like θ⁻² … θ⁻³, so the midpoint
-                // rule's relative error is about 0.5 / (r s)² (r in px): below
-                // 1e-4 everywhere with these steps.
-                const double r = std::hypot(dx, dy);
-                const int s = r < 2 ? 64 : r < 4 ? 32 : r < 16 ? 8 : r < 64 ? 2 : 1;
-                e = pixel_quadrature(gsf, dx, dy, f, s);
+        for (int dy = dy0; dy < dy1; ++dy)
+            for (int dx = 0; dx < width; ++dx) {
+                double e;
+                if (dx == 0 && dy == 0) {
+                    // The central pixel holds the steep core (the 0.0046° term): its
+                    // inscribed disc, a cone of half-angle atan(0.5/f), exactly by the
+                    // 1-D integral; the four corners by a fine midpoint rule.
+                    e = cie_energy_between(gsf, 0.0, std::atan(0.5 / f) * kRadToDeg) +
+                        pixel_quadrature(gsf, 0.0, 0.0, f, 256, 0.5);
+                } else {
+                    // Samples per axis: the GSF falls like θ⁻² … θ⁻³, so the midpoint
+                    // rule's relative error is about 0.5 / (r s)² (r in px): below
+                    // 1e-4 everywhere with these steps.
+                    const double r = std::hypot(dx, dy);
+                    const int s = r < 2 ? 64 : r < 4 ? 32 : r < 16 ? 8 : r < 64 ? 2 : 1;
+                    e = pixel_quadrature(gsf, dx, dy, f, s);
+                }
+                k.value[static_cast<std::size_t>(dy) * width + dx] = e;
             }
-            k.value[static_cast<std::size_t>(dy) * width + dx] = e;
-        }
     });
     return k;
 }

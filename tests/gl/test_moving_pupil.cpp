@@ -51,8 +51,8 @@ TEST_F(MovingPupil, DuskToNightBuildsOnePsfPerGridPupilNotOnePerFrame) {
     // new trial, not yet a moving one); then one PSF per grid pupil crossed,
     // plus the stencil's four at the start.
     const int bound = 2 + static_cast<int>(std::ceil((p_last - p_first) / kPupilGridStepMm)) + 4;
-    std::printf("%d frames, pupil %.3f → %.3f mm: %d PSFs built (bound %d), %d kernels interpolated\n", frames,
-                p_first, p_last, c.kernels, bound, c.interpolations);
+    std::printf("%d frames, pupil %.3f → %.3f mm: %d PSFs built (bound %d), %d kernels interpolated\n", frames, p_first,
+                p_last, c.kernels, bound, c.interpolations);
     EXPECT_LE(c.kernels, bound);
     // Every frame after the first two but a few (measured: 97 of 98; a frame
     // whose stencil the eye refuses is built exactly instead).

@@ -30,8 +30,8 @@ struct KernelMaker {
     }
     GlareKernel operator()(double pupil_mm) const {
         return glare_model_type(GlareModel::wave_optics)
-            .billboard_kernel({scene.glare, scene, samples, scene.display.pixels_per_degree_at_centre(), pupil_mm,
-                               0.0, {}})
+            .billboard_kernel(
+                {scene.glare, scene, samples, scene.display.pixels_per_degree_at_centre(), pupil_mm, 0.0, {}})
             .kernel;
     }
 };

@@ -23,7 +23,9 @@ struct Frame {
     int w, h;
     double f;
     std::vector<float> rgba;
-    float& at(int i, int j, int c) { return rgba[(static_cast<std::size_t>(j) * w + i) * 4 + static_cast<std::size_t>(c)]; }
+    float& at(int i, int j, int c) {
+        return rgba[(static_cast<std::size_t>(j) * w + i) * 4 + static_cast<std::size_t>(c)];
+    }
 };
 
 // A 301×201 frame at 12 px per degree with `count` lights of different colours
