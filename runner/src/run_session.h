@@ -7,7 +7,7 @@
 // The parts live in session/: stimulus_renderer.h (a frame's overrides → the
 // displayed luminance around each judged light, cached), session_inputs.h
 // (options, protocol and scene checked), condition_scene.h, resume.h,
-// session_observer.h, trial_loop.h, trial_record.h, snapshot.h,
+// session_observer.h, session_display.h, trial_loop.h, trial_record.h, snapshot.h,
 // true_value.h, progress.h, summary.h. run_session() drives them: load and
 // validate everything, open the store, begin or resume a session, run the
 // trials, summarise.

@@ -13,7 +13,7 @@
 #include "session/progress.h"
 #include "session/session_observer.h"
 #include "session/stimulus_renderer.h"
-#include "session_display.h"
+#include "session/session_display.h"
 
 namespace atonlab::runner {
 

@@ -14,7 +14,7 @@
 #include "atonlab/store/records.h"
 #include "session/session_observer.h"
 #include "session/stimulus_renderer.h"
-#include "session_display.h"
+#include "session/session_display.h"
 
 namespace atonlab::runner {
 

@@ -1,5 +1,5 @@
 // What a session shows (session_display.h; docs/running.md "On screen").
-#include "session_display.h"
+#include "session/session_display.h"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 #include "atonlab/display/display_model.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/image_io.h"
-#include "run_session.h"
+#include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 
