@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "atonlab/protocols/protocol.h"
-#include "commands.h"
+#include "check_command.h"
 #include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {

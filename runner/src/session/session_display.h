@@ -16,7 +16,7 @@
 #include "atonlab/runner/presenter.h"
 #include "atonlab/runner/text.h"
 #include "atonlab/stimuli/scene.h"
-#include "commands.h"
+#include "session/run_options.h"
 
 namespace atonlab::runner {
 

@@ -9,7 +9,7 @@
 #include "atonlab/runner/presenter.h"
 #include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/store.h"
-#include "commands.h"
+#include "session/run_options.h"
 #include "session/progress.h"
 #include "session/session_observer.h"
 #include "session/stimulus_renderer.h"
