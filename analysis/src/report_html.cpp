@@ -5,7 +5,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <charconv>
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <map>
 #include <set>
@@ -162,81 +163,31 @@ code { background: #f4f4f4; padding: 0 0.2em; }
   .files { display: none; }
 })";
 
-/// A JSON text (valid: the store's CHECK has seen to that) as (path, value)
-/// pairs in document order, for the calibration's parameter table: objects
-/// give "a.b", arrays "a[0]"; strings are unquoted, numbers as written.
-class JsonFlattener {
-public:
-    explicit JsonFlattener(std::string_view text) : s_(text) {}
+/// A JSON value's leaves as (path, cell) rows in document order, for the
+/// calibration's parameter table: objects give "a.b", arrays "a[0]"; strings
+/// unquoted, numbers to 6 significant digits (summary.json keeps them whole).
+void flatten_json(const nlohmann::ordered_json& j, const std::string& path,
+                  std::vector<std::pair<std::string, std::string>>& out) {
+    if (j.is_object()) {
+        for (const auto& [key, value] : j.items()) flatten_json(value, path.empty() ? key : path + "." + key, out);
+    } else if (j.is_array()) {
+        for (std::size_t n = 0; n < j.size(); ++n) flatten_json(j[n], fmt::format("{}[{}]", path, n), out);
+    } else if (j.is_string()) {
+        out.emplace_back(path, esc(j.get<std::string>()));
+    } else if (j.is_number()) {
+        out.emplace_back(path, fmt::format("{:.6g}", j.get<double>()));
+    } else {
+        out.emplace_back(path, esc(j.dump()));  // true, false, null
+    }
+}
 
-    std::vector<std::pair<std::string, std::string>> run() {
-        value("");
-        return out_;
-    }
-
-private:
-    void ws() {
-        while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\n' || s_[i_] == '\r' || s_[i_] == '\t')) ++i_;
-    }
-    std::string string() {
-        std::string v;
-        ++i_;  // the opening quote
-        while (i_ < s_.size() && s_[i_] != '"') {
-            if (s_[i_] == '\\' && i_ + 1 < s_.size()) {
-                ++i_;
-                const char e = s_[i_];
-                v += e == 'n' ? '\n' : e == 't' ? '\t' : e == 'u' ? '?' : e;
-                if (e == 'u') i_ += 4;
-            } else {
-                v += s_[i_];
-            }
-            ++i_;
-        }
-        ++i_;  // the closing quote
-        return v;
-    }
-    void value(const std::string& path) {
-        ws();
-        if (i_ >= s_.size()) return;
-        const char c = s_[i_];
-        if (c == '{') {
-            ++i_;
-            ws();
-            while (i_ < s_.size() && s_[i_] != '}') {
-                ws();
-                const std::string k = string();
-                ws();
-                ++i_;  // ':'
-                value(path.empty() ? k : path + "." + k);
-                ws();
-                if (i_ < s_.size() && s_[i_] == ',') ++i_;
-                ws();
-            }
-            ++i_;
-        } else if (c == '[') {
-            ++i_;
-            ws();
-            for (int n = 0; i_ < s_.size() && s_[i_] != ']'; ++n) {
-                value(fmt::format("{}[{}]", path, n));
-                ws();
-                if (i_ < s_.size() && s_[i_] == ',') ++i_;
-                ws();
-            }
-            ++i_;
-        } else if (c == '"') {
-            out_.emplace_back(path, string());
-        } else {
-            const std::size_t start = i_;
-            while (i_ < s_.size() && s_[i_] != ',' && s_[i_] != '}' && s_[i_] != ']' && s_[i_] != ' ' && s_[i_] != '\n')
-                ++i_;
-            out_.emplace_back(path, std::string(s_.substr(start, i_ - start)));
-        }
-    }
-
-    std::string_view s_;
-    std::size_t i_ = 0;
-    std::vector<std::pair<std::string, std::string>> out_;
-};
+/// A calibration's fit_json (valid: the store's CHECK has seen to that) as rows; none when it does not parse.
+std::vector<std::pair<std::string, std::string>> fit_json_rows(const std::string& fit_json) {
+    std::vector<std::pair<std::string, std::string>> rows;
+    const auto j = nlohmann::ordered_json::parse(fit_json, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_discarded()) flatten_json(j, "", rows);
+    return rows;
+}
 
 /// A judged light in a table cell: "red, Fl(1) 4s, –, glare wave-optics".
 std::string light_cell(const LightLook& l, const std::string& glare) {
@@ -487,14 +438,8 @@ std::string calibration_html(const Dataset& d, const ReportContext& ctx, const s
                 "<p>Display model of <b>{}</b> (calibration {} of <code>{}</code>; its <code>fit_json</code>):</p>\n",
                 esc(c.display_name), c.id, esc(c.source));
             h += "<div class=\"table-wrap\"><table>\n<tr><th>parameter</th><th>value</th></tr>\n";
-            for (const auto& [key, value] : JsonFlattener(c.fit_json).run()) {
-                // Numbers to 6 significant digits (summary.json keeps them whole).
-                double x = 0.0;
-                const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
-                const bool number = ec == std::errc() && end == value.data() + value.size();
-                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key),
-                                 number ? fmt::format("{:.6g}", x) : esc(value));
-            }
+            for (const auto& [key, cell] : fit_json_rows(c.fit_json))
+                h += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{}</td></tr>\n", esc(key), cell);
             h += "</table></div>\n";
         }
         if (ctx.plots)

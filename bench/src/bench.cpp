@@ -98,11 +98,7 @@ BenchSummary run_bench(const BenchOptions& options, const gl::ContextInfo& conte
         "The whole bench took {:.0f} s.",
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     write_markdown(path("bench.md"), m, b.rows, b.points, b.scaling_notes);
-    for (const auto& [name, text] : b.documents) {
-        std::ofstream f(path(name.c_str()));
-        f << text;
-        if (!f) throw std::runtime_error(fmt::format("cannot write {}.", summary.files.back()));
-    }
+    for (const auto& [name, text] : b.documents) write_output(path(name.c_str()), text);
     if (options.plots) {
         summary.plotted = write_plots(options.out_dir, b.rows, b.points);
         if (summary.plotted) {

@@ -10,10 +10,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/image_io.h"
@@ -24,28 +24,6 @@ namespace atonlab::bench {
 
 using namespace atonlab::stimuli;
 using namespace atonlab::display;
-
-namespace {
-
-// pfsoutpfm's PFM: "PF\nW H\n-1\n", little-endian float RGB, bottom row first; returned top row first.
-std::vector<float> read_pfm_top_down(const std::filesystem::path& path, int w, int h) {
-    std::ifstream in(path, std::ios::binary);
-    std::string magic;
-    int fw = 0, fh = 0;
-    double scale = 0;
-    in >> magic >> fw >> fh >> scale;
-    in.get();
-    std::vector<float> bottom_up(static_cast<std::size_t>(w) * h * 3);
-    if (magic != "PF" || fw != w || fh != h || !(scale < 0)) return {};
-    in.read(reinterpret_cast<char*>(bottom_up.data()), static_cast<std::streamsize>(bottom_up.size() * 4));
-    std::vector<float> top_down(bottom_up.size());
-    for (int y = 0; y < h; ++y)
-        std::copy_n(&bottom_up[static_cast<std::size_t>(h - 1 - y) * w * 3], w * 3,
-                    &top_down[static_cast<std::size_t>(y) * w * 3]);
-    return top_down;
-}
-
-}  // namespace
 
 void bench_tonemap_pfstools(Bench& b) {
     if (std::system("command -v pfstmo_reinhard02 > /dev/null 2>&1 && command -v pfsoutpfm > /dev/null 2>&1") != 0) {
@@ -103,8 +81,16 @@ void bench_tonemap_pfstools(Bench& b) {
     auto pfstools = [&] { pfs_status = std::system(pfs_command.c_str()); };
     const std::vector<Timing> times = measure_interleaved({atonlab_tonemap, pfstools}, b.spec(5, false));
 
-    const std::vector<float> theirs =
-        pfs_status == 0 ? read_pfm_top_down(pfm, frame.width, frame.height) : std::vector<float>{};
+    std::vector<float> theirs;  // empty: pfstools failed, or its PFM is not this frame's size
+    if (pfs_status == 0) {
+        try {
+            int w = 0, h = 0;
+            theirs = read_pfm_rgb(pfm, w, h);
+            if (w != frame.width || h != frame.height) theirs.clear();
+        } catch (const InputError&) {
+            theirs.clear();
+        }
+    }
     double sum = 0;
     int worst = 0;
     for (std::size_t i = 0; i < theirs.size(); ++i) {

@@ -15,17 +15,12 @@
 #include <sstream>
 #include <thread>
 
+#include "atonlab/common/atomic_file.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::bench {
 
 namespace {
-
-std::ofstream open_for_writing(const std::string& path) {
-    std::ofstream out(path);
-    if (!out) throw InputError(SourceLocation{path, 0, 0, "--out"}, fmt::format("cannot write {}.", path));
-    return out;
-}
 
 std::string csv_text(const std::string& s) {
     std::string out = "\"";
@@ -87,6 +82,14 @@ std::vector<std::string> series_order(const std::vector<ScalePoint>& points) {
 }
 
 }  // namespace
+
+void write_output(const std::string& path, const std::string& text) {
+    try {
+        files::write_file_atomically(path, text);
+    } catch (const files::WriteError& e) {
+        throw InputError(SourceLocation{path, 0, 0, "--out"}, fmt::format("cannot write {}: {}.", path, e.reason()));
+    }
+}
 
 Fit fit_line(const std::vector<ScalePoint>& points, const std::string& series) {
     double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
@@ -172,7 +175,7 @@ Machine describe_machine(const std::string& label, const std::string& vendor, co
 }
 
 void write_csv(const std::string& path, const std::vector<Row>& rows) {
-    std::ofstream out = open_for_writing(path);
+    std::ostringstream out;
     out << "bench,setting,default,time_ms,time_q1_ms,time_q3_ms,time_min_ms,time_max_ms,repeats,clock,"
            "wall_ms,gpu_ms,error,metric,max_code_diff,energy_error_pct,pareto,note\n";
     for (const Row& r : rows) {
@@ -184,10 +187,11 @@ void write_csv(const std::string& path, const std::vector<Row>& rows) {
             << csv_text(r.metric) << ',' << num(r.codes) << ',' << num(r.energy_pct) << ',' << (r.pareto ? 1 : 0)
             << ',' << csv_text(r.note) << '\n';
     }
+    write_output(path, out.str());
 }
 
 void write_scaling_csv(const std::string& path, const std::vector<ScalePoint>& points) {
-    std::ofstream out = open_for_writing(path);
+    std::ostringstream out;
     out << "series,lights,drawn,time_ms,time_q1_ms,time_q3_ms,time_min_ms,time_max_ms,repeats,clock,wall_ms\n";
     for (const ScalePoint& p : points) {
         const Stats& t = p.time.primary();
@@ -195,10 +199,11 @@ void write_scaling_csv(const std::string& path, const std::vector<ScalePoint>& p
             << ',' << num(t.q3) << ',' << num(t.min) << ',' << num(t.max) << ',' << t.n << ',' << p.time.clock()
             << ',' << num(p.time.wall.median) << '\n';
     }
+    write_output(path, out.str());
 }
 
 void write_machine(const std::string& path, const Machine& m) {
-    std::ofstream out = open_for_writing(path);
+    std::ostringstream out;
     out << "label: " << m.label << "\n"
         << "gl_renderer: " << m.gl_renderer << "\n"
         << "gl_vendor: " << m.gl_vendor << "\n"
@@ -211,11 +216,12 @@ void write_machine(const std::string& path, const Machine& m) {
         << "atonlab: " << m.version << " (" << m.build << ")\n"
         << "load_average_1_5_15min: " << m.load_start << " (at the start), " << load_average() << " (at the end)\n"
         << "form: " << (m.quick ? "quick" : "full") << "\n";
+    write_output(path, out.str());
 }
 
 void write_markdown(const std::string& path, const Machine& m, const std::vector<Row>& rows,
                     const std::vector<ScalePoint>& points, const std::vector<std::string>& scaling_notes) {
-    std::ofstream out = open_for_writing(path);
+    std::ostringstream out;
     out << "# atonlab bench: run time against error\n\n"
         << "Machine: **" << m.label << "** — GL `" << m.gl_renderer << "`, " << m.gl_version << " (" << m.gl_platform
         << (m.software ? ", software rasteriser" : "") << "); CPU " << m.cpu << ", " << m.cpu_cores << " cores, "
@@ -269,6 +275,7 @@ void write_markdown(const std::string& path, const Machine& m, const std::vector
         out << "\n";
     }
     for (const std::string& n : scaling_notes) out << "- " << n << "\n";
+    write_output(path, out.str());
 }
 
 bool write_plots(const std::string& dir, const std::vector<Row>& rows, const std::vector<ScalePoint>& points) {
@@ -289,7 +296,7 @@ bool write_plots(const std::string& dir, const std::vector<Row>& rows, const std
         plotted.push_back(b);
         // Exact settings (error 0) sit a decade below the smallest error, labelled "exact".
         const double floor_err = min_positive > 0 ? min_positive / 10 : 1e-9;
-        std::ofstream all((plot / (b + ".dat")).string()), front((plot / (b + "-front.dat")).string());
+        std::ostringstream all, front;
         all << "# error time_ms is_default label (error 0 drawn at " << floor_err << ")\n";
         std::vector<const Row*> sorted;
         for (const Row& r : rows)
@@ -301,10 +308,12 @@ bool write_plots(const std::string& dir, const std::vector<Row>& rows, const std
             all << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", e, r->time.primary().median, r->is_default ? 1 : 0, label);
             if (r->pareto) front << fmt::format("{:.6g} {:.6g}\n", e, r->time.primary().median);
         }
+        write_output((plot / (b + ".dat")).string(), all.str());
+        write_output((plot / (b + "-front.dat")).string(), front.str());
     }
     const int cols = 3, nrows = std::max(1, static_cast<int>((plotted.size() + cols - 1) / cols));
     {
-        std::ofstream gp((plot / "pareto.gp").string());
+        std::ostringstream gp;
         gp << "# Time against error per knob, Pareto front as a line, the default as a red star.\n"
            << fmt::format("set terminal pngcairo size {},{} font 'sans,9' noenhanced\n", 520 * cols, 420 * nrows)
            << "set output 'pareto.png'\n"
@@ -323,9 +332,10 @@ bool write_plots(const std::string& dir, const std::vector<Row>& rows, const std
                << "     '" << d << "' using 1:2:4 with labels offset 0.8,0.6 left font 'sans,7'\n";
         }
         gp << "unset multiplot\n";
+        write_output((plot / "pareto.gp").string(), gp.str());
     }
     if (!points.empty()) {
-        std::ofstream gp((plot / "scaling.gp").string());
+        std::ostringstream gp;
         gp << "# Frame time against the number of lights, per series.\n"
            << "set terminal pngcairo size 900,600 font 'sans,10' noenhanced\n"
            << "set output 'scaling.png'\n"
@@ -337,16 +347,18 @@ bool write_plots(const std::string& dir, const std::vector<Row>& rows, const std
             std::string file = s;
             for (char& c : file)
                 if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-            std::ofstream d((plot / ("scaling-" + file + ".dat")).string());
+            std::ostringstream d;
             for (const ScalePoint& p : points)
                 if (p.series == s)  // 0 lights at x = 0.5 on the log axis
                     d << (p.lights > 0 ? p.lights : 0.5) << ' ' << p.time.primary().median << ' '
                       << p.time.primary().min << ' ' << p.time.primary().max << '\n';
+            write_output((plot / ("scaling-" + file + ".dat")).string(), d.str());
             gp << (first ? "" : ", \\\n     ") << "'plot/scaling-" << file << ".dat"
                << "' using 1:2:3:4 with yerrorlines title '" << s << "'";
             first = false;
         }
         gp << "\n";
+        write_output((plot / "scaling.gp").string(), gp.str());
     }
     // Paths in the scripts are relative to dir, so the results can be moved and re-plotted.
     if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) return false;

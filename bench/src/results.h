@@ -61,6 +61,10 @@ struct Machine {
 Machine describe_machine(const std::string& label, const std::string& vendor, const std::string& renderer,
                          const std::string& version, const std::string& platform, bool software, bool quick);
 
+/// Every file the bench writes goes through here: whole or not at all
+/// (common's AtomicFile); a failure is an InputError naming the file (`--out`).
+void write_output(const std::string& path, const std::string& text);
+
 void write_csv(const std::string& path, const std::vector<Row>& rows);
 void write_scaling_csv(const std::string& path, const std::vector<ScalePoint>& points);
 void write_machine(const std::string& path, const Machine& m);

@@ -12,6 +12,7 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
+#include "atonlab/display/readings_text.h"
 
 namespace atonlab::display {
 
@@ -38,15 +39,6 @@ std::string_view trim(std::string_view s) {
     if (b == std::string_view::npos) return {};
     const auto e = s.find_last_not_of(" \t\r");
     return s.substr(b, e - b + 1);
-}
-
-std::optional<double> parse_number(std::string_view s) {
-    s = trim(s);
-    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-    double v = 0.0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-    return v;
 }
 
 std::string read_text(const std::filesystem::path& path) {
@@ -176,8 +168,7 @@ CsvHeader parse_csv_header(const std::vector<std::pair<std::string_view, int>>& 
         }
         if (reading_name) {
             h.reading_key = std::string(name);
-            // 1 fL = (1/π) cd/ft², 1 ft = 0.3048 m: 3.4262591 cd/m² (NIST SP 811, B.9).
-            h.reading_scale = name == "fL" ? 3.4262590996353905 : 1.0;
+            h.reading_scale = name == "fL" ? kCdM2PerFootLambert : 1.0;
         }
     }
     const bool xyz = h.col_x >= 0 || col_y >= 0 || h.col_z >= 0;
@@ -234,7 +225,7 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
         const auto& [channel_text, channel_col] = fields[static_cast<std::size_t>(col_channel)];
         const auto& [cd_text, cd_col] = fields[static_cast<std::size_t>(col_cd)];
 
-        const auto raw_level = parse_number(level_text);
+        const auto raw_level = reading_number(level_text);
         if (!raw_level)
             throw InputError(SourceLocation{file_name, line_no, level_col, level_key},
                              fmt::format("'{}' is not a number", level_text));
@@ -278,7 +269,7 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
                 SourceLocation{file_name, line_no, channel_col, "channel"},
                 fmt::format("unknown channel '{}'; use red, green, blue, grey, white or black", channel_text));
         }
-        const auto cd = parse_number(cd_text);
+        const auto cd = reading_number(cd_text);
         if (!cd)
             throw InputError(SourceLocation{file_name, line_no, cd_col, reading_key},
                              fmt::format("'{}' is not a number", cd_text));
@@ -291,7 +282,7 @@ std::vector<Measurement> parse_calibration_csv(std::string_view text, const std:
             double xz[2] = {};
             for (int k = 0; k < 2; ++k) {
                 const auto& [text_k, col_k] = fields[static_cast<std::size_t>(k == 0 ? col_x : col_z)];
-                const auto v = parse_number(text_k);
+                const auto v = reading_number(text_k);
                 if (!v || *v < 0.0)
                     throw InputError(SourceLocation{file_name, line_no, col_k, k == 0 ? "X" : "Z"},
                                      fmt::format("'{}' is not a number >= 0", text_k));
@@ -322,36 +313,6 @@ std::vector<Measurement> read_calibration_csv(const std::filesystem::path& path,
 
 namespace {
 
-struct Token {
-    std::string text;
-    int column;  // 1-based
-};
-
-/// CGATS tokens: whitespace separated, "quoted strings" kept whole, # to end of line a comment.
-std::vector<Token> tokenize(std::string_view line) {
-    std::vector<Token> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        const char ch = line[i];
-        if (ch == ' ' || ch == '\t' || ch == '\r') {
-            ++i;
-        } else if (ch == '#') {
-            break;
-        } else if (ch == '"') {
-            const std::size_t end = line.find('"', i + 1);
-            const std::size_t stop = end == std::string_view::npos ? line.size() : end;
-            out.push_back({std::string(line.substr(i + 1, stop - i - 1)), static_cast<int>(i) + 1});
-            i = stop + 1;
-        } else {
-            std::size_t j = i;
-            while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r' && line[j] != '#') ++j;
-            out.push_back({std::string(line.substr(i, j - i)), static_cast<int>(i) + 1});
-            i = j;
-        }
-    }
-    return out;
-}
-
 struct Keyword {
     std::string value;
     int line;
@@ -367,7 +328,7 @@ struct Ti3Table {
     std::vector<std::string> fields;
     int format_line = 0, data_line = 0, end_line = 0;
     std::optional<std::pair<long, int>> number_of_fields, number_of_sets;  // value, line
-    std::vector<std::pair<std::vector<Token>, int>> rows;                  // tokens, line
+    std::vector<std::pair<std::vector<ReadingToken>, int>> rows;           // tokens, line
 };
 
 /// Reads the lines of a .ti3 file into its table; throws where the file's structure is broken (no CTI3,
@@ -380,8 +341,8 @@ Ti3Table read_ti3_table(const std::vector<std::string_view>& lines, const std::s
     Ti3Table table;
     auto& [keywords, fields, format_line, data_line, end_line, number_of_fields, number_of_sets, rows] = table;
 
-    auto parse_count = [&](const std::vector<Token>& t, int line_no) {
-        const auto v = t.size() == 2 ? parse_number(t[1].text) : std::nullopt;
+    auto parse_count = [&](const std::vector<ReadingToken>& t, int line_no) {
+        const auto v = t.size() == 2 ? reading_number(t[1].text) : std::nullopt;
         if (!v || *v < 0.0 || *v != std::floor(*v))
             throw error(line_no, t[0].column, t[0].text, "expects one whole number");
         return std::pair{static_cast<long>(*v), line_no};
@@ -389,7 +350,7 @@ Ti3Table read_ti3_table(const std::vector<std::string_view>& lines, const std::s
 
     for (std::size_t li = 0; li < lines.size() && state != State::done; ++li) {
         const int line_no = static_cast<int>(li) + 1;
-        const auto tokens = tokenize(lines[li]);
+        const auto tokens = reading_tokens(lines[li]);
         if (tokens.empty()) continue;
         const std::string& head = tokens[0].text;
         switch (state) {
@@ -478,7 +439,7 @@ double ti3_absolute_scale(const std::map<std::string, Keyword>& keywords, const 
         std::istringstream ss(lum->second.value);
         std::string xs, ys, zs, extra;
         ss >> xs >> ys >> zs;
-        const auto x = parse_number(xs), y = parse_number(ys), z = parse_number(zs);
+        const auto x = reading_number(xs), y = reading_number(ys), z = reading_number(zs);
         if (!x || !y || !z || (ss >> extra) || *y <= 0.0)
             throw ti3_error(file_name, lum->second.line, 1, "LUMINANCE_XYZ_CDM2",
                             fmt::format("expects the white's X Y Z in cd/m² (three numbers, Y > 0), not \"{}\"",
@@ -537,7 +498,7 @@ std::vector<Measurement> parse_argyll_ti3(std::string_view text, const std::stri
                         fmt::format("this data line has {} values but BEGIN_DATA_FORMAT (line {}) names {} fields",
                                     tokens.size(), format_line, fields.size()));
         auto number = [&](std::size_t i) {
-            const auto v = parse_number(tokens[i].text);
+            const auto v = reading_number(tokens[i].text);
             if (!v)
                 throw error(line_no, tokens[i].column, fields[i], fmt::format("'{}' is not a number", tokens[i].text));
             return *v;

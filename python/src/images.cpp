@@ -14,7 +14,7 @@
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/image_io.h"
 #include "bindings.h"
-#include "commands.h"
+#include "psf_command.h"
 #include "image_commands.h"
 #include "light_command.h"
 

@@ -34,7 +34,7 @@
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
-#include "commands.h"
+#include "analyze_command.h"
 
 namespace atonlab::runner {
 

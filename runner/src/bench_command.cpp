@@ -13,7 +13,7 @@
 #include "atonlab/bench/bench.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
-#include "commands.h"
+#include "bench_command.h"
 
 namespace atonlab::runner {
 

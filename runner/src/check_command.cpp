@@ -22,7 +22,7 @@
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
 #include "calibrate/calibration_policy.h"
-#include "commands.h"
+#include "check_command.h"
 #include "displayability.h"
 #include "run_session.h"
 

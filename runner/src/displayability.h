@@ -40,7 +40,8 @@
 #include <vector>
 
 #include "atonlab/protocols/protocol.h"
-#include "run_session.h"
+#include "check_command.h"
+#include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

@@ -19,7 +19,7 @@
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/stimuli/spectral_path.h"
-#include "commands.h"
+#include "psf_command.h"
 
 namespace atonlab::runner {
 

@@ -18,7 +18,7 @@
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "commands.h"
+#include "render_command.h"
 #include "render_frame.h"
 
 namespace atonlab::runner {

@@ -13,7 +13,7 @@
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/error.h"
-#include "commands.h"
+#include "run_command.h"
 #include "run_session.h"
 
 namespace atonlab::runner {

@@ -28,7 +28,7 @@
 #include "session/stop_signals.h"
 #include "session/summary.h"
 #include "session/trial_loop.h"
-#include "session_display.h"
+#include "session/session_display.h"
 
 namespace atonlab::runner {
 
@@ -219,7 +219,7 @@ int run_session(const RunOptions& o) {
             std::fflush(stdout);
         }
         // --- What is shown: the screens and the trials, on screen or on the
-        // virtual display (session_display.h). The session clock goes on from
+        // virtual display (session/session_display.h). The session clock goes on from
         // the last stored answer.
         SessionDisplayOptions display_options;
         display_options.person = person;

@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <system_error>
@@ -393,6 +394,30 @@ std::vector<float> read_png_rgb(const std::filesystem::path& path, int& width, i
     width = static_cast<int>(shape.width);
     height = static_cast<int>(shape.height);
     return rgb;
+}
+
+std::vector<float> read_pfm_rgb(const std::filesystem::path& path, int& width, int& height) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, fmt::format("cannot open the PFM image: {}", errno_text(errno)));
+    std::string magic;
+    int w = 0, h = 0;
+    double scale = 0;
+    in >> magic >> w >> h >> scale;
+    in.get();  // the one whitespace character after the scale
+    if (!in || magic != "PF" || w <= 0 || h <= 0)
+        fail(path, "the file is not a colour PFM image (\"PF\", width, height, scale)");
+    if (!(scale < 0)) fail(path, "the PFM image is big-endian (a positive scale); only little-endian is read");
+    std::vector<float> bottom_up(static_cast<std::size_t>(w) * h * 3);
+    in.read(reinterpret_cast<char*>(bottom_up.data()), static_cast<std::streamsize>(bottom_up.size() * 4));
+    if (in.gcount() != static_cast<std::streamsize>(bottom_up.size() * 4))
+        fail(path, fmt::format("the PFM image is shorter than its {}x{} pixels", w, h));
+    std::vector<float> top_down(bottom_up.size());
+    for (int y = 0; y < h; ++y)
+        std::copy_n(&bottom_up[static_cast<std::size_t>(h - 1 - y) * w * 3], w * 3,
+                    &top_down[static_cast<std::size_t>(y) * w * 3]);
+    width = w;
+    height = h;
+    return top_down;
 }
 
 }  // namespace atonlab::stimuli

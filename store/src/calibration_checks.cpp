@@ -4,19 +4,11 @@
 
 #include <cmath>
 
+#include "atonlab/common/iso_date.h"
 #include "store_impl.h"
 
 namespace atonlab::store {
 namespace {
-
-bool iso_date_prefix(std::string_view s) {
-    if (s.size() < 10) return false;
-    for (std::size_t i = 0; i < 10; ++i) {
-        const bool dash = i == 4 || i == 7;
-        if (dash ? s[i] != '-' : (s[i] < '0' || s[i] > '9')) return false;
-    }
-    return true;
-}
 
 std::optional<int> optional_int(const sql::Statement& s, int col) {
     if (s.is_null(col)) return std::nullopt;
@@ -82,7 +74,7 @@ std::vector<CalibrationReading> Store::calibration_readings(CalibrationId id) co
 CalibrationCheckId Store::put_calibration_check(const CalibrationCheck& c) {
     const std::string doing = fmt::format("store a check of calibration {}", c.calibration.value);
     impl_->require_writable(doing);
-    if (!iso_date_prefix(c.checked_at)) impl_->invalid(doing, "checked_at is not an ISO 8601 date (YYYY-MM-DD...)");
+    if (!iso_date(c.checked_at)) impl_->invalid(doing, "checked_at is not an ISO 8601 date (YYYY-MM-DD...)");
     sql::Connection& db = *impl_->db;
     sql::Transaction tx(db, sql::Transaction::Kind::write, doing);
     if (!json_valid(db, c.results_json, doing)) impl_->invalid(doing, "results_json is not valid JSON");

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "atonlab/common/iso_date.h"
 #include "store_impl.h"
 
 namespace atonlab::store {
@@ -10,16 +11,6 @@ namespace {
 
 bool positive(double v) {
     return std::isfinite(v) && v > 0.0;
-}
-
-// ISO 8601 starts YYYY-MM-DD; with that prefix, text order is date order.
-bool iso_date_prefix(std::string_view s) {
-    if (s.size() < 10) return false;
-    for (std::size_t i = 0; i < 10; ++i) {
-        const bool dash = i == 4 || i == 7;
-        if (dash ? s[i] != '-' : (s[i] < '0' || s[i] > '9')) return false;
-    }
-    return true;
 }
 
 bool unit_interval(double v) {
@@ -104,7 +95,7 @@ CalibrationId Store::put_calibration(const Calibration& c, std::span<const Calib
     if (!positive(c.width_m) || !positive(c.height_m) || !positive(c.viewing_distance_m)) {
         impl_->invalid(doing, "the width, height and viewing distance must be positive metres");
     }
-    if (!iso_date_prefix(c.measured_at)) impl_->invalid(doing, "measured_at is not an ISO 8601 date (YYYY-MM-DD...)");
+    if (!iso_date(c.measured_at)) impl_->invalid(doing, "measured_at is not an ISO 8601 date (YYYY-MM-DD...)");
     for (std::size_t i = 0; i < readings.size(); ++i)
         if (const std::string why = reading_problem(readings[i]); !why.empty())
             impl_->invalid(doing, fmt::format("reading {} (patch \"{}\") {}", i, readings[i].patch, why));

@@ -13,15 +13,14 @@
 
 #include "atonlab/display/calibration.h"
 #include "input_error.h"
+#include "text_contains.h"
 
 namespace atonlab::display {
 namespace {
 
 using test::input_error_of;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 std::string data_path(const std::string& name) {
     return std::string(ATONLAB_SOURCE_DIR) + "/tests/data/calibration/" + name;

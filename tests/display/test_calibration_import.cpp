@@ -11,15 +11,14 @@
 
 #include "atonlab/display/calibration.h"
 #include "input_error.h"
+#include "text_contains.h"
 
 namespace atonlab::display {
 namespace {
 
 using test::input_error_of;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 double law_cd_m2(double v) {
     return 0.2 + 119.8 * std::pow(v, 2.2);

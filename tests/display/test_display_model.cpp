@@ -17,15 +17,14 @@
 
 #include "atonlab/display/display_model.h"
 #include "input_error.h"
+#include "text_contains.h"
 
 namespace atonlab::display {
 namespace {
 
 using test::input_error_of;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 // A measured-looking LUT with a flat toe (two equal readings) and uneven spacing.
 std::vector<LutPoint> measured_lut(double scale) {

@@ -34,6 +34,7 @@
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 #include "../support/skip.h"
+#include "text_contains.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -52,9 +53,7 @@ const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data";
 using Result = test::Captured;
 using test::atonlab;
 
-bool contains(const std::string& s, const std::string& what) {
-    return s.find(what) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& b) {
     a.insert(a.end(), b.begin(), b.end());

@@ -23,6 +23,7 @@
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
 #include "../support/skip.h"
+#include "text_contains.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -43,9 +44,7 @@ const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data";
 using Result = test::Captured;
 using test::atonlab;
 
-bool contains(const std::string& s, const std::string& what) {
-    return s.find(what) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 /// tests/data/run/small_2afc.toml with its display named `display`, written to dir.
 fs::path protocol_for(const fs::path& dir, const std::string& display) {

@@ -47,6 +47,7 @@
 #include "gl_test_support.h"
 #include "run_session.h"
 #include "../support/skip.h"
+#include "text_contains.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -182,9 +183,7 @@ INSTANTIATE_TEST_SUITE_P(Displayability, Examples, ::testing::ValuesIn(examples_
 using Result = test::Captured;
 using test::atonlab;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 /// IEC 61966-2-1 (sRGB) decoding of a drive level V in [0, 1]: the scene's
 /// default display (docs/scene-file.md: transfer "srgb", peak 100 cd/m², black

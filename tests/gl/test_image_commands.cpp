@@ -56,24 +56,6 @@ bool render(const fs::path& exr, const std::string& extra = "") {
     return rc == 0;
 }
 
-// pfsoutpfm's PFM: "PF\nW H\n-1\n" then little-endian float RGB, bottom row first.
-std::vector<float> read_pfm(const fs::path& path, int& w, int& h) {
-    std::ifstream in(path, std::ios::binary);
-    std::string magic;
-    double scale = 0;
-    in >> magic >> w >> h >> scale;
-    in.get();
-    EXPECT_EQ(magic, "PF");
-    EXPECT_LT(scale, 0) << "little-endian";
-    std::vector<float> bottom_up(static_cast<std::size_t>(w) * h * 3);
-    in.read(reinterpret_cast<char*>(bottom_up.data()), static_cast<std::streamsize>(bottom_up.size() * 4));
-    std::vector<float> top_down(bottom_up.size());
-    for (int y = 0; y < h; ++y)
-        std::copy_n(&bottom_up[static_cast<std::size_t>(h - 1 - y) * w * 3], w * 3,
-                    &top_down[static_cast<std::size_t>(y) * w * 3]);
-    return top_down;
-}
-
 // IEC 61966-2-1 encoding of a linear value clipped to [0, 1], rounded to 8 bits.
 int srgb_code(double v) {
     v = std::clamp(v, 0.0, 1.0);
@@ -103,7 +85,7 @@ TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
     int w = 0, h = 0;
     const std::vector<float> ours = read_png_rgb(dir / "atonlab.png", w, h);
     int pw = 0, ph = 0;
-    const std::vector<float> pfs = read_pfm(dir / "pfs.pfm", pw, ph);
+    const std::vector<float> pfs = read_pfm_rgb(dir / "pfs.pfm", pw, ph);
     ASSERT_EQ(w, pw);
     ASSERT_EQ(h, ph);
     // pfsout clips each channel at 1; atonlab's encoder keeps an out-of-gamut colour's

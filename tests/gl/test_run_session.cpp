@@ -156,7 +156,7 @@ protected:
         ASSERT_EQ(reference_.size(), static_cast<std::size_t>(kTrials));
     }
 
-    int run_atonlab(const std::vector<std::string>& args, bool drop_root = false) {
+    int run_study(const std::vector<std::string>& args, bool drop_root = false) {
         return wait_for(spawn(db(), args, out(), err(), drop_root));
     }
     fs::path db() const { return dir_.path() / "study.db"; }
@@ -173,7 +173,7 @@ protected:
 };
 
 TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
-    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet"}), 0) << text_of(err());
     EXPECT_EQ(text_of(out()), "") << "--quiet prints nothing";
     Store s = Store::open_read_only(db());
     EXPECT_EQ(s.integrity_check(), "ok");
@@ -307,7 +307,7 @@ TEST_F(run, KilledRepeatedlyEachResumeContinuesTheUninterruptedSequence) {
     for (const auto& r : Store::open_read_only(db()).sessions())
         unfinished = unfinished || r.status != store::SessionStatus::completed;
     if (unfinished) {
-        ASSERT_EQ(run_atonlab({"--resume-last", "--quiet"}), 0) << text_of(err());
+        ASSERT_EQ(run_study({"--resume-last", "--quiet"}), 0) << text_of(err());
     }
     Store s = Store::open_read_only(db());
     const auto completed = s.sessions().size();
@@ -346,7 +346,7 @@ TEST_F(run, SigtermQuitsBetweenTrialsAndTheSessionContinues) {
         expect_prefix(trials, reference_);
         EXPECT_NE(text_of(out()).find("--resume 1"), std::string::npos) << "says how to continue";
     }
-    ASSERT_EQ(run_atonlab({"--resume", "1", "--quiet"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--resume", "1", "--quiet"}), 0) << text_of(err());
     Store s = Store::open_read_only(db());
     const auto sessions = s.sessions();
     ASSERT_EQ(sessions.size(), 1u);
@@ -360,7 +360,7 @@ TEST_F(run, SigtermQuitsBetweenTrialsAndTheSessionContinues) {
 TEST_F(run, DiskFullStopsWithStatus4AndLosesNothing) {
     // Session 1 completes; session 2 may grow the file by the first
     // condition's snapshot and a few pages, and hits the limit.
-    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet"}), 0) << text_of(err());
     std::int64_t logical = 0, snapshot = 0;
     {
         RawDb raw(db());
@@ -369,7 +369,7 @@ TEST_F(run, DiskFullStopsWithStatus4AndLosesNothing) {
     }
     const std::vector<TrialRecord> first = trials_of(db(), store::SessionId{1});
     const std::int64_t limit = logical + snapshot + 24 * 1024;
-    ASSERT_EQ(run_atonlab({"--quiet", "--db-max-bytes", std::to_string(limit)}), 4) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet", "--db-max-bytes", std::to_string(limit)}), 4) << text_of(err());
     const std::string message = text_of(err());
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
     EXPECT_NE(message.find("full"), std::string::npos) << message;
@@ -391,7 +391,7 @@ TEST_F(run, DiskFullStopsWithStatus4AndLosesNothing) {
         expect_prefix(partial, reference_);
     }
     // With room again, the session continues where it stopped.
-    ASSERT_EQ(run_atonlab({"--quiet", "--resume-last"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet", "--resume-last"}), 0) << text_of(err());
     const auto trials = trials_of(db(), store::SessionId{2});
     ASSERT_EQ(trials.size(), static_cast<std::size_t>(kTrials));
     for (std::size_t i = 0; i < trials.size(); ++i) expect_same_trial(trials[i], reference_[i]);
@@ -400,12 +400,12 @@ TEST_F(run, DiskFullStopsWithStatus4AndLosesNothing) {
 }
 
 TEST_F(run, WriteProtectedFileStopsWithStatus4AndIsUnchanged) {
-    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet"}), 0) << text_of(err());
     const std::string before = file_bytes(db());
     ASSERT_EQ(chmod(db().c_str(), 0444), 0);
     // "nobody" must reach the directory (not write it) to be told the file is protected.
     ASSERT_EQ(chmod(dir_.path().c_str(), 0755), 0);
-    const int code = run_atonlab({"--quiet"}, /*drop_root=*/true);
+    const int code = run_study({"--quiet"}, /*drop_root=*/true);
     if (code == 121) ATONLAB_SKIP_NOT_APPLICABLE() << "running as root and cannot drop to nobody, for whom permissions apply";
     EXPECT_EQ(code, 4) << text_of(err());
     const std::string message = text_of(err());
@@ -418,13 +418,13 @@ TEST_F(run, WriteProtectedFileStopsWithStatus4AndIsUnchanged) {
 }
 
 TEST_F(run, NewerSchemaStopsWithStatus4AndIsUnchanged) {
-    ASSERT_EQ(run_atonlab({"--quiet"}), 0) << text_of(err());
+    ASSERT_EQ(run_study({"--quiet"}), 0) << text_of(err());
     {
         RawDb raw(db());
         ASSERT_EQ(raw.exec("PRAGMA user_version = 99"), "");
     }
     const std::string before = file_bytes(db());
-    EXPECT_EQ(run_atonlab({"--quiet"}), 4) << text_of(err());
+    EXPECT_EQ(run_study({"--quiet"}), 4) << text_of(err());
     const std::string message = text_of(err());
     EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
     EXPECT_NE(message.find("newer atonlab"), std::string::npos) << message;
@@ -439,7 +439,7 @@ TEST_F(run, ScriptedObserverAnswersFromItsFile) {
         script << "# the first interval, always\n";
         for (int i = 0; i < kTrials; ++i) script << "left 0.5\n";
     }
-    ASSERT_EQ(run_atonlab({"--quiet", "--script", (dir_.path() / "answers.txt").string(), "--observer", "S01"}), 0)
+    ASSERT_EQ(run_study({"--quiet", "--script", (dir_.path() / "answers.txt").string(), "--observer", "S01"}), 0)
         << text_of(err());
     Store s = Store::open_read_only(db());
     const auto sessions = s.sessions();
@@ -459,7 +459,7 @@ TEST_F(run, ScriptRunningOutLeavesTheSessionToContinue) {
         std::ofstream f(script);
         for (int i = 0; i < 5; ++i) f << "right\n";
     }
-    EXPECT_EQ(run_atonlab({"--quiet", "--script", script.string()}), 2);
+    EXPECT_EQ(run_study({"--quiet", "--script", script.string()}), 2);
     const std::string message = text_of(err());
     EXPECT_NE(message.find("answers.txt"), std::string::npos) << message;
     EXPECT_NE(message.find("used up"), std::string::npos) << message;

@@ -41,12 +41,6 @@ using store::test_support::TempDir;
 
 const fs::path kData = fs::path(ATONLAB_SOURCE_DIR) / "tests/data/runner";
 
-int run_atonlab(const std::vector<std::string>& args, const fs::path& out, const fs::path& err) {
-    std::vector<std::string> argv{ATONLAB_BINARY};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return test::run_to_files(std::move(argv), out, err);
-}
-
 /// screen_stall.toml with its scene path made absolute and `extra` added to [timing].
 fs::path protocol_copy(const TempDir& dir, const std::string& name, const std::string& timing_extra,
                        bool repeat_missed = true) {
@@ -70,17 +64,19 @@ protected:
         std::vector<std::string> args{"run",        protocol.string(), "--db",         db.string(),
                                       "--headless", "--quiet",         "--no-true-pse"};
         args.insert(args.end(), extra.begin(), extra.end());
-        const int status = run_atonlab(args, dir_.path() / "out.txt", dir_.path() / "err.txt");
-        if (status == 3) skipped_ = true;
-        return status;
+        const test::Captured r = test::atonlab(std::move(args), dir_.path());
+        err_ = r.err;
+        if (r.code == 3) skipped_ = true;
+        return r.code;
     }
-    std::string err() const { return file_bytes(dir_.path() / "err.txt"); }
+    const std::string& err() const { return err_; }
     std::vector<TrialRecord> trials(const fs::path& db) {
         Store s = Store::open_read_only(db);
         return s.trials(s.sessions().back().id);
     }
     TempDir dir_;
     bool skipped_ = false;
+    std::string err_;  ///< the last run's stderr
 };
 
 TEST_F(RunnerVirtual, AStallMarksItsTrialWhichIsShownAgain) {

@@ -32,6 +32,7 @@
 #include "../support/skip.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
+#include "text_contains.h"
 
 #ifndef ATONLAB_BINARY
 #error "ATONLAB_BINARY (the atonlab executable) must be defined by the build"
@@ -58,9 +59,7 @@ Result run_tiny(const fs::path& db, const fs::path& dir, const std::string& tag 
                    tag);
 }
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 /// One line on stderr that names the file.
 void expect_one_sentence_naming(const Result& r, const fs::path& file) {

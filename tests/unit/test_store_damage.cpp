@@ -20,6 +20,7 @@
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
 #include "../support/skip.h"
+#include "text_contains.h"
 
 namespace atonlab::store {
 namespace {
@@ -32,9 +33,7 @@ using test_support::make_trial;
 using test_support::RawDb;
 using test_support::TempDir;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 /// A closed study file (no -wal left) with one session of `n` trials whose
 /// rows span many pages.

@@ -18,6 +18,7 @@
 #include "../store/store_test_support.h"
 #include "atonlab/store/schema.h"
 #include "atonlab/store/store.h"
+#include "text_contains.h"
 
 namespace atonlab::store {
 namespace {
@@ -30,9 +31,7 @@ using test_support::make_trial;
 using test_support::RawDb;
 using test_support::TempDir;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 // Every trial 0..n-1 of the file's only session is there, exactly as written,
 // and SQLite finds the file sound. Read with a fresh connection after the writer

@@ -21,6 +21,7 @@
 #include "atonlab/store/json.h"
 #include "atonlab/store/profiles.h"
 #include "atonlab/store/store.h"
+#include "text_contains.h"
 
 namespace atonlab::store {
 namespace {
@@ -33,9 +34,7 @@ using test_support::make_trial;
 using test_support::RawDb;
 using test_support::TempDir;
 
-bool contains(const std::string& s, const std::string& part) {
-    return s.find(part) != std::string::npos;
-}
+using ::atonlab::test::contains;
 
 /// Whether `s` is valid UTF-8, by glibc's iconv (not by the code under test).
 bool valid_utf8(const std::string& s) {

@@ -15,6 +15,7 @@
 #include <ctime>
 #include <fstream>
 
+#include "atonlab/common/atomic_file.h"
 #include "atonlab/display/calibration.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/store/error.h"
@@ -152,17 +153,21 @@ fs::path save_typed_readings(const CalibrateOptions& o, const std::vector<Patch>
                              const std::vector<PhotometerReading>& readings, const std::string& how = "typed") {
     const fs::path path =
         output_path(o, fmt::format("{}-{}.readings", file_safe(o.display), utc_now("%Y%m%dT%H%M%SZ")));
-    std::ofstream f(path, std::ios::binary);
-    f << fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n", o.mode, o.display,
-                     how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
+    std::string text = fmt::format("# atonlab calibrate {} of display \"{}\", {} {} (cd/m²; X Y Z where given)\n",
+                                   o.mode, o.display, how, utc_now("%Y-%m-%dT%H:%M:%SZ"));
     for (std::size_t i = 0; i < patches.size(); ++i) {
         const PhotometerReading& r = readings[i];
         if (r.xyz_cd_m2)
-            f << fmt::format("{} {} {} {}\n", patches[i].name, r.xyz_cd_m2->x, r.xyz_cd_m2->y, r.xyz_cd_m2->z);
+            text += fmt::format("{} {} {} {}\n", patches[i].name, r.xyz_cd_m2->x, r.xyz_cd_m2->y, r.xyz_cd_m2->z);
         else
-            f << fmt::format("{} {}\n", patches[i].name, r.luminance_cd_m2);
+            text += fmt::format("{} {}\n", patches[i].name, r.luminance_cd_m2);
     }
-    if (!f) throw InputError(SourceLocation{path.string(), 0, 0, ""}, "cannot write the typed readings here.");
+    try {
+        files::write_file_atomically(path, text);  // whole or not at all
+    } catch (const files::WriteError& e) {
+        throw InputError(SourceLocation{path.string(), 0, 0, ""},
+                         fmt::format("cannot write the typed readings here: {}.", e.reason()));
+    }
     return path;
 }
 

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 
+#include "atonlab/common/atomic_file.h"
 #include "atonlab/store/json.h"
 
 extern char** environ;
@@ -178,6 +180,15 @@ std::string plot_check(const std::filesystem::path& out, const CheckOutcome& o, 
                         1.3;
     std::string quoted_title;
     for (char ch : title) quoted_title += ch == '"' ? '\'' : ch;
+    // gnuplot writes the figure to a temporary sibling, renamed over `out` only
+    // when gnuplot succeeds (common's AtomicFile): whole or not at all.
+    std::optional<files::AtomicFile> figure;
+    try {
+        figure.emplace(out);
+        figure->close_fd();
+    } catch (const files::WriteError& e) {
+        return e.what();
+    }
     const std::string script = fmt::format(
         "set terminal {}\nset output \"{}\"\n"
         "$model << EOD\n{}EOD\n$points << EOD\n{}EOD\n$errors << EOD\n{}EOD\n"
@@ -197,7 +208,7 @@ std::string plot_check(const std::filesystem::path& out, const CheckOutcome& o, 
         "     0 with lines lc rgb '#08519c' notitle, \\\n"
         "     $errors using 1:2 with points pt 7 ps 1.3 lc rgb '#d62728' title 'measured − predicted'\n"
         "unset multiplot\n",
-        terminal, out.string(), model_rows, points, errors, quoted_title, -span, span, black_note,
+        terminal, figure->temp_path().string(), model_rows, points, errors, quoted_title, -span, span, black_note,
         tol.luminance_percent, -tol.luminance_percent, tol.luminance_percent, tol.peak_percent, tol.peak_percent,
         -tol.peak_percent);
     const std::filesystem::path script_path =
@@ -221,7 +232,13 @@ std::string plot_check(const std::filesystem::path& out, const CheckOutcome& o, 
             why = fmt::format("gnuplot failed on {} (exit status {})", script_path.string(),
                               WIFEXITED(status) ? WEXITSTATUS(status) : -1);
     }
-    if (why.empty()) std::filesystem::remove(script_path);
+    if (!why.empty()) return why;
+    std::filesystem::remove(script_path);
+    try {
+        figure->commit();
+    } catch (const files::WriteError& e) {
+        return e.what();
+    }
     return why;
 }
 

@@ -7,23 +7,12 @@
 #include <cstdio>
 #include <ctime>
 
+#include "atonlab/common/iso_date.h"
 #include "atonlab/store/json.h"
 #include "calibration_record.h"
 
 namespace atonlab::runner {
 namespace {
-
-std::optional<std::chrono::sys_days> date_of(const std::string& iso) {
-    if (iso.size() < 10 || iso[4] != '-' || iso[7] != '-') return std::nullopt;
-    for (std::size_t i : {0u, 1u, 2u, 3u, 5u, 6u, 8u, 9u})
-        if (iso[i] < '0' || iso[i] > '9') return std::nullopt;
-    const int y = std::stoi(iso.substr(0, 4));
-    const unsigned m = static_cast<unsigned>(std::stoi(iso.substr(5, 2)));
-    const unsigned d = static_cast<unsigned>(std::stoi(iso.substr(8, 2)));
-    const std::chrono::year_month_day ymd{std::chrono::year{y}, std::chrono::month{m}, std::chrono::day{d}};
-    if (!ymd.ok()) return std::nullopt;
-    return std::chrono::sys_days(ymd);
-}
 
 /// "peak_percent 10.3 > 5, luminance_percent 10.1 > 5" from a check's results_json.
 std::string failed_tolerances(const store::CalibrationCheck& check) {
@@ -58,7 +47,7 @@ std::string utc_today() {
 }
 
 std::optional<long> days_between(const std::string& iso, const std::string& today) {
-    const auto a = date_of(iso), b = date_of(today);
+    const auto a = iso_date(iso), b = iso_date(today);
     if (!a || !b) return std::nullopt;
     return static_cast<long>((*b - *a).count());
 }

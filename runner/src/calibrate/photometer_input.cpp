@@ -7,36 +7,19 @@
 #include <sstream>
 
 #include "atonlab/common/read_file.h"
+#include "atonlab/display/readings_text.h"
 #include "atonlab/stimuli/error.h"
 
 namespace atonlab::runner {
 namespace {
 
-struct Token {
-    std::string_view text;
-    int column;  // 1-based
-};
+using display::kCdM2PerFootLambert;
+using display::reading_number;
+using Token = display::ReadingToken;
 
+/// A readings line's words: blanks or commas separate them (a meter's log may be CSV).
 std::vector<Token> split(std::string_view line) {
-    std::vector<Token> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r' || line[i] == ',')) ++i;
-        if (i >= line.size()) break;
-        std::size_t j = i;
-        while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r' && line[j] != ',') ++j;
-        out.push_back({line.substr(i, j - i), static_cast<int>(i) + 1});
-        i = j;
-    }
-    return out;
-}
-
-std::optional<double> number(std::string_view s) {
-    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-    double v = 0.0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-    return v;
+    return display::reading_tokens(line, /*commas_separate=*/true);
 }
 
 /// cd/m² per unit for a unit word, or nullopt when `s` is not one.
@@ -50,7 +33,7 @@ std::optional<double> unit_scale(std::string_view s) {
 std::variant<PhotometerReading, std::pair<std::string, int>> values_of(const std::vector<Token>& t, std::size_t first) {
     double scale = 1.0;
     std::size_t end = t.size();
-    if (end > first && !number(t[end - 1].text)) {
+    if (end > first && !reading_number(t[end - 1].text)) {
         if (const auto s = unit_scale(t[end - 1].text)) {
             scale = *s;
             --end;
@@ -65,7 +48,7 @@ std::variant<PhotometerReading, std::pair<std::string, int>> values_of(const std
                          n == 0 ? 0 : t[first].column};
     double v[3] = {};
     for (std::size_t i = 0; i < n; ++i) {
-        const auto x = number(t[first + i].text);
+        const auto x = reading_number(t[first + i].text);
         if (!x) return std::pair{fmt::format("'{}' is not a number", t[first + i].text), t[first + i].column};
         if (*x < 0.0)
             return std::pair{fmt::format("{} is negative; a photometer reads 0 or more", t[first + i].text),
@@ -105,7 +88,7 @@ std::vector<PhotometerReading> read_readings_file(const std::filesystem::path& p
         const Patch& patch = patches[out.size()];
         std::size_t first = 0;
         // A name only before a value: a lone word is a value that is not a number.
-        if (t.size() >= 2 && !number(t[0].text) && !unit_scale(t[1].text)) {
+        if (t.size() >= 2 && !reading_number(t[0].text) && !unit_scale(t[1].text)) {
             if (t[0].text != patch.name)
                 throw InputError(SourceLocation{file, line_no, t[0].column, "patch"},
                                  fmt::format("reading {} is for patch \"{}\", not \"{}\" (the patches are read in "

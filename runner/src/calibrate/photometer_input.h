@@ -41,7 +41,4 @@ enum class OperatorCommand { repeat, back, quit, help };
 using OperatorLine = std::variant<TypedReading, OperatorCommand, std::string>;
 OperatorLine parse_operator_line(std::string_view line);
 
-/// 1 foot-lambert in cd/m²: (1/π) cd/ft², 1 ft = 0.3048 m.
-inline constexpr double kCdM2PerFootLambert = 3.4262590996353905;
-
 }  // namespace atonlab::runner

@@ -13,7 +13,7 @@
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/store/store.h"
-#include "commands.h"
+#include "session/run_options.h"
 #include "session/session_observer.h"
 
 namespace atonlab::runner {

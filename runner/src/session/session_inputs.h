@@ -14,7 +14,7 @@
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "commands.h"
+#include "session/run_options.h"
 
 namespace atonlab::runner {
 

@@ -9,7 +9,7 @@
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "commands.h"
+#include "session/run_options.h"
 #include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {

@@ -9,11 +9,11 @@
 #include "atonlab/runner/presenter.h"
 #include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/store.h"
-#include "commands.h"
+#include "session/run_options.h"
 #include "session/progress.h"
 #include "session/session_observer.h"
 #include "session/stimulus_renderer.h"
-#include "session_display.h"
+#include "session/session_display.h"
 
 namespace atonlab::runner {
 

@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 
 #include "atonlab/stimuli/glare_stage.h"
 #include "session/scene_queries.h"
@@ -16,6 +18,40 @@ namespace st = atonlab::store;
 /// Keys in the order written (nlohmann::json would sort them).
 using Json = nlohmann::ordered_json;
 
+namespace {
+
+/// A time or rate as the stimulus column has always stored it: a whole value as
+/// an integer ("60", not "60.0"; the record was once written with fmt's
+/// shortest form and read back), so records of this and earlier versions, and
+/// a resumed session's and an uninterrupted one's, hold the same text.
+Json stored_number(double v) {
+    if (std::isfinite(v) && v == std::trunc(v) && std::abs(v) < 1e15) return static_cast<std::int64_t>(v);
+    return v;
+}
+
+Json frames_shown_json(const FramesShown& f) {
+    Json j;
+    j["refresh_hz"] = stored_number(f.refresh_hz);
+    j["stimulus_frames"] = f.stimulus_frames;
+    j["inter_stimulus_frames"] = f.inter_stimulus_frames;
+    j["inter_trial_frames"] = f.inter_trial_frames;
+    j["presented_s"] = stored_number(f.presented_s);
+    Json shown = Json::array();
+    for (const ShownStep& step : f.shown) {
+        Json one;
+        one["step"] = step.frame >= 0 ? "frame" + std::to_string(step.frame) : std::string("blank");
+        one["onset_s"] = stored_number(step.onset_s);
+        one["duration_s"] = stored_number(step.duration_s);
+        one["flips"] = step.flips;
+        one["dropped"] = step.dropped;
+        shown.push_back(std::move(one));
+    }
+    j["shown"] = std::move(shown);
+    return j;
+}
+
+}  // namespace
+
 std::string view_glare(const s::Scene& sc, const std::string& light) {
     for (const s::Light& l : sc.lights)
         if (!light.empty() && (l.name == light || l.name.starts_with(light + "/")))
@@ -24,7 +60,7 @@ std::string view_glare(const s::Scene& sc, const std::string& light) {
 }
 
 std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, const p::ScheduledTrial& t,
-                          const std::vector<double>& frame_times, const std::string& frames_shown_json,
+                          const std::vector<double>& frame_times, const std::optional<FramesShown>& frames_shown,
                           const std::vector<std::string>& view_glares) {
     const p::Stimulus& stim = t.stimulus;
     Json j;
@@ -65,7 +101,7 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
     timing["stimulus_s"] = tm.stimulus_s;
     timing["inter_stimulus_s"] = tm.inter_stimulus_s;
     timing["inter_trial_s"] = tm.inter_trial_s;
-    timing["frames"] = frames_shown_json.empty() ? Json(nullptr) : Json::parse(frames_shown_json);
+    timing["frames"] = frames_shown ? frames_shown_json(*frames_shown) : Json(nullptr);
     j["timing"] = std::move(timing);
     return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
@@ -113,7 +149,7 @@ st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTria
     tr.procedure_id = t.procedure_id;
     tr.level = t.proposal.level;
     tr.test_on_left = t.proposal.test_on_left;
-    tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.timing_json, view_glares);
+    tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.frames, view_glares);
     tr.response = counted ? std::string(p::response_word(*shown.response))
                           : std::string(shown.end == TrialEnd::timeout ? p::kTimeoutWord : p::kMissedWord);
     if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;

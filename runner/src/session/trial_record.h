@@ -14,7 +14,7 @@
 #include "atonlab/store/records.h"
 #include "session/session_observer.h"
 #include "session/stimulus_renderer.h"
-#include "session_display.h"
+#include "session/session_display.h"
 
 namespace atonlab::runner {
 
@@ -27,7 +27,7 @@ std::string view_glare(const stimuli::Scene& sc, const std::string& light);
 /// views (frame, light, role, glare), timing asked for and what the flips gave.
 std::string stimulus_json(const protocols::Protocol& protocol, const protocols::Condition& c,
                           const protocols::ScheduledTrial& t, const std::vector<double>& frame_times,
-                          const std::string& frames_shown_json, const std::vector<std::string>& view_glares);
+                          const std::optional<FramesShown>& frames_shown, const std::vector<std::string>& view_glares);
 
 /// The procedure's state after the trial, who answered, and what: `answer` is
 /// the answer given (kept for a "missed" trial, whose response column says it

@@ -53,4 +53,10 @@ void write_png_rgb8(const std::filesystem::path& path, int width, int height,
 /// Reads an 8-bit or 16-bit PNG as RGB in [0, 1] (for tests and obstacle images).
 std::vector<float> read_png_rgb(const std::filesystem::path& path, int& width, int& height);
 
+/// Reads a colour PFM ("PF", W H, a negative scale: little-endian floats, rows
+/// bottom first, as pfstools' pfsoutpfm writes it) as linear RGB, top row
+/// first, values as stored (no scale applied). Throws InputError with the path
+/// when the file is not such a PFM or is shorter than its header says.
+std::vector<float> read_pfm_rgb(const std::filesystem::path& path, int& width, int& height);
+
 }  // namespace atonlab::stimuli

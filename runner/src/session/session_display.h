@@ -16,7 +16,7 @@
 #include "atonlab/runner/presenter.h"
 #include "atonlab/runner/text.h"
 #include "atonlab/stimuli/scene.h"
-#include "commands.h"
+#include "session/run_options.h"
 
 namespace atonlab::runner {
 
@@ -38,6 +38,26 @@ enum class TrialEnd : std::uint8_t {
     interrupted,  ///< a signal
 };
 
+/// One step of a trial as its flips showed it; times from the stimulus onset, s.
+struct ShownStep {
+    int frame = -1;  ///< the stimulus frame it showed, or -1 for a blank
+    double onset_s = 0.0;
+    double duration_s = 0.0;
+    int flips = 0;    ///< flips made while it was up
+    int dropped = 0;  ///< refreshes missed at its flips
+};
+
+/// The frames a trial asked for and what the flips gave: whole refreshes at
+/// the measured (on screen) or nominal (headless) rate.
+struct FramesShown {
+    double refresh_hz = 0.0;
+    int stimulus_frames = 0;
+    int inter_stimulus_frames = 0;
+    int inter_trial_frames = 0;
+    double presented_s = 0.0;      ///< the stimulus's onset to its offset, s
+    std::vector<ShownStep> shown;  ///< the steps from the onset (16 at most)
+};
+
 /// One trial as it was shown.
 struct TrialShown {
     TrialEnd end = TrialEnd::answered;
@@ -48,9 +68,8 @@ struct TrialShown {
     double answer_after_offset_s = 0.0;  ///< the answer after the stimulus ended, s (< 0: during it)
     int dropped_frames = 0;              ///< refreshes missed at the stimulus's flips (onsets and offset included)
     bool missed_deadline = false;        ///< a stimulus flip came > 1.5 periods late
-    /// JSON object: the frames asked for and what the flips gave ("refresh_hz",
-    /// "stimulus_frames", "inter_stimulus_frames", "inter_trial_frames", "shown").
-    std::string timing_json;
+    /// The frames asked for and what the flips gave; none before the trial was presented.
+    std::optional<FramesShown> frames;
 };
 
 /// Test hooks (docs/running.md, "Testing").

@@ -1,5 +1,5 @@
 // What a session shows (session_display.h; docs/running.md "On screen").
-#include "session_display.h"
+#include "session/session_display.h"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 #include "atonlab/display/display_model.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/image_io.h"
-#include "run_session.h"
+#include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 
@@ -86,11 +86,10 @@ TrialSteps trial_steps(const std::vector<Screen>& frames, const Screen& bg, cons
 // (so a resumed session stores the same text as an uninterrupted one).
 double trial_time(double dt, bool on_screen, double hz) { return on_screen ? dt : std::round(dt * hz) / hz; }
 
-/// A trial's timing: the first stimulus onset, the last interval's onset, the offset, and the shown steps as
-/// the timing JSON's "shown" objects.
+/// A trial's timing: the first stimulus onset, the last interval's onset, the offset, and the shown steps.
 struct ShownTimes {
     double onset = 0.0, window = 0.0, offset = 0.0;
-    std::string shown;
+    std::vector<ShownStep> shown;
 };
 
 /// The timing of what play() showed; adds the stimulus's dropped frames and missed deadlines to `out`.
@@ -101,7 +100,7 @@ ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_scr
     auto rel = [&](double dt) { return trial_time(dt, on_screen, hz); };
     double onset = 0.0, window = 0.0, offset = played.intervals.back().onset_s;
     bool onset_seen = false, window_seen = false;
-    std::string shown;
+    std::vector<ShownStep> shown;
     for (std::size_t i = 0; i < played.intervals.size(); ++i) {
         const IntervalTiming& iv = played.intervals[i];
         const std::size_t step = played.step_of[i];
@@ -119,10 +118,7 @@ ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_scr
             out.missed_deadline = out.missed_deadline || (step < steps.size() ? iv.missed : iv.late_onset);
         }
         if (step < steps.size() && onset_seen && i < 16)
-            shown += fmt::format("{}{{\"step\":\"{}\",\"onset_s\":{},\"duration_s\":{},\"flips\":{},\"dropped\":{}}}",
-                                 shown.empty() ? "" : ",",
-                                 frame_of_step[step] >= 0 ? fmt::format("frame{}", frame_of_step[step]) : "blank",
-                                 rel(iv.onset_s - onset), rel(iv.duration_s()), iv.flips, iv.dropped);
+            shown.push_back({frame_of_step[step], rel(iv.onset_s - onset), rel(iv.duration_s()), iv.flips, iv.dropped});
     }
     return {onset, window, offset, shown};
 }
@@ -377,10 +373,7 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
     const double onset = times.onset, window = times.window, offset = times.offset;
     const double presented = trial_time(offset - onset, on_screen, hz);
     out.onset_s = onset + clock_offset_s_;
-    out.timing_json = fmt::format(
-        "{{\"refresh_hz\":{},\"stimulus_frames\":{},\"inter_stimulus_frames\":{},\"inter_trial_frames\":{},"
-        "\"presented_s\":{},\"shown\":[{}]}}",
-        hz, n_stim, n_isi, n_iti, presented, times.shown);
+    out.frames = FramesShown{hz, n_stim, n_isi, n_iti, presented, times.shown};
 
     auto is_quit = [&](const InputEvent& e) { return answer_action(e) == p::Action::Quit; };
     if (played.stopped && !(loop && presenter_.input().find(sequence_start, [&](const InputEvent& e) {

@@ -1,0 +1,59 @@
+#pragma once
+// The options of `atonlab run`, the session engine's input (run_session.h;
+// run_command.h is the command line around it).
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace atonlab::runner {
+
+/// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
+/// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
+/// 6 the observer ended the session (quit key, confirmed), 128 + N stopped by signal N.
+struct RunOptions {
+    std::string protocol;
+    std::string db;
+    std::string profiles;      ///< --profiles: the display-profile file (default: profile_location.h)
+    bool no_profiles = false;  ///< --no-profiles: the study file's calibrations only
+    bool model_observer = false;
+    std::string observer;  ///< the observer code (--observer)
+    std::string script;    ///< scripted answers (--script)
+    bool headless = false;
+    std::optional<std::int64_t> resume;
+    bool resume_last = false;
+    std::optional<std::uint64_t> seed;
+    std::optional<std::uint64_t> observer_seed;
+    bool quiet = false;
+    int progress_every = 0;         ///< 0: 25 when stdout is not a terminal (a terminal gets one updating line)
+    bool true_pse = true;           ///< model observer: compute the true PSE / threshold for the summary
+    std::int64_t db_max_bytes = 0;  ///< > 0: the study file may not grow past this (StoreOptions::max_size_bytes)
+    bool allow_undisplayable = false;  ///< run a protocol the displayability check refuses (recorded with the session)
+    /// Headless: a GL 4.5 context is already current (the Python module's one
+    /// context) and is used instead of a new one.
+    bool gl_context_current = false;
+    /// Called after each trial is committed with the session's stored trials
+    /// and the schedule's bound (the Python module's progress callback and its
+    /// Ctrl-C check); it may call request_stop() (session/stop_signals.h).
+    std::function<void(std::size_t stored, std::optional<std::size_t> bound)> after_trial;
+
+    // On screen (without --headless; docs/running.md "On screen").
+    int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary
+    std::optional<double> software_vsync_hz;  ///< pace flips by a timer (a display without vblank, e.g. Xvfb)
+    bool skip_sync_test = false;              ///< start even when the refresh measurement fails
+    double sync_sd_max_ms = 1.0;              ///< the flip intervals' SD must be below this, ms
+    double refresh_tolerance = 0.02;          ///< measured vs nominal refresh rate, relative
+    std::string font;                         ///< TrueType font (default DejaVu Sans)
+    bool trace = false;                       ///< print what each screen waits for (tests drive keys from it)
+
+    // Test-only (docs/running.md "Testing").
+    int inject_stall_frames = 0;                        ///< stall this many refreshes after a stimulus onset ...
+    std::optional<std::int64_t> inject_stall_at_trial;  ///< ... of this trial (the store's trial_index)
+    std::optional<std::int64_t> capture_trial;          ///< capture each frame of this trial as shown ...
+    std::string capture_dir;                            ///< ... into this folder
+    std::string capture_screen_file;                    ///< ... copying this file (Xvfb -fbdir's screen) instead of
+                                                        ///< reading the GL back buffer
+};
+
+}  // namespace atonlab::runner
