@@ -8,15 +8,17 @@
 #include <cmath>
 #include <complex>
 #include <memory>
+#include <mutex>
 #include <vector>
 
-#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/display/colour.h"
+#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/psf.h"
 #include "atonlab/stimuli/spectral_path.h"
+#include "fftw_planner.h"
 
 namespace atonlab::stimuli {
 namespace {
@@ -67,9 +69,13 @@ ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel
     std::unique_ptr<double, FftwFree> real(fftw_alloc_real(real_n));
     std::unique_ptr<fftw_complex, FftwFree> image_f(fftw_alloc_complex(complex_n));
     std::unique_ptr<fftw_complex, FftwFree> kernel_f(fftw_alloc_complex(complex_n));
+    // FFTW's planner is not thread-safe: the library's one lock (a render may
+    // run beside this one, e.g. from Python with the GIL released).
+    std::unique_lock planner(detail::fftw_planner_mutex());
     fftw_plan forward = fftw_plan_dft_r2c_2d(ph, pw, real.get(), image_f.get(), FFTW_ESTIMATE);
     fftw_plan forward_k = fftw_plan_dft_r2c_2d(ph, pw, real.get(), kernel_f.get(), FFTW_ESTIMATE);
     fftw_plan inverse = fftw_plan_dft_c2r_2d(ph, pw, image_f.get(), real.get(), FFTW_ESTIMATE);
+    planner.unlock();
 
     ImageGlareResult out;
     out.image.width = w;
@@ -114,6 +120,7 @@ ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel
         out.output_sum[c] = inside_sum;
         out.edge_cut[c] = in_sum > 0 ? (full_sum - inside_sum) / in_sum : 0.0;
     }
+    planner.lock();
     fftw_destroy_plan(forward);
     fftw_destroy_plan(forward_k);
     fftw_destroy_plan(inverse);
