@@ -7,9 +7,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -21,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "atonlab/stimuli/cpu_threads.h"
 #include "atonlab/stimuli/error.h"
 #include "fftw_planner.h"
 #include "gl_enums.h"
@@ -30,6 +33,18 @@ namespace atonlab::stimuli {
 std::mutex& detail::fftw_planner_mutex() {
     static std::mutex m;
     return m;
+}
+
+namespace {
+std::atomic<std::uint64_t> g_cpu_ffts{0};
+}  // namespace
+
+void detail::count_cpu_ffts(unsigned n) {
+    g_cpu_ffts.fetch_add(n, std::memory_order_relaxed);
+}
+
+std::uint64_t cpu_fft_count() {
+    return g_cpu_ffts.load(std::memory_order_relaxed);
 }
 
 bool is_power_of_two(int n) {
@@ -136,6 +151,7 @@ public:
         auto* buffer = reinterpret_cast<std::complex<T>*>(data_);
         std::copy_n(values, count_, buffer);
         Fftw<T>::execute(plan_);
+        detail::count_cpu_ffts();
         std::copy_n(buffer, count_, values);
     }
 

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <mutex>
 #include <numbers>
 
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/footprint.h"
+#include "fftw_planner.h"
 
 namespace atonlab::stimuli {
 
@@ -243,14 +245,19 @@ AreaLayers build_area_layers(const GlareKernel& kernel, double max_radius_px, in
     Spectrum2D kernel_hat[3], disc_hat(static_cast<std::size_t>(p) * pc), product(disc_hat.size());
     // std::complex<double> is layout-compatible with fftw_complex (FFTW manual §4.1.1).
     auto as_fftw = [](Spectrum2D& v) { return reinterpret_cast<fftw_complex*>(v.data()); };
+    // FFTW's planner is not thread-safe: the library's one lock (a render may
+    // run beside this one, e.g. from Python with the GIL released).
+    std::unique_lock planner(detail::fftw_planner_mutex());
     fftw_plan forward = fftw_plan_dft_r2c_2d(p, p, real.data(), as_fftw(disc_hat), FFTW_ESTIMATE);
     fftw_plan inverse = fftw_plan_dft_c2r_2d(p, p, as_fftw(product), real.data(), FFTW_ESTIMATE);
+    planner.unlock();
     for (int c = 0; c < 3; ++c) {
         std::fill(real.begin(), real.end(), 0.0);
         for (int j = 0; j < km; ++j)
             for (int i = 0; i < km; ++i) real[static_cast<std::size_t>(j) * p + i] = kernel.at(i, j)[c];
         kernel_hat[c].resize(disc_hat.size());
         fftw_execute_dft_r2c(forward, real.data(), as_fftw(kernel_hat[c]));
+        detail::count_cpu_ffts();
     }
     for (int layer = 1; layer < out.layers; ++layer) {
         // The disc of radius r centred on a pixel centre, exact pixel coverage,
@@ -267,9 +274,11 @@ AreaLayers build_area_layers(const GlareKernel& kernel, double max_radius_px, in
             }
         for (double& v : real) v /= area;
         fftw_execute_dft_r2c(forward, real.data(), as_fftw(disc_hat));
+        detail::count_cpu_ffts();
         for (int c = 0; c < 3; ++c) {
             for (std::size_t t = 0; t < product.size(); ++t) product[t] = kernel_hat[c][t] * disc_hat[t];
             fftw_execute_dft_c2r(inverse, as_fftw(product), real.data());  // unnormalised: divide by p²
+            detail::count_cpu_ffts();
             // Result index q in the kernel's frame; layer texel i ↔ kernel index i - reach.
             double sum = 0;
             glm::vec4* dst = &out.rgba[static_cast<std::size_t>(layer) * m * m];
@@ -286,6 +295,7 @@ AreaLayers build_area_layers(const GlareKernel& kernel, double max_radius_px, in
                 dst[t][c] = static_cast<float>(sum > 0 ? values[t] / sum : 0.0);
         }
     }
+    planner.lock();
     fftw_destroy_plan(forward);
     fftw_destroy_plan(inverse);
     return out;

@@ -89,6 +89,7 @@ ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel
         for (int j = 0; j < m; ++j)
             for (int i = 0; i < m; ++i) real.get()[static_cast<std::size_t>(m - 1 - j) * pw + i] = kernel.at(i, j)[c];
         fftw_execute(forward_k);
+        detail::count_cpu_ffts();
         std::fill(real.get(), real.get() + real_n, 0.0);
         double in_sum = 0;
         for (int y = 0; y < h; ++y)
@@ -103,6 +104,7 @@ ImageGlareResult convolve_image_glare(const ImageRGBA32F& hdr, const GlareKernel
         const auto* b = reinterpret_cast<const std::complex<double>*>(kernel_f.get());
         for (std::size_t k = 0; k < complex_n; ++k) a[k] *= b[k] * norm;
         fftw_execute(inverse);
+        detail::count_cpu_ffts(2);  // the image's forward transform and this inverse
         // Full result index (X, Y) is the image pixel (X - half, Y - half).
         double full_sum = 0, inside_sum = 0;
         for (int y = 0; y < ph; ++y)

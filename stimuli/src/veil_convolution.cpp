@@ -106,6 +106,7 @@ void VeilFft::build(const VeilKernelQuadrant& kernel) {
         p = fftw_plan_dft_r2c_2d(my_, mx_, wrapped.data(), reinterpret_cast<fftw_complex*>(hat.data()), FFTW_ESTIMATE);
     }
     fftw_execute(p);
+    count_cpu_ffts();
     {
         std::lock_guard lock(fftw_planner_mutex());
         fftw_destroy_plan(p);
@@ -117,6 +118,7 @@ void VeilFft::build(const VeilKernelQuadrant& kernel) {
 }
 
 void VeilFft::convolve(std::vector<double>& e) {
+    count_cpu_ffts(2);  // one forward and one inverse 2-D transform (rows and columns in stages below)
     const auto umx = static_cast<std::size_t>(mx_), ucols = static_cast<std::size_t>(cols_);
     const auto uw = static_cast<std::size_t>(w_);
     const int workers = static_cast<int>(row_forward_.size());
