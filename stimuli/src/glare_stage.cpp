@@ -307,8 +307,7 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
     std::string common;
     auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
     add(gs.psf_size, gs.spectral_samples, spectral_path_name(gs.spectral_path), gs.spectral_anchors,
-        glare_window_name(gs.window), gs.radius_deg.value_or(-1), gs.bloom_sigma_deg,
-        static_cast<int>(spencer_vision_for(scene)));
+        glare_window_name(gs.window), gs.radius_deg.value_or(-1), gs.bloom_sigma_deg);
     add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd);
     add(e.hippus.enabled, e.hippus.amplitude, e.hippus.max_pupil_mm);
     add(e.gratings.enabled, e.gratings.count, e.gratings.inner_radius_mm, e.gratings.width_um, e.gratings.opacity,
@@ -338,7 +337,11 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
         g.spd = group_spds[gi];
         // The pupil the kernel is computed for (hippus and the cache's tolerance applied).
         const double pupil_now = pupil_for(g.model);
-        const std::string key = fmt::format("{}|{}|{}", glare_model_name(g.model), common, g.spd);
+        // What of the scene the model's kernel reads (Spencer's vision class; the
+        // wave-optics eye's kernel does not change where the adaptation crosses
+        // 0.001 cd/m², so a dusk-to-night sweep keeps its cached kernels).
+        const std::string key = fmt::format("{}|{}|{}|{}", glare_model_name(g.model), common, g.spd,
+                                            glare_model_type(g.model).kernel_scene_key(scene));
         m.update_kernel(g, scene, ppd, time_s, pupil_now, key);
         // Layers only where a light covers more than a pixel; radius rounded up
         // to a power of two so a light approaching does not rebuild every frame.

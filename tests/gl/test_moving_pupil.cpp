@@ -83,5 +83,23 @@ TEST_F(MovingPupil, AStillPupilAndAOneOffChangeAreBuiltExactly) {
     ASSERT_NE(r.glare().psf(0), nullptr);  // the exact pupil's PSF
 }
 
+TEST_F(MovingPupil, CrossingIntoScotopicRebuildsOnlyTheKernelsThatReadTheVisionClass) {
+    // The adaptation crosses 0.001 cd/m² (Spencer's scotopic limit, CIE 191)
+    // with the pupil held: Spencer's PSF changes with the vision class and is
+    // rebuilt; the wave-optics eye's does not read it and is kept.
+    for (GlareModel model : {GlareModel::wave_optics, GlareModel::spencer}) {
+        Scene scene = moving_scene();
+        scene.glare.model = model;
+        scene.glare.pupil_mm = 5.0;
+        scene.adaptation_cd_m2 = 0.002;  // mesopic
+        FrameRenderer r;
+        r.render(scene, 0.0);
+        scene.adaptation_cd_m2 = 0.0005;  // scotopic
+        r.render(scene, 0.0);
+        EXPECT_EQ(r.glare().build_counts().kernels, model == GlareModel::spencer ? 2 : 1)
+            << glare_model_type(model).name();
+    }
+}
+
 }  // namespace
 }  // namespace atonlab::test

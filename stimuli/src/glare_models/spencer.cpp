@@ -37,6 +37,9 @@ public:
     }
     bool on_images() const override { return true; }
     double default_radius_deg(const GlareSettings&, double) const override { return kDefaultRadiusDeg; }
+    std::string kernel_scene_key(const Scene& scene) const override {
+        return fmt::format("vision {}", static_cast<int>(spencer_vision_for(scene)));
+    }
 
     GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const override {
         GlareModelKernel k;

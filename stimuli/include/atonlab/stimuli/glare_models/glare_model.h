@@ -97,6 +97,12 @@ public:
     /// The pupil (mm) its kernel is computed for at time_s, from the frame's pupil (before the cache's rounding).
     virtual double kernel_pupil_mm(const GlareSettings& g, double pupil_mm, double time_s) const;
 
+    /// What of the scene, beyond GlareSettings and the pupil, its kernel
+    /// depends on, as text for the glare stage's cache key (Spencer's: the
+    /// vision class its adaptation implies); empty for none. A change of it
+    /// rebuilds the kernel, so a model must name only what it reads.
+    virtual std::string kernel_scene_key(const Scene&) const { return {}; }
+
     /// The glare stage's kernel for a billboard (path() == billboard only).
     virtual GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const;
     /// `atonlab glare`'s kernel, on the CPU (on_images() only).
