@@ -40,6 +40,7 @@ const Entry kBenches[] = {
     {"tonemap_pfstools", bench_tonemap_pfstools},
     {"display_skips", bench_display_skips},
     {"lights", bench_lights},
+    {"simulator_frames", bench_simulator_frames},
     {"eye_validation", bench_eye_validation},
 };
 

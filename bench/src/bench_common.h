@@ -80,6 +80,7 @@ void bench_tonemap(Bench& b);
 void bench_tonemap_pfstools(Bench& b);
 void bench_display_skips(Bench& b);
 void bench_lights(Bench& b);
+void bench_simulator_frames(Bench& b);  // bench_simulator.cpp (issue 27 item 4)
 void bench_eye_validation(Bench& b);
 
 }  // namespace atonlab::bench
