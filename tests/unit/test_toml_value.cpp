@@ -1,9 +1,11 @@
-// One TOML value parsed from its text (common/toml_value.h). Expected values
+// One TOML value parsed from its text (common/toml_value.h), and the scene
+// override that carries it parsed (common/scene_override.h). Expected values
 // are written out by hand from the TOML 1.0 grammar.
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "atonlab/common/scene_override.h"
 #include "atonlab/common/toml_value.h"
 
 namespace atonlab {
@@ -139,6 +141,35 @@ TEST(TomlValue, CopiesShareTheParsedNode) {
     ASSERT_TRUE(v);
     const TomlValue copy = *v;
     EXPECT_EQ(&copy.node(), &v->node());
+}
+
+TEST(SceneOverride, ParsesItsValueOnceWhenMade) {
+    const SceneOverride o = SceneOverride::parse("camera.yaw_deg = 45");
+    ASSERT_NE(o.typed(), nullptr);
+    EXPECT_EQ(o.typed()->node().value<std::int64_t>(), 45);
+    EXPECT_TRUE(o.not_toml().empty());
+    EXPECT_EQ(o.text(), "camera.yaw_deg=45") << "the stored form is the text as written";
+
+    const SceneOverride a{"light.buoy.position_m", "[0.0, 3.0, -500.0]"};
+    ASSERT_NE(a.typed(), nullptr);
+    EXPECT_TRUE(a.typed()->node().is_array());
+    EXPECT_EQ(a.text(), "light.buoy.position_m=[0.0, 3.0, -500.0]");
+}
+
+TEST(SceneOverride, TakesTextThatIsNotTomlAsAString) {
+    const SceneOverride o = SceneOverride::parse("light.buoy.colour=red");
+    ASSERT_NE(o.typed(), nullptr);
+    EXPECT_EQ(o.typed()->node().value<std::string>(), "red");
+    EXPECT_FALSE(o.not_toml().empty()) << "the loader's note says why it was read as a string";
+    EXPECT_TRUE(o.unreadable().empty());
+    EXPECT_EQ(o.text(), "light.buoy.colour=red");
+
+    const SceneOverride bad{"light.buoy.colour", "doc\xb0"};
+    EXPECT_EQ(bad.typed(), nullptr) << "not even a string";
+    EXPECT_FALSE(bad.unreadable().empty());
+
+    const SceneOverride none;
+    EXPECT_EQ(none.typed(), nullptr);
 }
 
 }  // namespace
