@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <tuple>
 
+#include "atonlab/common/toml_value.h"
 #include "atonlab/display/colour.h"
 
 namespace atonlab::analysis {
@@ -29,11 +30,7 @@ std::string value_text(const toml::node& n) {
 /// An override's TOML value text, parsed; a value that is not TOML is a
 /// string, as the scene loader takes it (docs/scene-file.md "Overrides with --set").
 std::string override_value(const std::string& toml_value) {
-    try {
-        const toml::table t = toml::parse("v = " + toml_value);
-        if (const toml::node* n = t.get("v")) return value_text(*n);
-    } catch (const toml::parse_error&) {
-    }
+    if (const auto v = TomlValue::parse(toml_value)) return value_text(v->node());
     return toml_value;
 }
 

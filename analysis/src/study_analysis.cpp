@@ -8,11 +8,13 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <span>
 #include <stdexcept>
 #include <string_view>
 
+#include "atonlab/common/toml_value.h"
 #include "atonlab/protocols/procedures.h"
 
 namespace atonlab::analysis {
@@ -432,14 +434,9 @@ const GroupResult* StudyResults::main_group(const std::string& name) const {
 SettingValue setting_value(std::string_view toml_value) {
     SettingValue v;
     v.text = std::string(toml_value);
-    toml::table doc;
-    try {
-        doc = toml::parse("v = " + v.text);
-    } catch (const toml::parse_error&) {
-        return v;
-    }
-    const toml::node* n = doc.get("v");
-    if (!n) return v;
+    const std::optional<TomlValue> parsed = TomlValue::parse(v.text);
+    if (!parsed) return v;
+    const toml::node* n = &parsed->node();
     if (const auto x = n->value<double>(); x && (n->is_integer() || n->is_floating_point()))
         v.number = *x;
     else if (const auto b = n->value<bool>(); b && n->is_boolean())

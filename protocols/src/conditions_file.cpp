@@ -11,6 +11,7 @@
 
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
+#include "atonlab/common/toml_value.h"
 #include "protocol_reader.h"
 #include "protocol_schema.h"
 
@@ -36,13 +37,7 @@ std::string toml_string(std::string_view text) {
 /// A CSV cell as TOML: the text itself when it is one TOML value (a number,
 /// true / false, an array), else a TOML string of it.
 std::string toml_value(const std::string& cell, bool always_string) {
-    if (!always_string) {
-        try {
-            (void)toml::parse("v = " + cell);
-            return cell;
-        } catch (const toml::parse_error&) {
-        }
-    }
+    if (!always_string && TomlValue::parse(cell)) return cell;
     return toml_string(cell);
 }
 

@@ -90,28 +90,20 @@ Override Document::scene_override(const toml::node* n, const std::string& key, c
              context + fmt::format("expected \"section.key=value\" with a TOML value, e.g. 'eye.glare=\"none\"', "
                                    "got \"{}\".",
                                    text));
-    Override o;
-    o.key = std::string(trim(std::string_view(text).substr(0, eq)));
-    o.value = std::string(trim(std::string_view(text).substr(eq + 1)));
     // Where it was written: the protocol's line and key, or a conditions
     // file's row and column; errors about the value name it (scene loader).
-    o.origin = where(n, key);
+    SourceLocation origin = where(n, key);
     std::string no_message;
-    relocate(o.origin, no_message);
+    relocate(origin, no_message);
+    // The value is parsed here, once (SceneOverride's constructor).
+    Override o(std::string(trim(std::string_view(text).substr(0, eq))),
+               std::string(trim(std::string_view(text).substr(eq + 1))), std::move(origin));
     if (!is_scene_key(o.key))
         fail(n, key,
              context + fmt::format("\"{}\" is not a scene key: write section.key as in the scene file, e.g. "
                                    "'eye.glare=\"none\"'.",
                                    o.key));
-    bool ok = !o.value.empty();
-    if (ok) {
-        try {
-            const toml::table parsed = toml::parse("v = " + o.value);
-            ok = parsed.size() == 1 && parsed.contains("v");
-        } catch (const toml::parse_error&) {
-            ok = false;
-        }
-    }
+    const bool ok = o.not_toml().empty();  // one TOML value (empty text is none)
     if (!ok)
         fail(n, key,
              context + fmt::format("the value of '{}' is not one TOML value (a string needs quotes, as in "

@@ -121,11 +121,7 @@ std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::opti
     if (overrides)
         for (const auto& [k, v] : *overrides) {
             const std::string key = py::str(k);
-            SceneOverride o;
-            o.key = key;
-            o.value = toml_value(v, key);
-            o.origin = SourceLocation::command_line("overrides", key);
-            list.push_back(std::move(o));
+            list.emplace_back(key, toml_value(v, key), SourceLocation::command_line("overrides", key));
         }
     stimuli::Scene scene;
     {

@@ -66,41 +66,30 @@ void TreeEdits::undo() noexcept {
     throw InputError(std::move(where), message);
 }
 
-/// A TOML basic string holding `text`, for values that are not valid TOML.
-std::string toml_quoted(std::string_view text) {
-    std::string q = "\"";
-    for (const char ch : text) {
-        const auto c = static_cast<unsigned char>(ch);
-        if (ch == '"' || ch == '\\') {
-            q += '\\';
-            q += ch;
-        } else if (c < 0x20 || c == 0x7f) {
-            q += fmt::format("\\u{:04X}", static_cast<unsigned>(c));
-        } else {
-            q += ch;
-        }
-    }
-    return q + "\"";
+/// A copy of override `o`'s typed value, in `holder` under "v". A value that
+/// was not valid TOML was taken as a string when the override was made (so
+/// `colour=red` needs no quotes); `note` then says so, for the type error that
+/// usually follows a typo.
+toml::node& override_value(const SceneOverride& o, toml::table& holder, std::string& note) {
+    if (!o.not_toml().empty())
+        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", text::echo(o.value),
+                           o.not_toml());
+    const TomlValue* typed = o.typed();
+    if (typed == nullptr)
+        override_error(o, fmt::format("the value \"{}\" cannot be read: {}.", text::echo(o.value), o.unreadable()));
+    typed->node().visit([&](const auto& concrete) { holder.insert_or_assign("v", concrete); });
+    return *holder.get("v");
 }
 
-/// The parsed value of an override, with source path "--set KEY". A value that
-/// is not valid TOML is taken as a string (so `colour=red` needs no quotes);
-/// `note` then says so, for the type error that usually follows a typo.
-toml::table parse_override_value(const SceneOverride& o, std::string& note) {
-    const std::string source = std::string(kSetPrefix) + o.key;
-    try {
-        return toml::parse("v = " + o.value, std::string_view(source));
-    } catch (const toml::parse_error& e) {
-        note = fmt::format(" (the value \"{}\" is not valid TOML: {}; it was read as a string)", text::echo(o.value),
-                           std::string(e.description()));
-    }
-    try {
-        return toml::parse("v = " + toml_quoted(o.value), std::string_view(source));
-    } catch (const toml::parse_error& e) {
-        override_error(o,
-                       fmt::format("the value \"{}\" cannot be read: {}.", text::echo(o.value),
-                                   std::string(e.description())));
-    }
+/// Every node of `n` (an overridden value in the tree) is noted as written by
+/// the override `typed`: a copied node has no source of its own (toml++ does
+/// not copy it), and errors about it or an element of it name the override.
+void note_override_nodes(Document& doc, const toml::node& n, const std::string& typed) {
+    doc.note_made_for_override(&n, typed);
+    if (const toml::table* t = n.as_table())
+        for (const auto& [k, v] : *t) note_override_nodes(doc, v, typed);
+    else if (const toml::array* a = n.as_array())
+        for (const toml::node& e : *a) note_override_nodes(doc, e, typed);
 }
 
 bool is_number(const toml::node& n) {
@@ -245,8 +234,8 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o, Tr
     }
 
     std::string note;
-    toml::table parsed = parse_override_value(o, note);
-    toml::node* value = parsed.get("v");
+    toml::table holder;
+    toml::node* value = &override_value(o, holder, note);
 
     // The new value must have the type of the one it replaces (integers and
     // floats are interchangeable); values the file leaves at their default are
@@ -270,6 +259,7 @@ void apply_override(Document& doc, toml::table& root, const SceneOverride& o, Tr
     doc.note_override(k, schema_key, o.origin);
     doc.note_string_fallback(k, note);
     edits.assign(*target, key, *value);
+    note_override_nodes(doc, *target->get(key), k);
 }
 
 }  // namespace atonlab::stimuli::scene_reader

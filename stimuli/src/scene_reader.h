@@ -43,7 +43,8 @@ namespace atonlab::stimuli::scene_reader {
 using namespace ::atonlab::display;  // NOLINT: colour, the display model, calibration files (display/)
 
 inline constexpr std::string_view kSetOption = "--set";
-inline constexpr std::string_view kSetPrefix = "--set ";  // source path of an override's value: "--set KEY"
+// The source path of an override's value, "--set KEY" (SceneOverride's constructor).
+inline constexpr std::string_view kSetPrefix = "--set ";
 
 // ---------------------------------------------------------------------------
 // The schema: the keys each table takes. Unknown keys are errors, so a typo

@@ -1,20 +1,28 @@
 #pragma once
-// One scene override: a dotted scene key, a value in TOML syntax, and where it
-// was written. The one form in which a value reaches the scene loader, whether
-// `--set` gave it (render, view), a protocol's line (a condition's `set`, its
-// [display] table) or the protocol library made it (a procedure level, a
-// side-by-side position). Errors about the value name its origin
-// (docs/scene-file.md "Overrides with --set").
+// One scene override: a dotted scene key, its value, and where it was written.
+// The one form in which a value reaches the scene loader, whether `--set` gave
+// it (render, view), a protocol's line (a condition's `set`, its [display]
+// table) or the protocol library made it (a procedure level, a side-by-side
+// position). Errors about the value name its origin (docs/scene-file.md
+// "Overrides with --set").
+//
+// The value is parsed once, when the override is made (toml_value.h): the
+// scene loader applies the typed value; the text stays for the stored form
+// (`text()`, the study file's bytes) and for messages.
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/common/toml_value.h"
 
 namespace atonlab {
 
 struct SceneOverride {
     std::string key;    ///< dotted scene key: "eye.glare", "light.buoy.intensity_cd", "light[0].rhythm"
-    std::string value;  ///< TOML value text: "\"none\"", "120", "[0.0, 3.0, -500.0]"
+    /// The value's TOML text as written: "\"none\"", "120", "[0.0, 3.0, -500.0]".
+    /// Set by the constructor and not changed after it: typed() was parsed from it.
+    std::string value;
     /// Where the value was written: a file, line and column (a protocol's
     /// line; the key there, e.g. "block[0].condition[1].set[0]"), or the
     /// command-line option "--set". Errors about the value name it.
@@ -22,6 +30,22 @@ struct SceneOverride {
 
     /// The `--set` option's name.
     static constexpr std::string_view kSetOption = "--set";
+
+    SceneOverride() = default;
+    /// Parses `value`. Text that is not one TOML value is taken as a string
+    /// (so `--set light.buoy.colour=red` needs no quotes); not_toml() says why.
+    SceneOverride(std::string key, std::string value,
+                  SourceLocation origin = SourceLocation::command_line(std::string(kSetOption)));
+
+    /// The value: the TOML value, or the text as a string when it is not one
+    /// (not_toml() is then set). nullptr when it cannot be read even as a
+    /// string (unreadable() says why), or for a default-made override. Its
+    /// nodes' source path is "--set KEY".
+    const TomlValue* typed() const noexcept { return typed_ ? &*typed_ : nullptr; }
+    /// Why the text is not one TOML value (toml++'s description); "" when it is.
+    const std::string& not_toml() const noexcept { return not_toml_; }
+    /// Why the text cannot be read even as a string; "" when it can.
+    const std::string& unreadable() const noexcept { return unreadable_; }
 
     /// "key=value", as `--set` takes it and the study file stores it.
     std::string text() const { return key + "=" + value; }
@@ -36,6 +60,11 @@ struct SceneOverride {
         return a.key == b.key && a.value == b.value && x.file == y.file && x.line == y.line &&
                x.column == y.column && x.key == y.key && x.option == y.option && x.key_is_column == y.key_is_column;
     }
+
+private:
+    std::optional<TomlValue> typed_;
+    std::string not_toml_;
+    std::string unreadable_;
 };
 
 }  // namespace atonlab
