@@ -112,6 +112,7 @@ struct GlareStage::Impl {
         std::string base_key;  // everything the kernel depends on but the pupil
         bool has_pupil = false, pupil_changed = false;
         double pupil = 0;
+        double pupil_time_s = 0;  ///< the frame time the pupil was last seen at
     };
     std::map<std::string, Group> groups;  // by model and SPD name ("wave-optics|d65"), kept between frames
     std::vector<std::string> order;       // this frame's groups, index = group id
@@ -187,7 +188,11 @@ struct GlareStage::Impl {
     // The group's kernel for this frame's pupil: kept while the pupil stays,
     // built for it exactly when it has just changed (or was given a rounding
     // step), interpolated while it keeps moving (hippus, or a change at each of
-    // the last two frames: a dusk-to-night sequence, not a new trial).
+    // the last two frames with the frame time advancing at each: a dusk-to-night
+    // sequence, not a new trial). A frame at the same or an earlier time starts
+    // a new sequence, so the kernel never depends on stimuli rendered before it
+    // (a session's pre-check renders every condition at t = 0; a resumed session
+    // must draw the same kernels as the uninterrupted one).
     void update_kernel(Group& g, const Scene& scene, double ppd, double time_s, double pupil_mm,
                        const std::string& base_key) {
         if (g.base_key != base_key) {
@@ -195,12 +200,14 @@ struct GlareStage::Impl {
             g.has_pupil = g.pupil_changed = false;
             g.base_key = base_key;
         }
+        const bool continues = g.has_pupil && time_s > g.pupil_time_s;
+        g.pupil_time_s = time_s;
         if (g.has_pupil && pupil_mm == g.pupil) {
             g.pupil_changed = false;
             return;
         }
         const GlareSettings& gs = scene.glare;
-        const bool moving = !gs.pupil_tolerance_mm && (gs.eye.hippus.enabled || g.pupil_changed);
+        const bool moving = !gs.pupil_tolerance_mm && (gs.eye.hippus.enabled || (continues && g.pupil_changed));
         bool done = false;
         if (moving) {
             try {
@@ -212,7 +219,7 @@ struct GlareStage::Impl {
             }
         }
         if (!done) build_kernel(g, scene, ppd, time_s, pupil_mm);
-        g.pupil_changed = g.has_pupil;
+        g.pupil_changed = continues;
         g.has_pupil = true;
         g.pupil = pupil_mm;
     }

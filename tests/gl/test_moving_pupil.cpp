@@ -83,6 +83,27 @@ TEST_F(MovingPupil, AStillPupilAndAOneOffChangeAreBuiltExactly) {
     ASSERT_NE(r.glare().psf(0), nullptr);  // the exact pupil's PSF
 }
 
+TEST_F(MovingPupil, StimuliRenderedAtOneTimeGetTheKernelOfAFreshRenderer) {
+    // A session's pre-check renders every condition at t = 0, alternating
+    // pupils; a resumed session renders only the rest. Each kernel must be the
+    // one a fresh renderer builds for that stimulus, bit for bit, or a resumed
+    // session would show other images than the uninterrupted one.
+    Scene dusk = moving_scene();
+    Scene night = moving_scene();
+    night.adaptation_cd_m2 = 0.001;
+    FrameRenderer r;
+    for (int i = 0; i < 3; ++i) {
+        r.render(dusk, 0.0);
+        r.render(night, 0.0);
+    }
+    EXPECT_EQ(r.glare().build_counts().interpolations, 0);
+    FrameRenderer fresh;
+    fresh.render(night, 0.0);
+    ASSERT_NE(r.glare().kernel(0), nullptr);
+    ASSERT_NE(fresh.glare().kernel(0), nullptr);
+    EXPECT_TRUE(r.glare().kernel(0)->rgba == fresh.glare().kernel(0)->rgba);
+}
+
 TEST_F(MovingPupil, CrossingIntoScotopicRebuildsOnlyTheKernelsThatReadTheVisionClass) {
     // The adaptation crosses 0.001 cd/m² (Spencer's scotopic limit, CIE 191)
     // with the pupil held: Spencer's PSF changes with the vision class and is
