@@ -25,6 +25,7 @@ cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_
   -DCMAKE_CXX_COMPILER=clang++ -DATONLAB_FUZZ=ON -DATONLAB_BUILD_TESTS="$([ "$unit_tests" = 1 ] && echo ON || echo OFF)" \
   -DATONLAB_FUZZ_SECONDS="$seconds" ${ATONLAB_FUZZ_CMAKE_ARGS:-}
 cmake --build "$build_dir" --parallel "$(nproc)" --target "${targets[@]}"
+echo "fuzz: configure and build of $build_dir: $SECONDS s"
 if [ "$unit_tests" = 1 ]; then
   # Every unit.* test of the two executables (not the shape and GL-free checks,
   # which test.sh runs). A sanitizer report fails the test: UBSan stops at the

@@ -35,6 +35,7 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+setup_start=$SECONDS
 if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}"
   sudo_cmd=()
@@ -50,8 +51,12 @@ if ((${#missing[@]})); then
     "${unsafe_io[@]}" "${missing[@]}"
 fi
 
+echo "setup: packages: $((SECONDS - setup_start)) s (${#missing[@]} missing of ${#packages[@]})"
+
 build_dir="${ATONLAB_BUILD_DIR:-build}"
+build_start=$SECONDS
 # shellcheck disable=SC2086
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DATONLAB_WERROR=ON ${ATONLAB_CMAKE_ARGS:-}
 # shellcheck disable=SC2086
 cmake --build "$build_dir" --parallel "$(nproc)" ${ATONLAB_BUILD_TARGETS:+--target $ATONLAB_BUILD_TARGETS}
+echo "setup: configure and build of $build_dir: $((SECONDS - build_start)) s"

@@ -31,11 +31,13 @@ if [ ! -f "$cost_data" ]; then
   mkdir -p "$(dirname "$cost_data")"
   cp tests/ctest_cost_data.txt "$cost_data"
 fi
+tests_start=$SECONDS
 ctest_status=0
 ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" --timeout 600 --output-junit "$junit" ||
   ctest_status=$?
 skip_status=0
 python3 scripts/skipped_tests.py "$junit" || skip_status=$?
+echo "test: the suite in $build_dir: $((SECONDS - tests_start)) s"
 if [ "$ctest_status" -ne 0 ]; then exit "$ctest_status"; fi
 if [ "$skip_status" -ne 0 ]; then
   echo "test: failed: under CI=true, tests were skipped for a missing tool or library or without a reason (listed above)" >&2
@@ -44,5 +46,8 @@ fi
 # The sanitizer step: the unit tests under ASan + UBSan, then the loaders' fuzz
 # targets 20 s each, from one clang build in build-fuzz/ (docs/fuzzing.md).
 if [ "${ATONLAB_SANITIZE:-0}" != 1 ]; then
+  fuzz_start=$SECONDS
   bash scripts/fuzz.sh
+  echo "test: the sanitizer step (scripts/fuzz.sh): $((SECONDS - fuzz_start)) s"
 fi
+echo "test: done in $SECONDS s"
