@@ -16,6 +16,14 @@ add_library(atonlab_sanitize INTERFACE)
 if(ATONLAB_SANITIZE)
   target_compile_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(atonlab_sanitize INTERFACE -fsanitize=address,undefined)
+  # GCC's -Wmaybe-uninitialized is unreliable under the sanitizers' instrumentation
+  # (GCC's manual: "sanitizers tend to increase the rate of false positive warnings, most notably those around -Wmaybe-uninitialized"): GCC 12 reports std::function's
+  # members inside <regex> as maybe uninitialized, which stopped the
+  # ATONLAB_SANITIZE=1 build three times (test_image_commands, test_run_session,
+  # test_procedure_registry). The normal build keeps the warning.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(atonlab_sanitize INTERFACE -Wno-maybe-uninitialized)
+  endif()
 endif()
 
 # The fuzz build (fuzz/, docs/fuzzing.md): every library instrumented for
