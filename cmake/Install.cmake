@@ -24,8 +24,8 @@ install(TARGETS ${atonlab_installed_targets} atonlab_policy atonlab_warnings ato
         EXPORT atonlabTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(dir IN ITEMS display stimuli protocols store analysis common bench runner)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+foreach(lib IN LISTS atonlab_installed_libraries)  # each library's headers: <lib>/include/atonlab/<lib>/
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${lib}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           COMPONENT development)
 endforeach()
 install(TARGETS atonlab RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)

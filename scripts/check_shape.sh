@@ -3,8 +3,11 @@
 # "Rules"), checked over the repository at SOURCE_DIR (default: this script's
 # repository). CTest runs it as unit.source_shape. It fails when
 #   - a source file under the libraries (common/ display/ stimuli/ protocols/
-#     store/ analysis/ bench/ runner/ python/) is longer than 800 lines, unless it is
+#     store/ analysis/ bench/ present/ runner/ python/) is longer than 800 lines, unless it is
 #     in OVERSIZED_ALLOWED below;
+#   - a library includes the public headers (atonlab/<lib>/) of a library it
+#     does not depend on (docs/architecture.md, "Dependencies point one way";
+#     INCLUDES_ALLOWED below), e.g. present/ a header of the runner's;
 #   - a file of the repository (outside .git and build*) names the design or
 #     style document that lives outside it (every reference must be to
 #     docs/*.md);
@@ -22,7 +25,7 @@ import subprocess
 import sys
 
 root = sys.argv[1]
-LIBRARIES = ["common", "display", "stimuli", "protocols", "store", "analysis", "bench", "runner", "python"]
+LIBRARIES = ["common", "display", "stimuli", "protocols", "store", "analysis", "bench", "present", "runner", "python"]
 SOURCE_SUFFIXES = (".cpp", ".cc", ".c", ".h", ".hpp", ".comp", ".frag", ".vert", ".geom", ".glsl")
 MAX_FILE_LINES = 800
 MAX_FUNCTION_LINES = 150
@@ -34,6 +37,22 @@ OVERSIZED_ALLOWED: set[str] = set()
 # 13's function splits landed (a function that must stay whole says why in a
 # "one piece" comment above it instead).
 LONG_FUNCTIONS_ALLOWED: set[str] = set()
+
+# The public headers (atonlab/<lib>/...) each library's sources may include:
+# its own and those of the libraries it links, directly or through a public
+# link (docs/architecture.md, "The libraries" and "Rules"). runner and python
+# sit on top and may include every library's.
+INCLUDES_ALLOWED = {
+    "common": {"common"},
+    "display": {"display", "common"},
+    "stimuli": {"stimuli", "display", "common"},
+    "protocols": {"protocols", "common"},
+    "store": {"store", "common"},
+    "analysis": {"analysis", "store", "protocols", "display", "common"},
+    "bench": {"bench", "stimuli", "display", "common"},
+    "present": {"present", "stimuli", "protocols", "display", "common"},
+}
+ATONLAB_INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]atonlab/([A-Za-z0-9_]+)/', re.M)
 
 findings = []
 
@@ -187,6 +206,13 @@ for rel, path in library_sources():
     with open(path, encoding="utf-8", errors="replace") as f:
         text = f.read()
     lines = text.split("\n")
+    lib = rel.split(os.sep)[0]
+    if lib in INCLUDES_ALLOWED:
+        for m in ATONLAB_INCLUDE.finditer(text):
+            if m.group(1) not in INCLUDES_ALLOWED[lib]:
+                line = text.count("\n", 0, m.start()) + 1
+                findings.append(f"{rel}:{line}: {lib}/ includes atonlab/{m.group(1)}/, a library it does not "
+                                f"depend on (docs/architecture.md, \"Dependencies point one way\")")
     n_lines = text.count("\n") + (0 if text.endswith("\n") or text == "" else 1)
     if n_lines > MAX_FILE_LINES and rel not in OVERSIZED_ALLOWED:
         findings.append(f"{rel}:1: {n_lines} lines, more than {MAX_FILE_LINES}: split it along its parts")

@@ -10,8 +10,8 @@
 #include <cstdio>
 #include <string>
 
+#include "atonlab/present/screen_presenter.h"
 #include "atonlab/protocols/protocol.h"
-#include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/error.h"
 #include "run_command.h"
 #include "run_session.h"
@@ -133,7 +133,7 @@ int run_run(const RunOptions& o) {
         // error, ...): what is stored stays as it was; one sentence, status 4.
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 4;
-    } catch (const DisplayTimingRefused& e) {
+    } catch (const present::DisplayTimingRefused& e) {
         // The refresh measurement failed before any session began: nothing stored.
         std::fprintf(stderr, "atonlab: %s\n", e.what());
         return 5;

@@ -11,10 +11,10 @@
 #include <string>
 #include <string_view>
 
+#include "atonlab/present/presenter.h"
+#include "atonlab/present/screen_presenter.h"
+#include "atonlab/present/text.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "atonlab/runner/presenter.h"
-#include "atonlab/runner/screen_presenter.h"
-#include "atonlab/runner/text.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/store.h"
@@ -78,8 +78,8 @@ void reshow_open_match(SessionObserver& observer, StimulusRenderer& renderer, co
 }
 
 /// The measured screen, on stdout.
-void print_screen(const RunOptions& o, const ScreenPresenter& screen, const SessionDisplay& display) {
-    const RefreshEstimate& r = screen.refresh();
+void print_screen(const RunOptions& o, const present::ScreenPresenter& screen, const SessionDisplay& display) {
+    const present::RefreshEstimate& r = screen.refresh();
     std::printf(
         "screen: monitor %d \"%s\", %d×%d, %d bits per channel, mode %s; measured %.4f ms ± %.4f ms "
         "(SD) over %d flips (%d rejected) = %.3f Hz\n  flips timed by %s\n  %s\n",
@@ -181,16 +181,17 @@ int run_session(const RunOptions& o) {
 
     // --- GL (and the screen, measured) before the session: a machine without GL,
     // or a display whose timing is refused, leaves no empty session behind.
-    std::optional<Font> font;
+    std::optional<present::Font> font;
     if (!o.headless)
-        font = Font::load(o.font.empty() ? std::filesystem::path(kDefaultFontFile) : std::filesystem::path(o.font));
+        font = present::Font::load(o.font.empty() ? std::filesystem::path(present::kDefaultFontFile)
+                                                  : std::filesystem::path(o.font));
     std::unique_ptr<gl::Context> context;
-    std::unique_ptr<Presenter> presenter;
-    ScreenPresenter* screen = nullptr;
+    std::unique_ptr<present::Presenter> presenter;
+    present::ScreenPresenter* screen = nullptr;
     if (o.headless) {
         if (!o.gl_context_current) context = gl::create_headless_context();
-        presenter = std::make_unique<VirtualPresenter>(protocol.timing.refresh_hz.value_or(60.0),
-                                                       protocol.display.width_px, protocol.display.height_px);
+        presenter = std::make_unique<present::VirtualPresenter>(protocol.timing.refresh_hz.value_or(60.0),
+                                                                protocol.display.width_px, protocol.display.height_px);
     } else {
         presenter = open_screen(o, protocol, in.display_scene, screen);
     }

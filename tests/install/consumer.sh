@@ -11,8 +11,8 @@ mkdir -p "$work"
 prefix=$work/prefix
 
 cmake --install "$build" --prefix "$prefix" --component development > "$work/install.log"
-for f in include/atonlab/stimuli/pipeline.h lib/cmake/atonlab/atonlabConfig.cmake lib/pkgconfig/atonlab.pc \
-         lib/libatonlab_stimuli.a; do
+for f in include/atonlab/stimuli/pipeline.h include/atonlab/present/presenter.h lib/cmake/atonlab/atonlabConfig.cmake \
+         lib/pkgconfig/atonlab.pc lib/libatonlab_stimuli.a lib/libatonlab_present.a; do
   [ -f "$prefix/$f" ] || { echo "consumer: $f was not installed"; exit 1; }
 done
 # Nothing points back into the source or build tree.

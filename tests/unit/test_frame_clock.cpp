@@ -1,4 +1,4 @@
-// The full-screen runner's frame clock (runner/include/atonlab/runner/frame_clock.h)
+// The full-screen runner's frame clock (present/include/atonlab/present/frame_clock.h)
 // and the flip loop every presenter runs (presenter.h), on synthetic
 // timestamps: the refresh estimate and its SD against closed forms, the sync
 // test's verdicts, durations in whole frames, missed deadlines and dropped
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "atonlab/runner/frame_clock.h"
-#include "atonlab/runner/presenter.h"
+#include "atonlab/present/frame_clock.h"
+#include "atonlab/present/presenter.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 namespace {
 
 constexpr double kP = 1.0 / 60.0;
@@ -319,4 +319,4 @@ TEST(VirtualPresenter, StopEndsALoopAndNoPersonEverAnswers) {
 }
 
 }  // namespace
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -1,4 +1,4 @@
-// Keys and gamepad buttons of the full-screen runner (runner/include/atonlab/runner/input.h):
+// Keys and gamepad buttons of the full-screen runner (present/include/atonlab/present/input.h):
 // every key name a protocol may use has a GLFW key (and back), the protocol's
 // bindings give the actions a task takes, gamepad presses are the up-to-down
 // edges of the polled state, and the event queue hands out what a screen
@@ -8,10 +8,10 @@
 
 #include <set>
 
+#include "atonlab/present/input.h"
 #include "atonlab/protocols/protocol_file.h"
-#include "atonlab/runner/input.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 namespace {
 
 using protocols::Action;
@@ -137,4 +137,4 @@ TEST(RunnerKeys, TheQueueHandsOutAcceptedEventsInOrder) {
 }
 
 }  // namespace
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -1,4 +1,4 @@
-// Text on the participant screen (runner/include/atonlab/runner/text.h):
+// Text on the participant screen (present/include/atonlab/present/text.h):
 // UTF-8 decoding, DejaVu Sans through stb_truetype at a pixel height, word
 // wrapping, the blend into code values (exact for coverage 0, ½ and 1), and
 // the fixation cross's pixels.
@@ -7,11 +7,11 @@
 #include <filesystem>
 #include <numeric>
 
-#include "atonlab/runner/text.h"
+#include "atonlab/present/text.h"
 #include "atonlab/stimuli/error.h"
 #include "../support/skip.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 namespace {
 
 bool have_font() {
@@ -106,4 +106,4 @@ TEST(ScreenText, TheFixationCrossHasTwoBarsThroughItsCentre) {
 }
 
 }  // namespace
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "atonlab/runner/screen_presenter.h"
+#include "atonlab/present/screen_presenter.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/image_io.h"
@@ -46,15 +46,15 @@ std::string join_keys(const std::vector<std::string>& keys) {
 /// A trial's steps: the fixation screen (when n_iti > 0), then each frame for n_stim refreshes with a
 /// blank of n_isi between frames, and, when the stimulus loops, a blank after the last frame too.
 struct TrialSteps {
-    std::vector<Step> steps;
+    std::vector<present::Step> steps;
     std::vector<int> frame_of_step;   ///< the frame each step shows; -1 for a fixation or blank
     std::size_t last_frame_step = 0;  ///< the last interval's step, where 2AFC and yes-no answers are taken from
 };
 
-TrialSteps trial_steps(const std::vector<Screen>& frames, const Screen& bg, const Screen& fix, int n_stim, int n_isi,
-                       int n_iti, bool loop) {
+TrialSteps trial_steps(const std::vector<present::Screen>& frames, const present::Screen& bg,
+                       const present::Screen& fix, int n_stim, int n_isi, int n_iti, bool loop) {
     TrialSteps plan;
-    std::vector<Step>& steps = plan.steps;
+    std::vector<present::Step>& steps = plan.steps;
     std::vector<int>& frame_of_step = plan.frame_of_step;
     if (n_iti > 0) {
         steps.push_back({fix, n_iti, false});
@@ -93,8 +93,9 @@ struct ShownTimes {
 };
 
 /// The timing of what play() showed; adds the stimulus's dropped frames and missed deadlines to `out`.
-ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_screen, double hz, TrialShown& out) {
-    const std::vector<Step>& steps = plan.steps;
+ShownTimes shown_times(const present::Played& played, const TrialSteps& plan, bool on_screen, double hz,
+                       TrialShown& out) {
+    const std::vector<present::Step>& steps = plan.steps;
     const std::vector<int>& frame_of_step = plan.frame_of_step;
     const std::size_t last_frame_step = plan.last_frame_step;
     auto rel = [&](double dt) { return trial_time(dt, on_screen, hz); };
@@ -102,7 +103,7 @@ ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_scr
     bool onset_seen = false, window_seen = false;
     std::vector<ShownStep> shown;
     for (std::size_t i = 0; i < played.intervals.size(); ++i) {
-        const IntervalTiming& iv = played.intervals[i];
+        const present::IntervalTiming& iv = played.intervals[i];
         const std::size_t step = played.step_of[i];
         const bool stimulus = step < steps.size() ? steps[step].stimulus : true;  // the offset flip counts
         if (step < steps.size() && frame_of_step[step] >= 0 && !onset_seen) {
@@ -125,7 +126,7 @@ ShownTimes shown_times(const Played& played, const TrialSteps& plan, bool on_scr
 
 }  // namespace
 
-SessionDisplay::SessionDisplay(Presenter& presenter, StimulusRenderer& renderer, const p::Protocol& protocol,
+SessionDisplay::SessionDisplay(present::Presenter& presenter, StimulusRenderer& renderer, const p::Protocol& protocol,
                                const s::Scene& display_scene, SessionDisplayOptions options, double clock_origin_s)
     : presenter_(presenter),
       renderer_(renderer),
@@ -143,7 +144,8 @@ SessionDisplay::SessionDisplay(Presenter& presenter, StimulusRenderer& renderer,
         const glm::ivec3 c =
             d::encode_pixel(display, glm::dvec3(rel), glm::ivec2(0), 0, d::EncodeSettings{bits_, d::Dither::none, 0});
         shown = d::displayed_luminance_cd_m2(display, c, bits_);
-        return Code3{static_cast<std::uint16_t>(c.r), static_cast<std::uint16_t>(c.g), static_cast<std::uint16_t>(c.b)};
+        return present::Code3{static_cast<std::uint16_t>(c.r), static_cast<std::uint16_t>(c.g),
+                              static_cast<std::uint16_t>(c.b)};
     };
     text_ink_ = ink_for(protocol.screens.text_cd_m2, text_luminance_cd_m2_);
     cue_ink_ = ink_for(protocol.screens.cue_cd_m2, cue_luminance_cd_m2_);
@@ -162,7 +164,7 @@ double SessionDisplay::now_s() {
 }
 
 void SessionDisplay::set_clock(double t_s) {
-    if (auto* v = dynamic_cast<VirtualPresenter*>(&presenter_)) {
+    if (auto* v = dynamic_cast<present::VirtualPresenter*>(&presenter_)) {
         v->advance_to(t_s);
         clock_offset_s_ = 0.0;
     } else {
@@ -188,12 +190,13 @@ std::string SessionDisplay::keys_text(p::Action a) const {
     return join_keys(protocol_.responses.keys_of(a));
 }
 
-Overlay SessionDisplay::text_overlay(const std::string& text, Code3 ink, double y_fraction, double scale) const {
-    Overlay o;
+present::Overlay SessionDisplay::text_overlay(const std::string& text, present::Code3 ink, double y_fraction,
+                                              double scale) const {
+    present::Overlay o;
     o.ink = ink;
     if (!options_.font || text.empty()) return o;
     const int max_width = static_cast<int>(0.8 * presenter_.width_px());
-    auto bmp = std::make_shared<TextBitmap>(options_.font->render(text, text_px_ * scale, max_width));
+    auto bmp = std::make_shared<present::TextBitmap>(options_.font->render(text, text_px_ * scale, max_width));
     o.x = (presenter_.width_px() - bmp->width) / 2;
     o.y = static_cast<int>(std::lround(y_fraction * presenter_.height_px() - 0.5 * bmp->height));
     o.y = std::clamp(o.y, 0, std::max(0, presenter_.height_px() - bmp->height));
@@ -201,20 +204,20 @@ Overlay SessionDisplay::text_overlay(const std::string& text, Code3 ink, double 
     return o;
 }
 
-Overlay SessionDisplay::fixation_overlay() const {
+present::Overlay SessionDisplay::fixation_overlay() const {
     // A cross 0.3° across with arms 0.04° thick (at least 1 px), centred.
     const int arm = std::max(3, static_cast<int>(std::lround(0.15 * pixels_per_degree_)));
     const int thick = std::max(1, static_cast<int>(std::lround(0.04 * pixels_per_degree_)));
-    Overlay o;
+    present::Overlay o;
     o.ink = cue_ink_;
-    o.coverage = std::make_shared<TextBitmap>(fixation_cross(arm, thick));
+    o.coverage = std::make_shared<present::TextBitmap>(present::fixation_cross(arm, thick));
     o.x = presenter_.width_px() / 2 - arm;
     o.y = presenter_.height_px() / 2 - arm;
     return o;
 }
 
-Screen SessionDisplay::background_screen(const p::Condition& c) {
-    Screen sc;
+present::Screen SessionDisplay::background_screen(const p::Condition& c) {
+    present::Screen sc;
     sc.bits = bits_;
     if (!presenter_.on_screen()) return sc;  // nothing is drawn headless: nothing to render
     // The condition's scene with every light off: what surrounds the stimuli,
@@ -233,7 +236,7 @@ std::shared_ptr<const s::EncodedImage> SessionDisplay::frame_picture(const p::Sc
 
 bool SessionDisplay::confirm_quit(const std::string& progress) {
     trace("pause");
-    Screen sc;
+    present::Screen sc;
     sc.bits = bits_;
     sc.overlays.push_back(text_overlay(
         fmt::format("Paused.\n\nPress {} to go on, or {} to end the session.\nEverything answered so far is kept; "
@@ -241,18 +244,19 @@ bool SessionDisplay::confirm_quit(const std::string& progress) {
                     keys_text(p::Action::Continue), keys_text(p::Action::Quit)),
         text_ink_, 0.4));
     if (!progress.empty()) sc.overlays.push_back(text_overlay(progress, text_ink_, 0.85, 0.7));
-    const auto e = presenter_.wait(&sc, presenter_.now_s(), std::nullopt, [&](const InputEvent& ev) {
-        return action_of(protocol_.responses, InputContext::pause, p::Task::TwoAfc, ev).has_value();
+    const auto e = presenter_.wait(&sc, presenter_.now_s(), std::nullopt, [&](const present::InputEvent& ev) {
+        return present::action_of(protocol_.responses, present::InputContext::pause, p::Task::TwoAfc, ev).has_value();
     });
     if (!e) return true;  // interrupted (a signal): the session ends
-    const bool quit = action_of(protocol_.responses, InputContext::pause, p::Task::TwoAfc, *e) == p::Action::Quit;
+    const bool quit =
+        present::action_of(protocol_.responses, present::InputContext::pause, p::Task::TwoAfc, *e) == p::Action::Quit;
     trace(quit ? "quit confirmed" : "going on");
     return quit;
 }
 
 bool SessionDisplay::text_screen(const std::string& text, const std::string& footer, std::string_view what) {
     if (!options_.person || text.empty()) return true;
-    Screen sc;
+    present::Screen sc;
     sc.bits = bits_;
     sc.overlays.push_back(text_overlay(text, text_ink_, 0.4));
     std::string foot = fmt::format("Press {} to continue.", keys_text(p::Action::Continue));
@@ -260,11 +264,13 @@ bool SessionDisplay::text_screen(const std::string& text, const std::string& foo
     sc.overlays.push_back(text_overlay(foot, text_ink_, 0.88, 0.7));
     for (;;) {
         trace(fmt::format("waiting for continue ({})", what));
-        const auto e = presenter_.wait(&sc, presenter_.now_s(), std::nullopt, [&](const InputEvent& ev) {
-            return action_of(protocol_.responses, InputContext::screen, p::Task::TwoAfc, ev).has_value();
+        const auto e = presenter_.wait(&sc, presenter_.now_s(), std::nullopt, [&](const present::InputEvent& ev) {
+            return present::action_of(protocol_.responses, present::InputContext::screen, p::Task::TwoAfc, ev)
+                .has_value();
         });
         if (!e) return false;  // a signal
-        if (action_of(protocol_.responses, InputContext::screen, p::Task::TwoAfc, *e) == p::Action::Continue)
+        if (present::action_of(protocol_.responses, present::InputContext::screen, p::Task::TwoAfc, *e) ==
+            p::Action::Continue)
             return true;
         if (confirm_quit(footer)) return false;
     }
@@ -272,11 +278,11 @@ bool SessionDisplay::text_screen(const std::string& text, const std::string& foo
 
 bool SessionDisplay::adapt(const p::Condition& c, double seconds) {
     if (!(seconds > 0.0)) return true;
-    Screen bg = background_screen(c);
+    present::Screen bg = background_screen(c);
     const double start = presenter_.now_s();
     const double end = start + seconds;
     if (!presenter_.on_screen()) {
-        presenter_.wait(&bg, start, end, [](const InputEvent&) { return false; });
+        presenter_.wait(&bg, start, end, [](const present::InputEvent&) { return false; });
         return true;
     }
     const bool skippable = protocol_.timing.adaptation_skippable;
@@ -284,22 +290,23 @@ bool SessionDisplay::adapt(const p::Condition& c, double seconds) {
     for (;;) {
         const double now = presenter_.now_s();
         if (now >= end) return true;
-        Screen sc = bg;
+        present::Screen sc = bg;
         std::string line = fmt::format("Adapting: {}", clock_mm_ss(end - now));
         if (skippable) line += fmt::format(" (press {} to skip)", keys_text(p::Action::Continue));
         sc.overlays.push_back(text_overlay(line, cue_ink_, 0.92, 0.7));
         // Wake at the next whole second of the countdown to redraw it.
         const double left = end - now;
         const double next = end - (std::ceil(left - 1e-9) - 1.0);
-        const auto e = presenter_.wait(&sc, start, std::min(end, next), [&](const InputEvent& ev) {
-            const auto a = action_of(protocol_.responses, InputContext::screen, p::Task::TwoAfc, ev);
+        const auto e = presenter_.wait(&sc, start, std::min(end, next), [&](const present::InputEvent& ev) {
+            const auto a = present::action_of(protocol_.responses, present::InputContext::screen, p::Task::TwoAfc, ev);
             return a == p::Action::Quit || (skippable && a == p::Action::Continue);
         });
         if (!e) {
             if (presenter_.now_s() < std::min(end, next) - 1e-3) return false;  // a signal
             continue;
         }
-        if (action_of(protocol_.responses, InputContext::screen, p::Task::TwoAfc, *e) == p::Action::Continue) {
+        if (present::action_of(protocol_.responses, present::InputContext::screen, p::Task::TwoAfc, *e) ==
+            p::Action::Continue) {
             trace("adaptation skipped");
             return true;
         }
@@ -311,18 +318,18 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
                                    const std::optional<p::Answer>& observer_answer, const TrialHooks& hooks) {
     const p::Timing& tm = protocol_.timing;
     const double period = presenter_.period_s();
-    const int n_stim = frames_for(tm.stimulus_s, period, 1);
-    const int n_isi = frames_for(tm.inter_stimulus_s, period, 0);
-    const int n_iti = fixation ? frames_for(tm.inter_trial_s, period, 0) : 0;
+    const int n_stim = present::frames_for(tm.stimulus_s, period, 1);
+    const int n_isi = present::frames_for(tm.inter_stimulus_s, period, 0);
+    const int n_iti = fixation ? present::frames_for(tm.inter_trial_s, period, 0) : 0;
     const bool on_screen = presenter_.on_screen();
     const bool person = options_.person;
     const bool adjust = t.task == p::Task::Adjust;
     const bool loop = person && adjust;  // a person adjusts while the stimulus repeats
 
-    const Screen bg = background_screen(c);
-    std::vector<Screen> frames;
+    const present::Screen bg = background_screen(c);
+    std::vector<present::Screen> frames;
     for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
-        Screen sc;
+        present::Screen sc;
         sc.bits = bits_;
         if (on_screen) {
             const p::Frame& frame = t.stimulus.frames[f];
@@ -336,19 +343,19 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
         frames.push_back(std::move(sc));
     }
 
-    Screen fix = bg;  // shown before the stimulus when n_iti > 0
+    present::Screen fix = bg;  // shown before the stimulus when n_iti > 0
     if (n_iti > 0 && on_screen && protocol_.screens.fixation) fix.overlays.push_back(fixation_overlay());
     const TrialSteps plan = trial_steps(frames, bg, fix, n_stim, n_isi, n_iti, loop);
     const std::vector<int>& frame_of_step = plan.frame_of_step;
 
-    Screen then = bg;
+    present::Screen then = bg;
     if (on_screen && !c.prompt.empty() && !adjust) then.overlays.push_back(text_overlay(c.prompt, cue_ink_, 0.75));
 
-    auto answer_action = [&](const InputEvent& e) {
-        return action_of(protocol_.responses, InputContext::trial, t.task, e);
+    auto answer_action = [&](const present::InputEvent& e) {
+        return present::action_of(protocol_.responses, present::InputContext::trial, t.task, e);
     };
     const double sequence_start = presenter_.now_s();
-    PlayOptions po;
+    present::PlayOptions po;
     po.loop = loop;
     po.stall_frames = hooks.stall_frames;
     if (hooks.before_frame_onset)
@@ -360,11 +367,12 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
             if (frame_of_step[step] >= 0) hooks.after_frame_onset(static_cast<std::size_t>(frame_of_step[step]));
         };
     if (loop)
-        po.stop = [&](const InputQueue& q) {
-            return q.find(sequence_start, [&](const InputEvent& e) { return answer_action(e).has_value(); }) != nullptr;
+        po.stop = [&](const present::InputQueue& q) {
+            return q.find(sequence_start, [&](const present::InputEvent& e) { return answer_action(e).has_value(); }) !=
+                   nullptr;
         };
     trace(fmt::format("trial {}: presenting", t.step + 1));
-    const Played played = presenter_.play(plan.steps, then, po);
+    const present::Played played = presenter_.play(plan.steps, then, po);
 
     // Timing: onsets, offset and what was missed (shown_times).
     TrialShown out;
@@ -375,8 +383,8 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
     out.onset_s = onset + clock_offset_s_;
     out.frames = FramesShown{hz, n_stim, n_isi, n_iti, presented, times.shown};
 
-    auto is_quit = [&](const InputEvent& e) { return answer_action(e) == p::Action::Quit; };
-    if (played.stopped && !(loop && presenter_.input().find(sequence_start, [&](const InputEvent& e) {
+    auto is_quit = [&](const present::InputEvent& e) { return answer_action(e) == p::Action::Quit; };
+    if (played.stopped && !(loop && presenter_.input().find(sequence_start, [&](const present::InputEvent& e) {
             return answer_action(e).has_value();
         }))) {
         out.end = TrialEnd::interrupted;
@@ -390,16 +398,16 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
     }
 
     if (person) {
-        std::optional<InputEvent> e;
+        std::optional<present::InputEvent> e;
         if (adjust) {
-            e = presenter_.input().take_first(sequence_start,
-                                              [&](const InputEvent& ev) { return answer_action(ev).has_value(); });
+            e = presenter_.input().take_first(
+                sequence_start, [&](const present::InputEvent& ev) { return answer_action(ev).has_value(); });
         } else {
             std::optional<double> deadline;
             if (tm.response_timeout_s) deadline = offset + *tm.response_timeout_s;
             trace(fmt::format("trial {}: waiting for an answer", t.step + 1));
             e = presenter_.wait(nullptr, window, deadline,
-                                [&](const InputEvent& ev) { return answer_action(ev).has_value(); });
+                                [&](const present::InputEvent& ev) { return answer_action(ev).has_value(); });
             if (!e) {
                 if (deadline && presenter_.now_s() >= *deadline) {
                     out.end = TrialEnd::timeout;
@@ -423,7 +431,7 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
             return out;
         }
         out.response = p::response_of(*a);
-        out.input = (e->source == InputEvent::Source::gamepad ? "gamepad:" : "") + e->name;
+        out.input = (e->source == present::InputEvent::Source::gamepad ? "gamepad:" : "") + e->name;
         out.response_time_s = e->time_s - onset;
         out.answer_after_offset_s = e->time_s - offset;
         trace(fmt::format("trial {}: answered {} ({})", t.step + 1, e->name, to_string(*a)));
@@ -455,9 +463,9 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
     return out;
 }
 
-std::unique_ptr<Presenter> open_screen(const RunOptions& o, const p::Protocol& protocol, const s::Scene& display_scene,
-                                       ScreenPresenter*& screen) {
-    ScreenOptions so;
+std::unique_ptr<present::Presenter> open_screen(const RunOptions& o, const p::Protocol& protocol,
+                                                const s::Scene& display_scene, present::ScreenPresenter*& screen) {
+    present::ScreenOptions so;
     so.monitor = o.monitor;
     so.software_vsync_hz = o.software_vsync_hz;
     so.skip_sync_test = o.skip_sync_test;
@@ -465,7 +473,7 @@ std::unique_ptr<Presenter> open_screen(const RunOptions& o, const p::Protocol& p
     so.sync.max_deviation = o.refresh_tolerance;
     so.expected_hz = protocol.timing.refresh_hz;
     so.title = "atonlab: " + protocol.name;
-    std::unique_ptr<ScreenPresenter> sp = ScreenPresenter::open(so);
+    std::unique_ptr<present::ScreenPresenter> sp = present::ScreenPresenter::open(so);
     if (sp->width_px() != protocol.display.width_px || sp->height_px() != protocol.display.height_px)
         throw InputError(SourceLocation{protocol.file, 0, 0, "display.width_px"},
                          fmt::format("the protocol's display is {}×{} px but monitor {} shows {}×{}: the stimuli's "
@@ -483,8 +491,8 @@ std::unique_ptr<Presenter> open_screen(const RunOptions& o, const p::Protocol& p
     return sp;
 }
 
-void capture_frame(const RunOptions& o, ScreenPresenter* screen, StimulusRenderer& renderer, const p::ScheduledTrial& t,
-                   std::size_t row, std::size_t f, bool after_flip) {
+void capture_frame(const RunOptions& o, present::ScreenPresenter* screen, StimulusRenderer& renderer,
+                   const p::ScheduledTrial& t, std::size_t row, std::size_t f, bool after_flip) {
     const std::filesystem::path dir = o.capture_dir;
     std::filesystem::create_directories(dir);
     const std::string base = fmt::format("trial{}-frame{}", row, f);

@@ -11,23 +11,26 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/present/presenter.h"
+#include "atonlab/present/text.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "atonlab/runner/presenter.h"
-#include "atonlab/runner/text.h"
 #include "atonlab/stimuli/scene.h"
 #include "session/run_options.h"
+
+namespace atonlab::present {
+class ScreenPresenter;
+}  // namespace atonlab::present
 
 namespace atonlab::runner {
 
 class StimulusRenderer;
-class ScreenPresenter;
 
 struct SessionDisplayOptions {
-    bool person = false;                ///< a person answers (keys, gamepad); else an observer's answers are given
-    bool trace = false;                 ///< print what the screen waits for (tests drive the keys from it)
-    const Font* font = nullptr;         ///< on screen: the font of every text
-    ScreenPresenter* screen = nullptr;  ///< on screen: the presenter's own hooks (captures)
+    bool person = false;                  ///< a person answers (keys, gamepad); else an observer's answers are given
+    bool trace = false;                   ///< print what the screen waits for (tests drive the keys from it)
+    const present::Font* font = nullptr;  ///< on screen: the font of every text
+    present::ScreenPresenter* screen = nullptr;  ///< on screen: the presenter's own hooks (captures)
 };
 
 /// How a trial's presentation ended.
@@ -85,10 +88,10 @@ class SessionDisplay {
 public:
     /// clock_origin_s: the session clock at the presenter's time now (a resumed
     /// session goes on from its last answer).
-    SessionDisplay(Presenter& presenter, StimulusRenderer& renderer, const protocols::Protocol& protocol,
+    SessionDisplay(present::Presenter& presenter, StimulusRenderer& renderer, const protocols::Protocol& protocol,
                    const stimuli::Scene& display_scene, SessionDisplayOptions options, double clock_origin_s);
 
-    Presenter& presenter() noexcept { return presenter_; }
+    present::Presenter& presenter() noexcept { return presenter_; }
     /// The session clock now, s.
     double now_s();
     /// Moves a virtual presenter's clock to session time t (headless resume).
@@ -117,20 +120,21 @@ public:
     double text_px() const noexcept { return text_px_; }
 
 private:
-    Screen background_screen(const protocols::Condition& c);
+    present::Screen background_screen(const protocols::Condition& c);
     std::shared_ptr<const stimuli::EncodedImage> frame_picture(const protocols::ScheduledTrial& t, std::size_t f);
-    Overlay text_overlay(const std::string& text, Code3 ink, double y_fraction, double scale = 1.0) const;
-    Overlay fixation_overlay() const;
+    present::Overlay text_overlay(const std::string& text, present::Code3 ink, double y_fraction,
+                                  double scale = 1.0) const;
+    present::Overlay fixation_overlay() const;
     std::string keys_text(protocols::Action a) const;
     void trace(const std::string& line) const;
 
-    Presenter& presenter_;
+    present::Presenter& presenter_;
     StimulusRenderer& renderer_;
     const protocols::Protocol& protocol_;
     SessionDisplayOptions options_;
     double clock_offset_s_;  ///< session clock − presenter clock
     int bits_ = 8;
-    Code3 text_ink_{0, 0, 0}, cue_ink_{0, 0, 0};
+    present::Code3 text_ink_{0, 0, 0}, cue_ink_{0, 0, 0};
     double text_luminance_cd_m2_ = 0.0, cue_luminance_cd_m2_ = 0.0;
     double text_px_ = 24.0;
     double pixels_per_degree_ = 0.0;
@@ -142,15 +146,15 @@ private:
 /// protocol's [display] (else the pixels per degree would be wrong) and its
 /// framebuffer has the encoder's bits. Throws gl::ContextUnavailable,
 /// DisplayTimingRefused, InputError.
-std::unique_ptr<Presenter> open_screen(const RunOptions& options, const protocols::Protocol& protocol,
-                                       const stimuli::Scene& display_scene, ScreenPresenter*& screen);
+std::unique_ptr<present::Presenter> open_screen(const RunOptions& options, const protocols::Protocol& protocol,
+                                                const stimuli::Scene& display_scene, present::ScreenPresenter*& screen);
 
 /// Test hook (--capture-trial): frame `f` of trial `t` (stored as trial_index
 /// `row`) into options.capture_dir: trialROW-frameF.xwd, a copy of
 /// --capture-screen-file after the onset flip (after_flip); or
 /// trialROW-frameF.png, the window's back buffer drawn for the onset flip
 /// (!after_flip), or headless the frame's codes.
-void capture_frame(const RunOptions& options, ScreenPresenter* screen, StimulusRenderer& renderer,
+void capture_frame(const RunOptions& options, present::ScreenPresenter* screen, StimulusRenderer& renderer,
                    const protocols::ScheduledTrial& t, std::size_t row, std::size_t f, bool after_flip);
 
 }  // namespace atonlab::runner

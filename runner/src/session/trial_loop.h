@@ -4,10 +4,10 @@
 // next is shown.
 #include <cstddef>
 
+#include "atonlab/present/presenter.h"
+#include "atonlab/present/screen_presenter.h"
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "atonlab/runner/presenter.h"
-#include "atonlab/runner/screen_presenter.h"
 #include "atonlab/store/store.h"
 #include "session/run_options.h"
 #include "session/progress.h"
@@ -26,8 +26,8 @@ struct SessionParts {
     StimulusRenderer& renderer;
     SessionObserver& observer;
     SessionDisplay& display;
-    Presenter& presenter;
-    ScreenPresenter* screen;  ///< null headless
+    present::Presenter& presenter;
+    present::ScreenPresenter* screen;  ///< null headless
     Progress& progress;
 };
 

@@ -1,12 +1,12 @@
 // The flip loop both presenters share, and the virtual (headless) presenter
 // (presenter.h; docs/running.md "Timing").
-#include "atonlab/runner/presenter.h"
+#include "atonlab/present/presenter.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 Played Presenter::play(std::span<const Step> steps, const Screen& then, const PlayOptions& o) {
     std::vector<std::unique_ptr<Prepared>> prepared;
@@ -116,4 +116,4 @@ void VirtualPresenter::wait_events(double until_s) {
     advance_to(until_s);
 }
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

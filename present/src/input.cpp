@@ -1,14 +1,14 @@
 // Key and gamepad names (input.h). The names are the protocol file's
 // (protocols/src/protocol_file.cpp, docs/protocol-file.md "Key names"); the
 // codes are GLFW's, which name keys by their place on a US layout.
-#include "atonlab/runner/input.h"
+#include "atonlab/present/input.h"
 
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
 #include <utility>
 
-namespace atonlab::runner {
+namespace atonlab::present {
 namespace {
 
 const std::vector<std::pair<std::string, int>>& key_table() {
@@ -109,4 +109,4 @@ void InputQueue::drop_before(double t_s) {
     while (!events_.empty() && events_.front().time_s < t_s) events_.pop_front();
 }
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 /// The refresh period estimated from consecutive flip timestamps, after
 /// Psychtoolbox's sync test (Screen('GetFlipInterval'): the mean of many
@@ -131,4 +131,4 @@ private:
     std::vector<IntervalTiming> intervals_;
 };
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -21,12 +21,12 @@
 #include <span>
 #include <vector>
 
-#include "atonlab/runner/frame_clock.h"
-#include "atonlab/runner/input.h"
-#include "atonlab/runner/text.h"
+#include "atonlab/present/frame_clock.h"
+#include "atonlab/present/input.h"
+#include "atonlab/present/text.h"
 #include "atonlab/stimuli/display_pipeline.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 using Code3 = std::array<std::uint16_t, 3>;
 
@@ -174,4 +174,4 @@ private:
     double last_k_ = -1.0;  ///< the refresh index of the last flip (an integer)
 };
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -1,5 +1,5 @@
 // The on-screen presenter (screen_presenter.h; docs/running.md "Timing").
-#include "atonlab/runner/screen_presenter.h"
+#include "atonlab/present/screen_presenter.h"
 
 #include <epoxy/gl.h>
 // GLFW after epoxy: epoxy provides the GL declarations.
@@ -16,7 +16,7 @@
 #include "atonlab/stimuli/gl/window.h"
 #include "atonlab/stimuli/image_io.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 namespace {
 
 /// Codes as present.frag reads them: per pixel uvec2(r | g << 16, b), rows
@@ -373,4 +373,4 @@ void ScreenPresenter::sync_with_server() const {
     glfwGetWindowPos(window_->glfw_window(), &x, &y);
 }
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

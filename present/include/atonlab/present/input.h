@@ -14,7 +14,7 @@
 
 #include "atonlab/protocols/protocol.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 /// One press of a key or a gamepad button.
 struct InputEvent {
@@ -82,4 +82,4 @@ private:
     std::deque<InputEvent> events_;
 };
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "atonlab/runner/presenter.h"
+#include "atonlab/present/presenter.h"
 
 struct GLFWwindow;
 
@@ -23,7 +23,7 @@ namespace atonlab::gl {
 class WindowContext;
 }
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 /// The display's timing failed the start-up measurement; what() is one sentence.
 class DisplayTimingRefused : public std::runtime_error {
@@ -102,4 +102,4 @@ private:
     std::array<GamepadButtons, 16> pads_{};
 };
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -1,7 +1,7 @@
 // Text rasterised by stb_truetype (text.h). The implementation of stb_truetype
 // is compiled here, once; the header is Debian's (libstb-dev), a system header,
 // so its own code does not trip the project's warnings.
-#include "atonlab/runner/text.h"
+#include "atonlab/present/text.h"
 
 #define STB_TRUETYPE_IMPLEMENTATION
 #include <fmt/format.h>
@@ -14,7 +14,7 @@
 
 #include "atonlab/stimuli/error.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 std::vector<char32_t> decode_utf8(std::string_view s) {
     std::vector<char32_t> out;
@@ -229,4 +229,4 @@ TextBitmap fixation_cross(int arm_px, int thickness_px) {
     return b;
 }
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

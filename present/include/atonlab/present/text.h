@@ -16,7 +16,7 @@
 
 #include "atonlab/stimuli/display_pipeline.h"
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 /// The font the runner uses unless told otherwise (Debian fonts-dejavu-core).
 inline constexpr const char* kDefaultFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -72,4 +72,4 @@ void blend_text(stimuli::EncodedImage& image, const TextBitmap& text, int x, int
 /// wide, as a coverage bitmap of (2 arm + 1)² px centred on its middle pixel.
 TextBitmap fixation_cross(int arm_px, int thickness_px);
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present

@@ -1,5 +1,5 @@
 // The frame clock (frame_clock.h; docs/running.md "Timing").
-#include "atonlab/runner/frame_clock.h"
+#include "atonlab/present/frame_clock.h"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace atonlab::runner {
+namespace atonlab::present {
 
 RefreshEstimate estimate_refresh(std::span<const double> t) {
     RefreshEstimate e;
@@ -156,4 +156,4 @@ void FrameClock::clear_intervals() {
     onset_pending_ = false;
 }
 
-}  // namespace atonlab::runner
+}  // namespace atonlab::present
