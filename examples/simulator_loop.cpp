@@ -54,7 +54,6 @@ int main(int argc, char** argv) {
         scene.environment.luminance_cd_m2 = 0.03;
         scene.adaptation_cd_m2 = 0.03;
         scene.output.adaptation.mode = st::AdaptationMode::dynamic;
-        scene.output.adaptation.fixed_cd_m2 = 0.03;
         scene.output.ldr_glare = ldr;
         scene.glare.model = st::GlareModel::wave_optics;
         scene.glare.psf_size = 256;

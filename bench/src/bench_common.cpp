@@ -68,7 +68,6 @@ Scene k2012_scene(int lights, Layout layout, unsigned seed, int width_px) {
     s.environment.background = Background::sky_sea;
     s.environment.luminance_cd_m2 = 0.01;
     s.adaptation_cd_m2 = 0.01;
-    s.output.adaptation.fixed_cd_m2 = 0.01;
     s.glare.model = GlareModel::wave_optics;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);

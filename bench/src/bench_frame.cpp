@@ -66,7 +66,7 @@ CodeAgreement compare_codes(const std::vector<std::uint16_t>& a, const std::vect
 void bench_hdr_format(Bench& b) {
     Scene scene = frame_scene(b);
     scene.output.encode.dither = Dither::none;
-    const double la = scene.output.adaptation.fixed_cd_m2;
+    const double la = scene.adaptation_cd_m2;
     FrameRenderer renderer;
     DisplayPipeline display;
     // The reference: the RGBA32F frame through the CPU double tone mapper and encoder.
@@ -99,7 +99,7 @@ void bench_hdr_format(Bench& b) {
         renderers.back()->render(scene, 0.0);  // its PSF, outside the timed runs
         runs.emplace_back([&display, &scene, r = renderers.back().get()] {
             r->render(scene, 0.0);
-            display.process(r->hdr_texture(), scene.output, 0.0, 0, r->pre_exposure());
+            display.process(r->hdr_texture(), scene.output, scene.adaptation_cd_m2, 0.0, 0, r->pre_exposure());
         });
     }
     const std::vector<Timing> times = measure_interleaved(runs, b.spec(7, true));
@@ -108,7 +108,7 @@ void bench_hdr_format(Bench& b) {
         const Timing& t = times[k];
         FrameRenderer& fr = *renderers[k];
         fr.render(scene, 0.0);
-        display.process(fr.hdr_texture(), scene.output, 0.0, 0, fr.pre_exposure());
+        display.process(fr.hdr_texture(), scene.output, la, 0.0, 0, fr.pre_exposure());
         const ImageRGBA32F img = fr.read_hdr();
         const CodeAgreement a = compare_codes(display.read_codes().rgb, ref_codes);
         Row r;
@@ -144,9 +144,9 @@ void bench_adaptation_stride(Bench& b) {
     };
     std::vector<std::function<void()>> runs;
     for (int stride : strides)
-        runs.emplace_back([&display, &renderer, out = settings_for(stride)] {
+        runs.emplace_back([&display, &renderer, &scene, out = settings_for(stride)] {
             display.reset_adaptation();
-            display.process(renderer.hdr_texture(), out, 0.0, 0);
+            display.process(renderer.hdr_texture(), out, scene.adaptation_cd_m2, 0.0, 0);
         });
     const std::vector<Timing> times = measure_interleaved(runs, b.spec(9, true));
     for (std::size_t k = 0; k < strides.size(); ++k) {
@@ -154,7 +154,7 @@ void bench_adaptation_stride(Bench& b) {
         const Timing& t = times[k];
         const OutputSettings out = settings_for(stride);
         display.reset_adaptation();
-        display.process(renderer.hdr_texture(), out, 0.0, 0);
+        display.process(renderer.hdr_texture(), out, scene.adaptation_cd_m2, 0.0, 0);
         const double got = display.adaptation_cd_m2();
         Row r;
         r.bench = "adaptation_stride";
@@ -172,7 +172,7 @@ void bench_adaptation_stride(Bench& b) {
 
 void bench_tonemap(Bench& b) {
     Scene scene = frame_scene(b);
-    const double la = scene.output.adaptation.fixed_cd_m2;
+    const double la = scene.adaptation_cd_m2;
     FrameRenderer renderer;
     renderer.render(scene, 0.0);
     const ImageRGBA32F hdr = renderer.read_hdr();
@@ -183,14 +183,13 @@ void bench_tonemap(Bench& b) {
         OutputSettings out = scene.output;
         out.tonemap.tone_operator = *tone_operator_from_name(name);
         std::vector<std::uint16_t> ref;
-        const std::vector<Timing> times =
-            measure_interleaved({[&] { display.process(renderer.hdr_texture(), out, 0.0, 0); },
-                                 [&] { ref = cpu_codes(hdr, la, out); }},
-                                TimeSpec{1, b.quick() ? 1 : 5, false});
+        const std::vector<Timing> times = measure_interleaved(
+            {[&] { display.process(renderer.hdr_texture(), out, la, 0.0, 0); }, [&] { ref = cpu_codes(hdr, la, out); }},
+            TimeSpec{1, b.quick() ? 1 : 5, false});
         Timing gpu = times[0];
         gpu.use_gpu = true;  // the GPU's own clock where it is trusted (measured by the wall clock here)
         const Timing& cpu = times[1];
-        display.process(renderer.hdr_texture(), out, 0.0, 0);
+        display.process(renderer.hdr_texture(), out, la, 0.0, 0);
         const CodeAgreement a = compare_codes(display.read_codes().rgb, ref);
         const std::string bench = "tonemap_" + name;
         Row g;
@@ -217,7 +216,7 @@ void bench_tonemap(Bench& b) {
 
 void bench_display_skips(Bench& b) {
     const Scene scene = b.quick() ? k2012_scene(40, Layout::apart, 11, 320) : k2012_scene(300, Layout::apart, 11);
-    const double la = scene.output.adaptation.fixed_cd_m2;
+    const double la = scene.adaptation_cd_m2;
     FrameRenderer renderer;
     renderer.render(scene, 0.0);
     const ImageRGBA32F exact = renderer.read_hdr();

@@ -63,8 +63,9 @@ void bench_lights(Bench& b) {
         const Scene scene = k2012_scene(0, Layout::apart, 3, width);
         renderer.render(scene, 0.0);
         DisplayPipeline display;
-        const Timing t = measure_void([&] { display.process(renderer.hdr_texture(), scene.output, 0.0, 0); },
-                                      b.spec(3, true));
+        const Timing t =
+            measure_void([&] { display.process(renderer.hdr_texture(), scene.output, scene.adaptation_cd_m2, 0.0, 0); },
+                         b.spec(3, true));
         b.scaling_notes.push_back(fmt::format(
             "Times are FrameRenderer::render (lights and glare); the display pass (tone mapping, encoding) adds "
             "{:.0f} ms (median, {}) per {}×{} frame whatever the number of lights.",

@@ -25,8 +25,7 @@ using namespace atonlab::stimuli;
 
 std::vector<SimulatorFrame> run_simulator_sequence(const SimulatorSequence& q, bool gpu_timing) {
     Scene scene = k2012_scene(q.lights, Layout::apart, 7, q.width_px);
-    scene.output.adaptation.mode = AdaptationMode::dynamic;
-    scene.output.adaptation.fixed_cd_m2 = q.adaptation_from_cd_m2;  // the tone mapper's starting state
+    scene.output.adaptation.mode = AdaptationMode::dynamic;  // the first frame adopts its log-average
     scene.glare.model = q.glare;
     scene.glare.eye.hippus.enabled = q.hippus;
     if (q.psf_size > 0) scene.glare.psf_size = q.psf_size;
@@ -48,7 +47,7 @@ std::vector<SimulatorFrame> run_simulator_sequence(const SimulatorSequence& q, b
         const double t = i * dt;
         const double la = q.adaptation_from_cd_m2 * std::pow(10.0, decades * t / span);
         scene.environment.luminance_cd_m2 = la;
-        scene.adaptation_cd_m2 = la;  // the pupil's (K2012 eq 3.15)
+        scene.adaptation_cd_m2 = la;  // the eye's: the pupil (K2012 eq 3.15); the tone mapper measures the frame
         const std::uint64_t ffts = cpu_fft_count();
         const auto t0 = std::chrono::steady_clock::now();
         pipeline.render(scene, t, i == 0 ? 0.0 : dt);

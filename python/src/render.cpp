@@ -127,7 +127,7 @@ std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::opti
     {
         py::gil_scoped_release release;
         scene = stimuli::load_scene(path, list);
-        stimuli::validate_output_settings(scene.output);
+        stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
     }
     return std::make_unique<PyScene>(path, std::move(scene));
 }

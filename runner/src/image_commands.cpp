@@ -118,7 +118,7 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
     if (!o.scene.empty()) {
         const stimuli::Scene scene = stimuli::load_scene(o.scene, {});
         out = scene.output;
-        if (out.adaptation.mode == stimuli::AdaptationMode::fixed) scene_adaptation = out.adaptation.fixed_cd_m2;
+        if (out.adaptation.mode == stimuli::AdaptationMode::fixed) scene_adaptation = scene.adaptation_cd_m2;
     }
     display::ToneMapSettings& tm = out.tonemap;
     if (o.tone_operator) {

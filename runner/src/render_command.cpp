@@ -61,7 +61,7 @@ int run_render(const RenderOptions& o) {
     // Validate everything before touching the GPU or the output paths.
     stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);
     if (o.white_cd_m2) scene.output.tonemap.white_cd_m2 = *o.white_cd_m2;
-    stimuli::validate_output_settings(scene.output);
+    stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
 
     auto context = gl::create_headless_context();
     stimuli::Pipeline pipeline;

@@ -241,7 +241,7 @@ int run_view(const ViewOptions& o) {
         throw InputError(SourceLocation::command_line("--time"), "the time must be a finite number of seconds >= 0");
     std::deque<ViewKey> script = parse_keys(o.keys);
     stimuli::Scene scene = stimuli::load_scene(o.scene, overrides);
-    stimuli::validate_output_settings(scene.output);
+    stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
     if (o.display.empty() != o.db.empty())
         throw InputError(SourceLocation::command_line(o.display.empty() ? "--db" : "--display"),
                          "--display and --db go together: the display's calibration is read from the study file.");
@@ -311,11 +311,11 @@ int run_view(const ViewOptions& o) {
             (is_held_key(k) ? held : pressed).push_back(k);
         }
         const double speed = held_speed(win);
-        const double adapted = first ? scene.output.adaptation.fixed_cd_m2 : pipeline.display().adaptation_cd_m2();
+        const double adapted = first ? scene.adaptation_cd_m2 : pipeline.display().adaptation_cd_m2();
         for (const ViewKey k : pressed) {
             const std::string said = controls.press(k, adapted);
             try {
-                stimuli::validate_output_settings(controls.scene().output);
+                stimuli::validate_output_settings(controls.scene().output, controls.scene().adaptation_cd_m2);
             } catch (const InputError& e) {
                 controls.revert();
                 std::printf("not possible: %s\n", e.message().c_str());

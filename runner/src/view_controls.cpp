@@ -70,8 +70,7 @@ std::string ViewControls::press(ViewKey key, double adapted_cd_m2) {
     stimuli::Scene& s = scene_;
     auto set_fixed = [&](double cd_m2) {
         s.output.adaptation.mode = stimuli::AdaptationMode::fixed;
-        s.output.adaptation.fixed_cd_m2 = cd_m2;
-        s.adaptation_cd_m2 = cd_m2;  // the pupil, hence the glare PSF, follows it
+        s.adaptation_cd_m2 = cd_m2;  // the tone mapper's level; the pupil, hence the glare PSF, follows it
     };
     switch (key) {
         case ViewKey::pause:
@@ -87,9 +86,9 @@ std::string ViewControls::press(ViewKey key, double adapted_cd_m2) {
         case ViewKey::adapt_up:
         case ViewKey::adapt_down: {
             const bool dynamic = s.output.adaptation.mode == stimuli::AdaptationMode::dynamic;
-            const double from = dynamic ? adapted_cd_m2 : s.output.adaptation.fixed_cd_m2;
+            const double from = dynamic ? adapted_cd_m2 : s.adaptation_cd_m2;
             set_fixed(key == ViewKey::adapt_up ? from * kAdaptationStep : from / kAdaptationStep);
-            return fmt::format("adaptation fixed at {:.4g} cd/m²", s.output.adaptation.fixed_cd_m2);
+            return fmt::format("adaptation fixed at {:.4g} cd/m²", s.adaptation_cd_m2);
         }
         case ViewKey::adapt_mode:
             if (s.output.adaptation.mode == stimuli::AdaptationMode::dynamic) {
@@ -203,7 +202,7 @@ std::string ViewControls::status() const {
     return fmt::format(
         "glare {}, tone {}, adaptation {}, t {:.2f} s{}, camera [{:.1f}, {:.1f}, {:.1f}] m yaw {:.1f}° pitch {:.1f}°",
         stimuli::glare_model_name(s.glare.model), display::tone_operator_name(s.output.tonemap.tone_operator),
-        dynamic ? std::string("dynamic") : fmt::format("{:.4g} cd/m²", s.output.adaptation.fixed_cd_m2), time_s_,
+        dynamic ? std::string("dynamic") : fmt::format("{:.4g} cd/m²", s.adaptation_cd_m2), time_s_,
         playing_ ? "" : " (paused)", s.camera.position_m.x, s.camera.position_m.y, s.camera.position_m.z,
         s.camera.yaw_deg, s.camera.pitch_deg);
 }

@@ -51,7 +51,7 @@ uniform uint partial_count;
 uniform uint sample_count;
 uniform float epsilon_cd_m2;
 uniform int fixed_mode;        // 1: state.x = fixed_cd_m2
-uniform double fixed_cd_m2;
+uniform double fixed_cd_m2;    // the eye's level (Scene::adaptation_cd_m2); fixed mode only
 uniform double dt_s;           // frame time (s), ≥ 0
 uniform float tau_rod_s;       // K2012: 0.4 s
 uniform float tau_cone_s;      // K2012: 0.1 s

@@ -19,13 +19,23 @@ void validate_output_settings(const OutputSettings& s) {
     if (s.adaptation.stride < 1)
         throw InputError(SourceLocation{"", 0, 0, "eye.adaptation_stride"},
                          fmt::format("the log-average stride must be at least 1 pixel, not {}.", s.adaptation.stride));
-    if (!(s.adaptation.fixed_cd_m2 > 0) || !std::isfinite(s.adaptation.fixed_cd_m2))
-        throw InputError(SourceLocation{"", 0, 0, "eye.adaptation_cd_m2"},
-                         fmt::format("the adaptation luminance must be a positive number of cd/m², not {}.",
-                                     s.adaptation.fixed_cd_m2));
     if (!(s.adaptation.epsilon_cd_m2 > 0) || !std::isfinite(s.adaptation.epsilon_cd_m2))
         throw InputError(SourceLocation{"", 0, 0, "eye.adaptation_epsilon_cd_m2"},
                          "the log-average's ε must be a positive number of cd/m².");
+}
+
+namespace {
+void validate_adaptation(double adaptation_cd_m2) {
+    if (!(adaptation_cd_m2 > 0) || !std::isfinite(adaptation_cd_m2))
+        throw InputError(
+            SourceLocation{"", 0, 0, "eye.adaptation_cd_m2"},
+            fmt::format("the adaptation luminance must be a positive number of cd/m², not {}.", adaptation_cd_m2));
+}
+}  // namespace
+
+void validate_output_settings(const OutputSettings& s, double adaptation_cd_m2) {
+    validate_output_settings(s);
+    validate_adaptation(adaptation_cd_m2);
 }
 
 namespace {
@@ -93,8 +103,8 @@ void DisplayPipeline::reset_adaptation() {
     impl_->reset();
 }
 
-void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s, double dt_s, std::uint32_t frame,
-                              double pre_exposure) {
+void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s, double adaptation_cd_m2, double dt_s,
+                              std::uint32_t frame, double pre_exposure) {
     Impl& m = *impl_;
     if (!(dt_s >= 0) || !std::isfinite(dt_s))
         throw InputError(SourceLocation{"", 0, 0, "dt_s"},
@@ -102,10 +112,11 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
     if (!(pre_exposure > 0) || !std::isfinite(pre_exposure))
         throw InputError(SourceLocation{"", 0, 0, "pre_exposure"},
                          fmt::format("the HDR frame's pre-exposure must be a positive number, not {}.", pre_exposure));
+    const bool dynamic = s.adaptation.mode == AdaptationMode::dynamic;
+    if (!dynamic) validate_adaptation(adaptation_cd_m2);
     const auto inv_pre_exposure = static_cast<float>(1.0 / pre_exposure);
     m.upload_settings(s);
     m.size_for(hdr);
-    const bool dynamic = s.adaptation.mode == AdaptationMode::dynamic;
     const int stride = std::max(1, s.adaptation.stride);
     const unsigned samples =
         static_cast<unsigned>(((m.width + stride - 1) / stride) * ((m.height + stride - 1) / stride));
@@ -127,7 +138,7 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
     m.final_pass.set("sample_count", dynamic ? samples : 1u);
     m.final_pass.set("epsilon_cd_m2", static_cast<float>(s.adaptation.epsilon_cd_m2));
     m.final_pass.set("fixed_mode", dynamic ? 0 : 1);
-    m.final_pass.set("fixed_cd_m2", s.adaptation.fixed_cd_m2);
+    m.final_pass.set("fixed_cd_m2", adaptation_cd_m2);  // read in fixed mode only
     m.final_pass.set("dt_s", dt_s);
     m.final_pass.set("tau_rod_s", static_cast<float>(display::kTauRodS));
     m.final_pass.set("tau_cone_s", static_cast<float>(display::kTauConeS));
@@ -140,16 +151,17 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
 }
 
 void DisplayPipeline::process_ldr(const gl::Texture2D& ldr, const gl::Texture2D& glare, const OutputSettings& s,
-                                  std::uint32_t frame, double hdr_scale) {
+                                  double adaptation_cd_m2, std::uint32_t frame, double hdr_scale) {
     Impl& m = *impl_;
+    validate_adaptation(adaptation_cd_m2);
     if (ldr.width() != glare.width() || ldr.height() != glare.height())
         throw InputError(SourceLocation{"", 0, 0, "ldr"},
                          fmt::format("the LDR frame is {}×{} but the glare buffer is {}×{}.", ldr.width(), ldr.height(),
                                      glare.width(), glare.height()));
     m.upload_settings(s);
     m.size_for(ldr);
-    // The LDR path has no HDR scene to measure: adaptation is the fixed level.
-    const double st[4] = {s.adaptation.fixed_cd_m2, s.adaptation.fixed_cd_m2, 1.0, 0.0};
+    // The LDR path has no HDR scene to measure: adaptation is the eye's level.
+    const double st[4] = {adaptation_cd_m2, adaptation_cd_m2, 1.0, 0.0};
     m.state.upload(0, sizeof(st), st);
     ldr.bind(0);
     glare.bind(1);

@@ -166,7 +166,7 @@ std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const
     const display::ToneMapGpuParams tp = display::tonemap_gpu_params(out.tonemap);
     const display::GpuDisplayParams dp = display::gpu_display_params(out.display, out.encode);
     const std::vector<double> lut = display::gpu_display_lut(out.display);
-    const double state[3] = {out.adaptation.fixed_cd_m2, floor_cd_m2, k.threshold_codes};
+    const double state[3] = {scene.adaptation_cd_m2, floor_cd_m2, k.threshold_codes};
     bytes(&tp, sizeof(tp));
     bytes(&dp, sizeof(dp));
     bytes(lut.data(), lut.size() * sizeof(double));
@@ -180,7 +180,7 @@ std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const
         const glm::dvec3 c = scene.lights[i].rgb_per_cd;
         auto [it, fresh] = per_colour.try_emplace({c.r, c.g, c.b}, 0.0);
         if (fresh)
-            it->second = invisible_luminance_cd_m2(out, out.adaptation.fixed_cd_m2, floor_cd_m2, c, k.threshold_codes);
+            it->second = invisible_luminance_cd_m2(out, scene.adaptation_cd_m2, floor_cd_m2, c, k.threshold_codes);
         result[i] = it->second * omega_min;
     }
     return result;
@@ -327,7 +327,7 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     projection_ = CameraProjection::from_scene(scene);
     const CameraProjection& P = projection_;
     m.resize(P.width_px, P.height_px);
-    m.pre_exposure = m.options.pre_exposure > 0 ? m.options.pre_exposure : 1.0 / scene.output.adaptation.fixed_cd_m2;
+    m.pre_exposure = m.options.pre_exposure > 0 ? m.options.pre_exposure : 1.0 / scene.adaptation_cd_m2;
     const auto pre = static_cast<float>(m.pre_exposure);
     m.timed = m.options.gpu_timing;
     if (m.timed && !m.timers[0])

@@ -47,7 +47,6 @@ Scene build_scene(Document& doc, const toml::table& root_table) {
     step([&] { scene.environment = read_environment(doc, root); });
     step(
         [&] { scene.adaptation_cd_m2 = read_eye(doc, root, scene.environment, scene.glare, scene.output.adaptation); });
-    scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
     // The pupil the glare stage will use (glare_stage.h glare_pupil_mm): given,
     // or eq 3.15 from the fixed adaptation, or the dark-adapted 7.9 mm when the
     // adaptation follows the frame.

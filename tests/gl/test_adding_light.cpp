@@ -90,7 +90,7 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                         o.tonemap.hue_preservation = s.hue_preservation;
                         o.tonemap.blueshift = s.blueshift;
                         o.tonemap.blueshift_luminance = s.blueshift_luminance;
-                        display.process(frame.hdr_texture(), o, 0.0, 0, frame.pre_exposure());
+                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
                         out.push_back(window_of(display.read_codes(), scene.output.display));
                     }
                     return out;

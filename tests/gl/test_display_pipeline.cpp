@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "atonlab/stimuli/display_pipeline.h"
@@ -18,6 +19,9 @@ using namespace atonlab::stimuli;
 using namespace atonlab::display;
 
 constexpr int kW = 128, kH = 96;
+// The eye's adaptation level (Scene::adaptation_cd_m2's default), passed where the
+// adaptation is dynamic: the tone mapper then measures the frames and does not read it.
+constexpr double kEyeCdM2 = 0.001;
 
 // Random HDR pixels, rows in GL order (row 0 at the bottom): luminance log-uniform over
 // 1e-6 … 1e9 cd/m², random chromaticities, pure primaries, exact zeros.
@@ -109,9 +113,8 @@ TEST_F(DisplayPipelineGL, EightBitCodesMatchTheCpuReferenceForEveryOperator) {
         for (double adaptation : {1e-6, 1e-3, 1.0, 1e3, 1e6}) {
             OutputSettings s;
             s.tonemap.tone_operator = op;
-            s.adaptation.fixed_cd_m2 = adaptation;
             const std::uint32_t frame = 7;
-            pipeline.process(tex, s, 0.0, frame);
+            pipeline.process(tex, s, adaptation, 0.0, frame);
             const Agreement a = compare(pipeline.read_codes(), hdr, adaptation, s, frame);
             EXPECT_GE(a.identical, 0.999) << tone_operator_name(op) << " at " << adaptation;
             EXPECT_LE(a.max_diff, 1) << tone_operator_name(op) << " at " << adaptation;
@@ -127,7 +130,7 @@ TEST_F(DisplayPipelineGL, LogAverageMatchesTheCpuReference) {
     s.adaptation.mode = AdaptationMode::dynamic;
     auto check = [&](const std::vector<float>& px, const char* what) {
         pipeline.reset_adaptation();
-        pipeline.process(texture_of(px), s, 0.0, 0);
+        pipeline.process(texture_of(px), s, kEyeCdM2, 0.0, 0);
         const double cpu = atonlab::stimuli::log_average_luminance(image_of(px), s.adaptation.epsilon_cd_m2);
         EXPECT_NEAR(pipeline.log_average_cd_m2() / cpu, 1.0, 1e-4) << what;
         EXPECT_NEAR(pipeline.adaptation_cd_m2() / cpu, 1.0, 1e-4) << what << ": the first frame adopts it";
@@ -149,23 +152,23 @@ TEST_F(DisplayPipelineGL, TemporalAdaptationReachesSixtyThreePercentAfterTau) {
     s.adaptation.mode = AdaptationMode::dynamic;
     const std::vector<float> dark(static_cast<std::size_t>(kW) * kH * 4, 0.01f);
     const std::vector<float> bright(dark.size(), 10.0f);
-    pipeline.process(texture_of(dark), s, 0.0, 0);
+    pipeline.process(texture_of(dark), s, kEyeCdM2, 0.0, 0);
     const double start = pipeline.adaptation_cd_m2();
     const gl::Texture2D b = texture_of(bright);
     const double target = atonlab::stimuli::log_average_luminance(image_of(bright), s.adaptation.epsilon_cd_m2);
     const double tau = adaptation_time_constant_s(target);
     const double dt = 1.0 / 60.0;
     const int frames = static_cast<int>(std::lround(tau / dt));
-    for (int f = 0; f < frames; ++f) pipeline.process(b, s, dt, static_cast<std::uint32_t>(f));
+    for (int f = 0; f < frames; ++f) pipeline.process(b, s, kEyeCdM2, dt, static_cast<std::uint32_t>(f));
     const double reached = (pipeline.adaptation_cd_m2() - start) / (target - start);
     const double expected = 1.0 - std::exp(-frames * dt / tau);
     EXPECT_NEAR(reached, expected, 1e-4);
     EXPECT_NEAR(reached, 1.0 - std::exp(-1.0), 0.02);
     // Δt = 0 holds still; a huge Δt lands on the target.
     const double held = pipeline.adaptation_cd_m2();
-    pipeline.process(b, s, 0.0, 0);
+    pipeline.process(b, s, kEyeCdM2, 0.0, 0);
     EXPECT_DOUBLE_EQ(pipeline.adaptation_cd_m2(), held);
-    pipeline.process(b, s, 1e6, 0);
+    pipeline.process(b, s, kEyeCdM2, 1e6, 0);
     EXPECT_NEAR(pipeline.adaptation_cd_m2() / target, 1.0, 1e-6);
 }
 
@@ -177,14 +180,13 @@ TEST_F(DisplayPipelineGL, LdrPathAddsToneMappedGlareToTheDisplayReferredFrame) {
     const std::vector<float> glare = random_hdr(4);
     DisplayPipeline pipeline;
     OutputSettings s;
-    s.adaptation.fixed_cd_m2 = 0.03;
-    pipeline.process_ldr(texture_of(ldr), texture_of(glare), s, 5);
+    pipeline.process_ldr(texture_of(ldr), texture_of(glare), s, 0.03, 5);
     const Agreement a = compare(pipeline.read_codes(), ldr, 0.03, s, 5, &glare);
     EXPECT_GE(a.identical, 0.999);
     EXPECT_LE(a.max_diff, 1);
     // An HDR scene shown by exposure (× scale, clipped) in the same path.
     const std::vector<float> hdr = random_hdr(5);
-    pipeline.process_ldr(texture_of(hdr), texture_of(glare), s, 5, 1.0 / 0.06);
+    pipeline.process_ldr(texture_of(hdr), texture_of(glare), s, 0.03, 5, 1.0 / 0.06);
     const Agreement b = compare(pipeline.read_codes(), hdr, 0.03, s, 5, &glare, 1.0 / 0.06);
     EXPECT_GE(b.identical, 0.999);
     EXPECT_LE(b.max_diff, 1);
@@ -194,13 +196,42 @@ TEST_F(DisplayPipelineGL, BadSettingsAreInputErrors) {
     DisplayPipeline pipeline;
     const gl::Texture2D tex = texture_of(random_hdr(6));
     OutputSettings s;
-    EXPECT_THROW(pipeline.process(tex, s, -1.0, 0), InputError);
-    EXPECT_THROW(pipeline.process(tex, s, std::nan(""), 0), InputError);
+    EXPECT_THROW(pipeline.process(tex, s, kEyeCdM2, -1.0, 0), InputError);
+    EXPECT_THROW(pipeline.process(tex, s, kEyeCdM2, std::nan(""), 0), InputError);
     s.encode.bits = 0;
     EXPECT_THROW(validate_output_settings(s), InputError);
     s.encode.bits = 8;
     s.display.black_cd_m2 = 200.0;  // above its peak
     EXPECT_THROW(validate_output_settings(s), InputError);
+}
+
+TEST_F(DisplayPipelineGL, AFixedLevelIsThePositiveLevelPassedIn) {
+    // The level is the scene's (Scene::adaptation_cd_m2), passed to each frame: refused where
+    // it is used (fixed adaptation, the LDR path) unless positive and finite, under its key.
+    DisplayPipeline pipeline;
+    const gl::Texture2D tex = texture_of(random_hdr(7));
+    OutputSettings s;
+    for (const double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+        EXPECT_THROW(pipeline.process(tex, s, bad, 0.0, 0), InputError) << bad;
+        EXPECT_THROW(pipeline.process_ldr(tex, tex, s, bad, 0), InputError) << bad;
+        try {
+            validate_output_settings(s, bad);
+            ADD_FAILURE() << bad << " was accepted";
+        } catch (const InputError& e) {
+            ASSERT_TRUE(e.where().has_value());
+            EXPECT_EQ(e.where()->key, "eye.adaptation_cd_m2");
+        }
+    }
+    EXPECT_NO_THROW(validate_output_settings(s, 0.03));
+    pipeline.process(tex, s, 0.03, 0.0, 0);
+    EXPECT_EQ(pipeline.adaptation_cd_m2(), 0.03);
+    // Dynamic adaptation measures the frame: the level passed in is not read.
+    s.adaptation.mode = AdaptationMode::dynamic;
+    pipeline.reset_adaptation();
+    EXPECT_NO_THROW(pipeline.process(tex, s, 0.0, 0.0, 0));
+    const double log_average =
+        atonlab::stimuli::log_average_luminance(image_of(random_hdr(7)), s.adaptation.epsilon_cd_m2);
+    EXPECT_NEAR(pipeline.adaptation_cd_m2() / log_average, 1.0, 1e-4);
 }
 
 }  // namespace

@@ -114,7 +114,7 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
                 for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual}) {
                     OutputSettings o = scene.output;
                     o.tonemap.tone_operator = op;
-                    display.process(frame.hdr_texture(), o, 0.0, 0, frame.pre_exposure());
+                    display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
                     const double sum = frame_sum_cd_m2(display.read_codes(), scene.output.display);
                     const std::string name(tone_operator_name(op));
                     if (colour.empty()) added[name]["sky"] = sum;

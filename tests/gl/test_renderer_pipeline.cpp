@@ -41,10 +41,10 @@ s::EncodedImage old_runner_codes(const s::Scene& sc) {
         const display::ToneMapSettings& tm = os.tonemap;
         const double white = tm.white_cd_m2
                                  ? *tm.white_cd_m2
-                                 : os.adaptation.fixed_cd_m2 * tm.display_peak_cd_m2 / display::display_adaptation_cd_m2(tm);
-        display.process_ldr(frame.hdr_texture(), *glare, os, 0, 1.0 / white);
+                                 : sc.adaptation_cd_m2 * tm.display_peak_cd_m2 / display::display_adaptation_cd_m2(tm);
+        display.process_ldr(frame.hdr_texture(), *glare, os, sc.adaptation_cd_m2, 0, 1.0 / white);
     } else {
-        display.process(frame.hdr_texture(), os, 0.0, 0);
+        display.process(frame.hdr_texture(), os, sc.adaptation_cd_m2, 0.0, 0);
     }
     return display.read_codes();
 }

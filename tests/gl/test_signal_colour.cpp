@@ -122,7 +122,7 @@ int check_every_level(const std::string& glare, bool area) {
                 out.tonemap.tone_operator = op;
                 out.tonemap.blueshift = blueshift;
                 out.tonemap.blueshift_luminance = whose;
-                display.process(frame.hdr_texture(), out, 0.0, 0, frame.pre_exposure());
+                display.process(frame.hdr_texture(), out, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
                 return display.read_codes();
             };
             const EncodedImage photopic = codes_with(false, BlueshiftLuminance::pixel);

@@ -44,7 +44,6 @@ Scene grid_scene(GlareModel model) {
     s.environment.background = Background::uniform;
     s.environment.luminance_cd_m2 = 0.01;
     s.adaptation_cd_m2 = 0.01;
-    s.output.adaptation.fixed_cd_m2 = 0.01;
     s.output.encode.dither = Dither::none;
     s.glare.model = model;
     s.glare.bloom_sigma_deg = 0.3;
@@ -87,13 +86,14 @@ Frame render(FrameRenderer& r, const Scene& s, const DisplaySkips& skips) {
 }
 
 /// The largest change of any channel's continuous code (before dither) between
-/// two HDR frames, through the CPU double tone mapper and display model.
-double worst_code_change(const ImageRGBA32F& a, const ImageRGBA32F& b, const OutputSettings& out) {
+/// two HDR frames, through the CPU double tone mapper and display model of the scene.
+double worst_code_change(const ImageRGBA32F& a, const ImageRGBA32F& b, const Scene& scene) {
+    const OutputSettings& out = scene.output;
     double worst = 0;
     for (std::size_t i = 0; i < a.rgba.size(); i += 4) {
         const glm::dvec3 pa{a.rgba[i], a.rgba[i + 1], a.rgba[i + 2]}, pb{b.rgba[i], b.rgba[i + 1], b.rgba[i + 2]};
         if (pa == pb) continue;
-        const double L = out.adaptation.fixed_cd_m2;
+        const double L = scene.adaptation_cd_m2;
         const glm::dvec3 ca = continuous_codes(out.display, tonemap_pixel(pa, L, out.tonemap), out.encode.bits);
         const glm::dvec3 cb = continuous_codes(out.display, tonemap_pixel(pb, L, out.tonemap), out.encode.bits);
         const glm::dvec3 d = glm::abs(ca - cb);
@@ -114,7 +114,7 @@ TEST_F(Skips, InvisibleLightsAreCulledWithinTheStatedBound) {
         const Scene scene = grid_scene(model);
         const Frame exact = render(r, scene, {});
         const Frame culled = render(r, scene, {true, false, 0.25});
-        const double change = worst_code_change(exact.hdr, culled.hdr, scene.output);
+        const double change = worst_code_change(exact.hdr, culled.hdr, scene);
         std::printf("%-14s: %d of %d lights drawn with the cull (%d without); worst code change %.4f (bound 0.25)\n",
                     std::string(glare_model_name(model)).c_str(), culled.stats.drawn, culled.stats.lights,
                     exact.stats.drawn, change);
@@ -148,7 +148,7 @@ TEST_F(Skips, CroppedBillboardsStayWithinTheStatedBound) {
         const double full = r.glare().kernel(0)->half() + 2.0;
         for (const auto& d : cropped.draws)
             if (d.area_px2 > 0 && d.crop_half_extent_px > 0 && d.crop_half_extent_px < full) ++crops;
-        const double change = worst_code_change(exact.hdr, cropped.hdr, scene.output);
+        const double change = worst_code_change(exact.hdr, cropped.hdr, scene);
         std::printf("%-14s: %d of %d drawn billboards cropped; worst code change %.4f (bound 0.25)\n",
                     std::string(glare_model_name(model)).c_str(), crops, cropped.stats.drawn, change);
         EXPECT_GT(crops, 0);
@@ -168,7 +168,7 @@ TEST_F(Skips, BothSkipsTogetherOnASkyAndSeaBackground) {
         std::swap(scene.lights[i].intensity_cd, scene.lights[scene.lights.size() - 1 - i].intensity_cd);
     const Frame exact = render(r, scene, {});
     const Frame skipped = render(r, scene, both());
-    const double change = worst_code_change(exact.hdr, skipped.hdr, scene.output);
+    const double change = worst_code_change(exact.hdr, skipped.hdr, scene);
     std::printf("sky-sea: %d of %d drawn with skips (%d without); worst code change %.4f\n", skipped.stats.drawn,
                 skipped.stats.lights, exact.stats.drawn, change);
     EXPECT_LT(skipped.stats.drawn, exact.stats.drawn);
@@ -182,7 +182,7 @@ TEST_F(Skips, SmallerThresholdSkipsLessAndStaysWithinItsBound) {
     int previous = 0;
     for (double t : {1.0, 0.25, 1.0 / 16}) {
         const Frame f = render(r, scene, both(t));
-        const double change = worst_code_change(exact.hdr, f.hdr, scene.output);
+        const double change = worst_code_change(exact.hdr, f.hdr, scene);
         std::printf("threshold %.4f codes: %d lights drawn, worst code change %.4f\n", t, f.stats.drawn, change);
         EXPECT_LE(change, t + 1e-3);
         EXPECT_GE(f.stats.drawn, previous);
@@ -385,7 +385,7 @@ TEST_F(Skips, PreExposedHalfFloatTargetMatchesTheFloatTarget) {
     o.pre_exposure = 0.0;  // 1 / adaptation
     r.set_options(o);
     r.render(scene, 0.0);
-    EXPECT_DOUBLE_EQ(r.pre_exposure(), 1.0 / scene.output.adaptation.fixed_cd_m2);
+    EXPECT_DOUBLE_EQ(r.pre_exposure(), 1.0 / scene.adaptation_cd_m2);
     const ImageRGBA32F half = r.read_hdr();
     const double ceiling = 65504.0 / r.pre_exposure();
     double worst = 0;

@@ -47,6 +47,10 @@ ImageRGBA32F image_of(const std::vector<float>& px) {
     return img;
 }
 
+// The eye's adaptation level (Scene::adaptation_cd_m2's default), passed where the
+// adaptation is dynamic: the tone mapper then measures the frames and does not read it.
+constexpr double kEyeCdM2 = 0.001;
+
 OutputSettings dynamic_settings() {
     OutputSettings s;
     s.adaptation.mode = AdaptationMode::dynamic;
@@ -67,7 +71,7 @@ TEST_F(StressDisplayPipeline, LogAverageOfAnAllBlackFrameIsEpsilon) {
     // tone mapper clamps to 1e-7 … 1e10; every code is black.
     DisplayPipeline pipeline;
     const OutputSettings s = dynamic_settings();
-    pipeline.process(texture_of(uniform_frame(0.0f)), s, 0.0, 0);
+    pipeline.process(texture_of(uniform_frame(0.0f)), s, kEyeCdM2, 0.0, 0);
     EXPECT_NEAR(pipeline.log_average_cd_m2(), s.adaptation.epsilon_cd_m2, 1e-6 * s.adaptation.epsilon_cd_m2);
     EXPECT_NEAR(pipeline.adaptation_cd_m2(), s.adaptation.epsilon_cd_m2, 1e-6 * s.adaptation.epsilon_cd_m2);
     const EncodedImage codes = pipeline.read_codes();
@@ -89,7 +93,7 @@ TEST_F(StressDisplayPipeline, LogAverageOfZerosAndOneE9MatchesTheCpu) {
     for (const auto* frame : {&half, &ramp}) {
         DisplayPipeline pipeline;
         const OutputSettings s = dynamic_settings();
-        pipeline.process(texture_of(*frame), s, 0.0, 0);
+        pipeline.process(texture_of(*frame), s, kEyeCdM2, 0.0, 0);
         const double cpu = log_average_luminance(image_of(*frame), s.adaptation.epsilon_cd_m2);
         EXPECT_NEAR(pipeline.log_average_cd_m2() / cpu, 1.0, 1e-5);
         expect_codes_in_range(pipeline.read_codes(), "zeros and 1e9");
@@ -108,12 +112,12 @@ TEST_F(StressDisplayPipeline, NonFinitePixelsDoNotPoisonAdaptation) {
         for (int c = 0; c < 3; ++c) frame[(k * 97) * 4 + static_cast<std::size_t>(c)] = specials[k];
     const OutputSettings s = dynamic_settings();
     DisplayPipeline pipeline;
-    pipeline.process(texture_of(frame), s, 0.0, 0);
+    pipeline.process(texture_of(frame), s, kEyeCdM2, 0.0, 0);
     const double cpu = log_average_luminance(image_of(frame), s.adaptation.epsilon_cd_m2);
     ASSERT_TRUE(std::isfinite(cpu));
     EXPECT_NEAR(pipeline.log_average_cd_m2() / cpu, 1.0, 1e-5) << "GPU " << pipeline.log_average_cd_m2();
     for (int f = 1; f <= 3; ++f) {
-        pipeline.process(texture_of(frame), s, 1.0 / 60.0, static_cast<std::uint32_t>(f));
+        pipeline.process(texture_of(frame), s, kEyeCdM2, 1.0 / 60.0, static_cast<std::uint32_t>(f));
         EXPECT_TRUE(std::isfinite(pipeline.adaptation_cd_m2())) << "frame " << f;
     }
     expect_codes_in_range(pipeline.read_codes(), "non-finite pixels");
@@ -123,10 +127,10 @@ TEST_F(StressDisplayPipeline, NonFinitePixelsDoNotPoisonAdaptation) {
     for (std::size_t p = 0; p < 50; ++p)
         for (int c = 0; c < 3; ++c) bright[p * 4 + static_cast<std::size_t>(c)] = 1e6f;
     DisplayPipeline half_pipeline;
-    half_pipeline.process(texture_of(bright, gl::PixelFormat::rgba16f), s, 0.0, 0);
+    half_pipeline.process(texture_of(bright, gl::PixelFormat::rgba16f), s, kEyeCdM2, 0.0, 0);
     const double adapted = half_pipeline.adaptation_cd_m2();
     EXPECT_TRUE(std::isfinite(adapted) && adapted > 0.0) << adapted;
-    half_pipeline.process(texture_of(bright, gl::PixelFormat::rgba16f), s, 10.0, 1);
+    half_pipeline.process(texture_of(bright, gl::PixelFormat::rgba16f), s, kEyeCdM2, 10.0, 1);
     EXPECT_TRUE(std::isfinite(half_pipeline.adaptation_cd_m2()));
     expect_codes_in_range(half_pipeline.read_codes(), "RGBA16F frame");
 }
@@ -137,7 +141,7 @@ TEST_F(StressDisplayPipeline, TemporalAdaptationWithDtZeroAndTenSecondsAcrossThe
     // on the CPU to 1e-5 and moves towards the target.
     DisplayPipeline pipeline;
     const OutputSettings s = dynamic_settings();
-    pipeline.process(texture_of(uniform_frame(0.0f)), s, 0.0, 0);
+    pipeline.process(texture_of(uniform_frame(0.0f)), s, kEyeCdM2, 0.0, 0);
     double current = pipeline.adaptation_cd_m2();
     std::uint32_t frame = 1;
     for (float level : {1e9f, 1e-3f, 1e6f, 0.0f}) {
@@ -146,7 +150,7 @@ TEST_F(StressDisplayPipeline, TemporalAdaptationWithDtZeroAndTenSecondsAcrossThe
         const double target = log_average_luminance(image_of(px), s.adaptation.epsilon_cd_m2);
         const double start = current;
         for (double dt : {0.0, 1.0 / 60.0, 0.5, 10.0}) {
-            pipeline.process(tex, s, dt, frame++);
+            pipeline.process(tex, s, kEyeCdM2, dt, frame++);
             const double gpu = pipeline.adaptation_cd_m2();
             const double cpu = temporal_adaptation(current, target, dt);
             ASSERT_TRUE(std::isfinite(gpu)) << level << " dt " << dt;
@@ -191,7 +195,6 @@ TEST_F(StressDisplayPipeline, CodesNonDecreasingAlongALuminanceRamp) {
             for (double adaptation : {1e-6, 1.0, 1e6}) {
                 for (bool pq : {false, true}) {
                     OutputSettings s;
-                    s.adaptation.fixed_cd_m2 = adaptation;
                     s.tonemap.tone_operator = static_cast<ToneOperator>(op);
                     s.tonemap.hue_preservation = static_cast<HuePreservation>(h);
                     s.encode.dither = Dither::none;
@@ -204,7 +207,7 @@ TEST_F(StressDisplayPipeline, CodesNonDecreasingAlongALuminanceRamp) {
                         s.display = DisplayModel::pq(1000.0, 0.005);
                         s.encode.bits = 10;
                     }
-                    pipeline.process(tex, s, 0.0, 0);
+                    pipeline.process(tex, s, adaptation, 0.0, 0);
                     const EncodedImage codes = pipeline.read_codes();
                     expect_codes_in_range(codes, "ramp");
                     for (int y = 0; y < kH; ++y) {

@@ -238,7 +238,6 @@ TEST_F(StressGlare, ExtremeLightsWithEveryCheapModelAndPupil) {
             Scene scene = stress_scene();
             scene.environment.luminance_cd_m2 = 0.0;
             scene.adaptation_cd_m2 = adaptation;
-            scene.output.adaptation.fixed_cd_m2 = adaptation;
             scene.glare.model = model;
             scene.glare.psf_size = 128;
             scene.glare.eye.gratings.enabled = false;
@@ -285,7 +284,6 @@ TEST_F(StressHalfFloatTarget, ExtremeLightsNeverOverflowTheRgba16fTarget) {
             Scene scene = stress_scene();
             scene.environment.luminance_cd_m2 = 1e-3;
             scene.adaptation_cd_m2 = adaptation;
-            scene.output.adaptation.fixed_cd_m2 = adaptation;
             scene.glare.model = model;
             scene.glare.radius_deg = 0.5;
             scene.glare.bloom_sigma_deg = 0.1;
@@ -338,8 +336,8 @@ TEST_F(StressPipeline, DisplayCodesInRangeForExtremeLightsEveryOperatorAndAdapta
             scene.output.encode.bits = mode % 2 ? 10 : 8;
             if (mode >= 2) scene.output.display = DisplayModel::pq(1000.0, 0.005);
             double dt = 0.0;
-            if (mode == 0) scene.output.adaptation.fixed_cd_m2 = 1e-6;
-            if (mode == 1) scene.output.adaptation.fixed_cd_m2 = 1e6;
+            if (mode == 0) scene.adaptation_cd_m2 = 1e-6;
+            if (mode == 1) scene.adaptation_cd_m2 = 1e6;
             if (mode >= 2) {
                 scene.output.adaptation.mode = AdaptationMode::dynamic;
                 pipeline.display().reset_adaptation();

@@ -126,7 +126,7 @@ protected:
         s.encode.bits = 10;
         s.encode.dither = Dither::none;
         DisplayPipeline pipeline;
-        pipeline.process_ldr(scene, glare, s, 0);
+        pipeline.process_ldr(scene, glare, s, 0.001, 0);  // the eye's level tone-maps the glare: none here
         const EncodedImage codes = pipeline.read_codes();
         ASSERT_EQ(codes.bits, 10);
         ASSERT_EQ(codes.width, width_);

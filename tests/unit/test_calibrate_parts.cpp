@@ -422,7 +422,7 @@ TEST(ViewKeys, NamesMoveTurnAndToggle) {
     stimuli::Scene scene;
     scene.camera.yaw_deg = 90.0;  // east: +x
     scene.glare.model = stimuli::GlareModel::wave_optics;
-    scene.output.adaptation.fixed_cd_m2 = 0.01;
+    scene.adaptation_cd_m2 = 0.01;
     ViewControls v(scene);
     const ViewKey fwd[] = {ViewKey::forward};
     v.hold(fwd, 2.0, 1.0);  // 10 m/s for 2 s
@@ -447,12 +447,11 @@ TEST(ViewKeys, NamesMoveTurnAndToggle) {
     EXPECT_EQ(v.scene().glare.model, stimuli::GlareModel::wave_optics);
 
     v.press(ViewKey::adapt_up, 0.0);
-    EXPECT_NEAR(v.scene().output.adaptation.fixed_cd_m2, 0.01 * std::pow(10.0, 0.25), 1e-15);
-    EXPECT_EQ(v.scene().adaptation_cd_m2, v.scene().output.adaptation.fixed_cd_m2);
+    EXPECT_NEAR(v.scene().adaptation_cd_m2, 0.01 * std::pow(10.0, 0.25), 1e-15);
     v.press(ViewKey::adapt_mode, 0.0);
     EXPECT_EQ(v.scene().output.adaptation.mode, stimuli::AdaptationMode::dynamic);
     v.press(ViewKey::adapt_down, 0.5);  // leaves dynamic at the adapted 0.5 cd/m²
-    EXPECT_NEAR(v.scene().output.adaptation.fixed_cd_m2, 0.5 / std::pow(10.0, 0.25), 1e-15);
+    EXPECT_NEAR(v.scene().adaptation_cd_m2, 0.5 / std::pow(10.0, 0.25), 1e-15);
 
     v.press(ViewKey::pause, 0.0);
     v.advance(1.0);

@@ -517,7 +517,7 @@ TEST(SceneFileOutput, TonemapDisplayAndAdaptationAreRead) {
                              "ldr_glare = true\n";
     const Scene scene = parse_scene(text, "out.toml");
     EXPECT_EQ(scene.output.adaptation.mode, AdaptationMode::dynamic);
-    EXPECT_EQ(scene.output.adaptation.fixed_cd_m2, 0.03);
+    EXPECT_EQ(scene.adaptation_cd_m2, 0.03);
     EXPECT_EQ(scene.output.display.peak_cd_m2, 250.0);
     EXPECT_EQ(scene.output.display.black_cd_m2, 0.2);
     EXPECT_EQ(scene.output.tonemap.display_peak_cd_m2, 250.0);

@@ -62,7 +62,6 @@ TEST(StressEyeModel, GlarePupilFollowsTheAdaptationOverItsWholeRange) {
     double prev = 7.9;
     for (int i = 0; i <= 120; ++i) {
         scene.adaptation_cd_m2 = std::pow(10.0, -6.0 + 0.1 * i);
-        scene.output.adaptation.fixed_cd_m2 = scene.adaptation_cd_m2;
         const double p = glare_pupil_mm(scene);
         ASSERT_TRUE(std::isfinite(p) && p >= 1.9 && p <= 7.9) << scene.adaptation_cd_m2;
         ASSERT_LE(p, prev);

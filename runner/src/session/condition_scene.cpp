@@ -42,7 +42,7 @@ s::Scene condition_scene(const s::SceneTemplate& scene, const p::Protocol& proto
         s::Scene made = scene.instantiate(frame.overrides);
         // The scene loader has checked that the glare billboard fits the display
         // (GL-free, naming the keys), so a session refuses it before it opens anything.
-        s::validate_output_settings(made.output);
+        s::validate_output_settings(made.output, made.adaptation_cd_m2);
         return made;
     } catch (const InputError& e) {
         const std::optional<SourceLocation>& w = e.where();

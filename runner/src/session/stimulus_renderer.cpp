@@ -137,7 +137,7 @@ std::shared_ptr<const s::Scene> StimulusRenderer::scene(const std::vector<SceneO
     if (const auto* hit = scenes_.find(key)) return *hit;
     s::Scene sc = template_.instantiate(overrides);
     if (display_model_) apply_display_model(sc, *display_model_);
-    s::validate_output_settings(sc.output);
+    s::validate_output_settings(sc.output, sc.adaptation_cd_m2);
     ++parsed_;
     return scenes_.put(key, std::make_shared<const s::Scene>(std::move(sc)));
 }

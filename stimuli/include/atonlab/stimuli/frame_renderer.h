@@ -91,7 +91,8 @@ struct FrameOptions {
     HdrFormat hdr_format = HdrFormat::rgba32f;
     /// The HDR target stores luminance × pre_exposure (pre-exposure as in
     /// Frostbite/UE4: brings the adaptation level near 1 for half floats). 0:
-    /// 1 / the fixed adaptation luminance (cd/m²). read_hdr() divides it out;
+    /// 1 / the eye's adaptation luminance, Scene::adaptation_cd_m2 (cd/m²; in
+    /// either adaptation mode). read_hdr() divides it out;
     /// DisplayPipeline::process() takes it as its pre_exposure.
     double pre_exposure = 1.0;
     DisplaySkips skips;

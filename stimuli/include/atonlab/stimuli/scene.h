@@ -137,11 +137,16 @@ struct Scene {
     ProfileTables profiles;
     std::vector<Light> lights;
     std::vector<Disc> discs;  ///< drawn over the background, under the lights, in order
-    double adaptation_cd_m2 = 0.001;  ///< recorded in image headers; drives later stages
+    /// The eye's adaptation luminance (cd/m², > 0; [eye] adaptation_cd_m2), the
+    /// one stored level: it sets the pupil (K2012 eq 3.15) and Spencer's vision
+    /// class, is recorded in image headers, is the tone mapper's level when
+    /// output.adaptation.mode is fixed, and gives the automatic pre-exposure
+    /// (FrameOptions::pre_exposure = 0). With dynamic adaptation the tone
+    /// mapper measures the frames instead (output_settings.h).
+    double adaptation_cd_m2 = 0.001;
     GlareSettings glare;
-    /// Adaptation, tone mapping, display model and encoding ([eye], [tonemap],
-    /// [display] of the scene file). output.adaptation.fixed_cd_m2 mirrors
-    /// adaptation_cd_m2.
+    /// Adaptation mode, tone mapping, display model and encoding ([eye],
+    /// [tonemap], [display] of the scene file).
     OutputSettings output;
 };
 
