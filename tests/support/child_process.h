@@ -3,6 +3,7 @@
 // stdout and stderr to files, an exit status as a shell reports it; and the
 // whole run captured (run_captured, and atonlab() where the test's build names
 // the binary in ATONLAB_BINARY).
+#include <cerrno>
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -24,7 +25,9 @@ inline int status_code(int status) {
 /// Starts argv[0] with argv, stdout and stderr to the files (truncated).
 /// stdin_null: stdin from /dev/null. drop_root: as root, run as "nobody"
 /// (root ignores file permissions). The child exits 120/121/122 when it
-/// cannot redirect, drop privileges or exec.
+/// cannot redirect, drop privileges or exec; 123 when, dropped to "nobody",
+/// it may not exec the program (EACCES: a directory above it, such as a
+/// mktemp -d checkout's, is not searchable by others).
 inline pid_t spawn_to_files(std::vector<std::string> argv, const std::filesystem::path& out,
                             const std::filesystem::path& err, bool stdin_null = false, bool drop_root = false) {
     const pid_t pid = fork();
@@ -41,7 +44,7 @@ inline pid_t spawn_to_files(std::vector<std::string> argv, const std::filesystem
         for (std::string& a : argv) cargs.push_back(a.data());
         cargs.push_back(nullptr);
         execv(cargs[0], cargs.data());
-        _exit(122);
+        _exit(drop_root && errno == EACCES ? 123 : 122);
     }
     return pid;
 }
