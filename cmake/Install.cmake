@@ -43,5 +43,11 @@ install(FILES ${PROJECT_BINARY_DIR}/atonlabConfig.cmake ${PROJECT_BINARY_DIR}/at
 # the file stays right wherever the prefix is moved.
 file(RELATIVE_PATH atonlab_pc_to_prefix /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
 string(REGEX REPLACE "/$" "" atonlab_pc_to_prefix "${atonlab_pc_to_prefix}")
+# Libraries built with the sanitizers (ATONLAB_SANITIZE) call into their
+# runtimes: a consumer must link them too, so the .pc file says so.
+set(atonlab_pc_sanitize_libs "")
+if(ATONLAB_SANITIZE)
+  set(atonlab_pc_sanitize_libs " -fsanitize=address,undefined")
+endif()
 configure_file(${PROJECT_SOURCE_DIR}/cmake/atonlab.pc.in ${PROJECT_BINARY_DIR}/atonlab.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/atonlab.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT development)
