@@ -71,16 +71,6 @@ std::vector<SimulatorFrame> run_simulator_sequence(const SimulatorSequence& q, b
 
 namespace {
 
-/// The p-th percentile (0–100) by linear interpolation between order statistics.
-double percentile(std::vector<double> v, double p) {
-    if (v.empty()) return kNaN;
-    std::sort(v.begin(), v.end());
-    const double x = p / 100.0 * static_cast<double>(v.size() - 1);
-    const auto i = static_cast<std::size_t>(x);
-    const double w = x - static_cast<double>(i);
-    return i + 1 < v.size() ? v[i] * (1 - w) + v[i + 1] * w : v[i];
-}
-
 template <class F>
 std::vector<double> column(const std::vector<SimulatorFrame>& frames, std::size_t first, F f) {
     std::vector<double> v;
@@ -131,15 +121,16 @@ void bench_simulator_frames(Bench& b) {
             return fmt::format("{:.2f} / {:.0f}", mean(v), v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()));
         };
         const double prepare =
-            percentile(column(frames, first, [](const auto& f) { return f.timings.glare_prepare_cpu_ms; }), 50);
-        const double veil = percentile(column(frames, first, [](const auto& f) { return f.timings.veil_cpu_ms; }), 50);
+            quantile_of(column(frames, first, [](const auto& f) { return f.timings.glare_prepare_cpu_ms; }), 0.50);
+        const double veil =
+            quantile_of(column(frames, first, [](const auto& f) { return f.timings.veil_cpu_ms; }), 0.50);
         const double gpu_ms =
-            gpu ? percentile(column(frames, first, [](const auto& f) { return f.timings.gpu_ms(); }), 50) : kNaN;
+            gpu ? quantile_of(column(frames, first, [](const auto& f) { return f.timings.gpu_ms(); }), 0.50) : kNaN;
         int builds = 0;
         for (const SimulatorFrame& f : frames) builds += f.psf_builds;
         const std::string name(glare_model_type(model).name());
         md << fmt::format("| `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", name,
-                          fmt_ms(percentile(wall, 50)), fmt_ms(percentile(wall, 99)),
+                          fmt_ms(quantile_of(wall, 0.50)), fmt_ms(quantile_of(wall, 0.99)),
                           fmt_ms(wall.empty() ? kNaN : *std::max_element(wall.begin(), wall.end())), fmt_ms(prepare),
                           fmt_ms(veil), fmt_ms(gpu_ms), per_frame([](const auto& f) { return f.psf_builds; }),
                           per_frame([](const auto& f) { return f.interpolations; }),
@@ -157,7 +148,8 @@ void bench_simulator_frames(Bench& b) {
         // so. The moving pupil's kernel error is the moving_pupil bench's.
         r.error = 0.0;
         r.metric = "none (0): frame times of the default pipeline (simulator_frames.md); kernel error in moving_pupil";
-        r.note = fmt::format("p99 {} ms, max {} ms over {} frames; {} PSF builds in all", fmt_ms(percentile(wall, 99)),
+        r.note = fmt::format("p99 {} ms, max {} ms over {} frames; {} PSF builds in all",
+                             fmt_ms(quantile_of(wall, 0.99)),
                              fmt_ms(r.time.wall.max), wall.size(), builds);
         b.add(r);
     }

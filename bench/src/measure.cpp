@@ -5,27 +5,40 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "atonlab/stimuli/gl/objects.h"
 
 namespace atonlab::bench {
+
+namespace {
+
+/// The p-quantile (0 … 1) of sorted values, interpolated linearly between order statistics.
+double quantile_sorted(const std::vector<double>& v, double p) {
+    const double h = p * static_cast<double>(v.size() - 1);
+    const auto lo = static_cast<std::size_t>(std::floor(h));
+    const std::size_t hi = std::min(lo + 1, v.size() - 1);
+    return v[lo] + (h - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+}  // namespace
+
+double quantile_of(std::vector<double> v, double p) {
+    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::sort(v.begin(), v.end());
+    return quantile_sorted(v, p);
+}
 
 Stats stats_of(std::vector<double> v) {
     Stats s;
     s.n = static_cast<int>(v.size());
     if (v.empty()) return s;
     std::sort(v.begin(), v.end());
-    auto quantile = [&v](double p) {
-        const double h = p * static_cast<double>(v.size() - 1);
-        const auto lo = static_cast<std::size_t>(std::floor(h));
-        const std::size_t hi = std::min(lo + 1, v.size() - 1);
-        return v[lo] + (h - static_cast<double>(lo)) * (v[hi] - v[lo]);
-    };
     s.min = v.front();
     s.max = v.back();
-    s.median = quantile(0.5);
-    s.q1 = quantile(0.25);
-    s.q3 = quantile(0.75);
+    s.median = quantile_sorted(v, 0.5);
+    s.q1 = quantile_sorted(v, 0.25);
+    s.q3 = quantile_sorted(v, 0.75);
     return s;
 }
 

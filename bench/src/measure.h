@@ -14,6 +14,8 @@ struct Stats {
 };
 /// Quartiles by linear interpolation between order statistics (type 7).
 Stats stats_of(std::vector<double> values);
+/// The p-quantile (0 … 1) of the values, interpolated linearly between order statistics; NaN for none.
+double quantile_of(std::vector<double> values, double p);
 
 struct Timing {
     Stats wall;             ///< ms, steady clock, glFinish before and after
