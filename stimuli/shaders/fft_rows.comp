@@ -6,10 +6,14 @@
 //   X[k] = Σ_x x[n] e^{-2πi k·x/N}  (forward, unnormalised, origin at index 0)
 //
 // Defines (prepended by GpuFft):
-//   FFT_N        line length, a power of two as a uint literal (16u ... 2048u)
+//   FFT_N        line length, a power of two as a uint literal (16u ... 2048u;
+//                up to 4096u for the veil where shared memory allows)
 //   FFT_LOG2N    log2(FFT_N) as a uint literal
 //   FFT_THREADS  workgroup size; a divisor of FFT_N / 2
-//   FFT_COLUMNS  transform columns (stride FFT_N) instead of rows (stride 1)
+//   FFT_COLUMNS  transform columns (stride FFT_PITCH) instead of rows (stride 1)
+//   FFT_PITCH    the image's row length as a uint literal (default FFT_N; a
+//                rectangular image, veil_gpu.cpp, transforms its columns of
+//                length FFT_N = its height with the pitch of its width)
 //   FFT_TWIDDLE_TABLE   twiddles from binding 1, W_N^k for k < N/2, computed in
 //                       double on the CPU and rounded once to float
 //   FFT_TWIDDLE_SINCOS  twiddles from fp32 cos()/sin() here (driver accuracy)
@@ -18,6 +22,10 @@ layout(local_size_x = FFT_THREADS) in;
 layout(std430, binding = 0) buffer Data { vec2 data[]; };  // (re, im), row-major
 #ifdef FFT_TWIDDLE_TABLE
 layout(std430, binding = 1) readonly buffer Twiddles { vec2 twiddles[]; };
+#endif
+
+#ifndef FFT_PITCH
+#define FFT_PITCH FFT_N
 #endif
 
 shared vec2 line_values[FFT_N];
@@ -39,9 +47,9 @@ void main() {
     const uint tid = gl_LocalInvocationID.x;
 #ifdef FFT_COLUMNS
     const uint base = gl_WorkGroupID.x;
-    const uint stride = FFT_N;
+    const uint stride = FFT_PITCH;
 #else
-    const uint base = gl_WorkGroupID.x * FFT_N;
+    const uint base = gl_WorkGroupID.x * FFT_PITCH;
     const uint stride = 1u;
 #endif
 

@@ -18,19 +18,6 @@ constexpr int kMaxSpectralSamples = 128;  // psf_spectral.comp MAX_SAMPLES
 unsigned groups_for(std::size_t count) {
     return static_cast<unsigned>((count + 255) / 256);
 }
-
-// The same rule as gl::ContextInfo::software, for the current context.
-bool software_renderer() {
-    const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const std::string renderer = r ? r : "";
-    return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
-           renderer.find("swrast") != std::string::npos;
-}
-
-PsfFftPlacement resolve(PsfFftPlacement p) {
-    if (p != PsfFftPlacement::automatic) return p;
-    return software_renderer() ? PsfFftPlacement::cpu : PsfFftPlacement::gpu;
-}
 }  // namespace
 
 struct GpuPsfGenerator::Impl {
@@ -49,7 +36,7 @@ struct GpuPsfGenerator::Impl {
     PsfGpuTimings last;
     double degrees_per_texel = 0;
 
-    Impl(int size, TwiddleSource twiddles, PsfFftPlacement where) : n(size), placement(resolve(where)) {
+    Impl(int size, TwiddleSource twiddles, PsfFftPlacement where) : n(size), placement(resolve_placement(where)) {
         if (placement == PsfFftPlacement::gpu)
             fft.emplace(size, twiddles);
         else if (!is_power_of_two(n) || n < kGpuFftMinSize || n > kGpuFftMaxSize)  // the GPU path's sizes either way

@@ -8,6 +8,7 @@
 
 #include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/psf.h"
 
 namespace atonlab::stimuli {
@@ -19,16 +20,13 @@ struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
 };
 
-/// Where the generator's FFT runs. The pupil plane is drawn on the CPU anyway,
-/// so transforming it there (FFTW double, rounded once to float) and uploading
-/// the spectrum replaces the compute-shader FFT: far cheaper where the "GPU" is
-/// the CPU (a software rasteriser; `atonlab bench`, fft_n512 on llvmpipe: 18 ms
-/// against 190 ms, and exact), far dearer than a real GPU's.
-enum class PsfFftPlacement {
-    automatic,  ///< the CPU on a software rasteriser (llvmpipe, softpipe, swrast), else the GPU
-    gpu,        ///< fp32 compute shaders (GpuFft)
-    cpu,        ///< FFTW double, rounded to float, then upload
-};
+/// Where the generator's FFT runs (placement.h). The pupil plane is drawn on
+/// the CPU anyway, so transforming it there (FFTW double, rounded once to
+/// float) and uploading the spectrum replaces the compute-shader FFT: far
+/// cheaper where the "GPU" is the CPU (a software rasteriser; `atonlab bench`,
+/// fft_n512 on llvmpipe: 18 ms against 190 ms, and exact), far dearer than a
+/// real GPU's. automatic: the CPU on a software rasteriser, else the GPU.
+using PsfFftPlacement = ComputePlacement;
 
 class GpuPsfGenerator {
 public:

@@ -19,9 +19,12 @@
 // image plane are stretched by about 1/cos²15° = 7% radially).
 #include <glm/glm.hpp>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "atonlab/stimuli/cie_glare.h"
+#include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/placement.h"
 
 namespace atonlab::stimuli {
 
@@ -46,6 +49,7 @@ struct VeilReport {
     CieObserver observer;
     glm::dvec3 outside_frame{0.0};  ///< per channel: energy fraction the GSF carried outside the frame
     double cpu_ms = 0;              ///< read-back, convolution (kernel build included) and upload
+    ComputePlacement placement = ComputePlacement::cpu;  ///< where the convolution ran (gpu or cpu)
 };
 
 /// How apply() convolves (issue 27 item 3). Both are the same linear
@@ -85,6 +89,46 @@ public:
     int kernel_builds() const;
     /// The method the last apply() used (direct or fft; automatic before any).
     VeilMethod last_method() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The same linear convolution as compute shaders in fp32 (issue 27 item 1;
+/// shaders/veil_gpu.comp): the kernel split at the square |dx|, |dy| ≤
+/// kNearRadiusPx into a near part summed directly and a far part convolved by
+/// the GPU FFT (zero-padded to powers of two ≥ 2W − 1 and 2H − 1), so that the
+/// fp32 FFT's rounding is relative to the far part only. Held on llvmpipe to
+/// the double-precision CPU path (GL.VeilGpu.*: 1e-4 at 1°, 2°, 5°, 10°, 15°).
+/// The outside fraction is Σ e·S / Σ e, S the share of a light at each pixel
+/// that the frame keeps (from the kernel in double, once per build). Needs a
+/// current GL 4.5 context for its whole life.
+class GpuVeilingGlare {
+public:
+    /// The near window's half-width (px): (2R + 1)² taps per pixel.
+    static constexpr int kNearRadiusPx = 8;
+
+    GpuVeilingGlare();
+    ~GpuVeilingGlare();
+    GpuVeilingGlare(const GpuVeilingGlare&) = delete;
+    GpuVeilingGlare& operator=(const GpuVeilingGlare&) = delete;
+
+    /// Why a width × height frame cannot be convolved on this context's GPU
+    /// (its transform lengths exceed what a workgroup's shared memory holds);
+    /// empty when it can.
+    static std::string unsupported_reason(int width, int height);
+
+    /// Convolves `light` (RGBA32F, cd/m²) with the observer's GSF; the result
+    /// replaces light's rgb (add_to == nullptr; alpha kept) or is added × scale
+    /// to add_to's rgb (RGBA32F or RGBA16F, light's size). Returns the outside
+    /// fractions as VeilingGlare::apply. The kernel is cached for the last
+    /// (size, focal length, observer). Throws InputError for a bad observer,
+    /// std::runtime_error for an unsupported size (unsupported_reason()).
+    glm::dvec3 apply(gl::Texture2D& light, gl::Texture2D* add_to, double scale, double focal_px,
+                     const CieObserver& observer);
+
+    int kernel_builds() const;
 
 private:
     struct Impl;

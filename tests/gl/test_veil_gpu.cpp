@@ -1,0 +1,167 @@
+// The `cie` veil on the GPU (issue 27 item 1; veiling_glare.h,
+// GpuVeilingGlare): held on this driver (llvmpipe in CI) to the
+// double-precision CPU path, pixel by pixel, at the angles the CIE equation is
+// checked at on the CPU, in its energy and in the outside fractions it
+// reports; the HDR-adding form and the half-float target too.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "atonlab/stimuli/cie_glare.h"
+#include "atonlab/stimuli/cpu_threads.h"
+#include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/veiling_glare.h"
+#include "gl_test_support.h"
+
+namespace atonlab::test {
+namespace {
+
+using namespace atonlab::stimuli;
+using VeilGpu = GLTest;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A 421×221 frame at 12 px per degree (±17.5° × ±9.2°): 15° fits on the centre row.
+struct Frame {
+    int w = 421, h = 221;
+    double f = 12.0 / kDeg;
+    std::vector<float> rgba;
+    Frame() : rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4, 0.0f) {}
+    float& at(int i, int j, int c) {
+        return rgba[(static_cast<std::size_t>(j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(i)) * 4 +
+                    static_cast<std::size_t>(c)];
+    }
+    void add_light(int i, int j, double e_lux, const double (&colour)[3]) {
+        const double omega = frame_pixel_solid_angle_sr(i, j, w, h, f);
+        for (int c = 0; c < 3; ++c) at(i, j, c) += static_cast<float>(e_lux * colour[c] / omega);
+    }
+};
+
+/// The GPU veil of `in` (replacing its rgb), downloaded; `outside` its report.
+std::vector<float> gpu_veil(const Frame& in, GpuVeilingGlare& veil, glm::dvec3& outside, const CieObserver& obs) {
+    gl::Texture2D t(in.w, in.h, gl::PixelFormat::rgba32f);
+    t.upload(in.rgba.data());
+    outside = veil.apply(t, nullptr, 1.0, in.f, obs);
+    return t.download_floats();
+}
+
+TEST_F(VeilGpu, OnePixelLightMatchesTheDoublePrecisionReferenceFromOneToFifteenDegrees) {
+    Frame fr;
+    const int ci = fr.w / 2, cj = fr.h / 2;
+    fr.add_light(ci, cj, 2.0, {1.0, 1.0, 1.0});
+    const CieObserver obs{25, 0.5};
+    Frame cpu = fr;
+    VeilingGlare reference;
+    const glm::dvec3 out_cpu = reference.apply(cpu.rgba, cpu.w, cpu.h, cpu.f, obs, VeilMethod::direct);
+    GpuVeilingGlare veil;
+    glm::dvec3 out_gpu;
+    const std::vector<float> gpu = gpu_veil(fr, veil, out_gpu, obs);
+    for (int degrees : {1, 2, 5, 10, 15}) {
+        const int dx = static_cast<int>(std::lround(fr.f * std::tan(degrees * kDeg)));
+        for (int c = 0; c < 3; ++c) {
+            const double want = cpu.at(ci + dx, cj, c);
+            const double got = gpu[(static_cast<std::size_t>(cj) * fr.w + static_cast<std::size_t>(ci + dx)) * 4 +
+                                   static_cast<std::size_t>(c)];
+            EXPECT_NEAR(got / want, 1.0, 1e-4) << degrees << "°, channel " << c;
+            if (c == 1) std::printf("%2d° (%3d px): GPU / CPU double = 1 %+.2e\n", degrees, dx, got / want - 1.0);
+        }
+    }
+    // Every pixel of the frame: relative to itself, with a floor of 1e-9 of the
+    // light's pixel (the veil at the frame's far corner is ≈ 3e-7 of it).
+    const double peak = cpu.at(ci, cj, 1);
+    double worst = 0;
+    int worst_i = 0, worst_j = 0;
+    for (std::size_t p = 0; p < gpu.size(); ++p) {
+        if (p % 4 == 3) continue;
+        const double d = std::abs(gpu[p] - static_cast<double>(cpu.rgba[p])) /
+                         (std::abs(static_cast<double>(cpu.rgba[p])) + 1e-9 * peak);
+        if (d > worst) {
+            worst = d;
+            worst_i = static_cast<int>(p / 4 % static_cast<std::size_t>(fr.w));
+            worst_j = static_cast<int>(p / 4 / static_cast<std::size_t>(fr.w));
+        }
+    }
+    std::printf("worst pixel: %.2e relative at (%d, %d); outside fraction CPU %.8f GPU %.8f\n", worst, worst_i, worst_j,
+                out_cpu.g, out_gpu.g);
+    EXPECT_LT(worst, 1e-4);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out_gpu[c], out_cpu[c], 1e-6) << "channel " << c;
+    EXPECT_EQ(veil.kernel_builds(), 1);
+}
+
+TEST_F(VeilGpu, ManyColouredLightsMatchTheCpuFftPixelByPixelAndKeepTheirEnergy) {
+    // 60 lights of different colours and illuminances, some near the edges and
+    // corners (their veil leaves the frame), blue absent in a third of them.
+    Frame fr;
+    for (int k = 0; k < 60; ++k) {
+        const int i = k == 0 ? 0 : (37 * k + 11) % fr.w, j = k == 0 ? fr.h - 1 : (53 * k + 7) % fr.h;
+        fr.add_light(i, j, 0.5 + 0.25 * (k % 7), {1.0, 0.3 + 0.1 * (k % 5), k % 3 == 0 ? 0.0 : 0.7});
+    }
+    const CieObserver obs{62, 1.0};
+    Frame cpu = fr;
+    VeilingGlare reference;
+    const glm::dvec3 out_cpu = reference.apply(cpu.rgba, cpu.w, cpu.h, cpu.f, obs, VeilMethod::fft);
+    GpuVeilingGlare veil;
+    glm::dvec3 out_gpu;
+    const std::vector<float> gpu = gpu_veil(fr, veil, out_gpu, obs);
+    float peak = 0;
+    for (float v : cpu.rgba) peak = std::max(peak, v);
+    double worst = 0, energy_cpu = 0, energy_gpu = 0;
+    for (int j = 0; j < fr.h; ++j)
+        for (int i = 0; i < fr.w; ++i) {
+            const double omega = frame_pixel_solid_angle_sr(i, j, fr.w, fr.h, fr.f);
+            for (int c = 0; c < 3; ++c) {
+                const std::size_t p = (static_cast<std::size_t>(j) * fr.w + static_cast<std::size_t>(i)) * 4 +
+                                      static_cast<std::size_t>(c);
+                worst = std::max(worst, std::abs(gpu[p] - static_cast<double>(cpu.rgba[p])) /
+                                            (std::abs(static_cast<double>(cpu.rgba[p])) + 1e-9 * peak));
+                energy_cpu += cpu.rgba[p] * omega;
+                energy_gpu += gpu[p] * omega;
+            }
+        }
+    std::printf("60 lights: worst pixel %.2e relative, energy GPU / CPU = 1 %+.2e\n", worst,
+                energy_gpu / energy_cpu - 1.0);
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_NEAR(energy_gpu / energy_cpu, 1.0, 1e-6);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out_gpu[c], out_cpu[c], 1e-6) << "channel " << c;
+}
+
+TEST_F(VeilGpu, AddsToAnHdrTargetOfEitherFormatRunsNoCpuFftAfterItsBuildAndRefusesOtherTextures) {
+    Frame fr;
+    fr.add_light(100, 60, 1.0, {1.0, 0.2, 0.05});  // a red light
+    const CieObserver obs{25, 0.0};
+    GpuVeilingGlare veil;
+    glm::dvec3 outside;
+    const std::vector<float> alone = gpu_veil(fr, veil, outside, obs);
+    std::vector<float> base(fr.rgba.size());
+    for (std::size_t p = 0; p < base.size(); ++p) base[p] = 0.01f * static_cast<float>(p % 4 + 1);  // a dim sky
+    for (gl::PixelFormat format : {gl::PixelFormat::rgba32f, gl::PixelFormat::rgba16f}) {
+        gl::Texture2D light(fr.w, fr.h, gl::PixelFormat::rgba32f), hdr(fr.w, fr.h, format);
+        light.upload(fr.rgba.data());
+        hdr.upload(base.data());
+        const auto ffts = cpu_fft_count();
+        // A pre-exposure: 2 in fp32; half floats end at 65504, and the light's own pixel is 5e5 cd/m².
+        const double scale = format == gl::PixelFormat::rgba16f ? 0.01 : 2.0;
+        veil.apply(light, &hdr, scale, fr.f, obs);
+        EXPECT_EQ(cpu_fft_count(), ffts) << "no CPU transform once the kernel is built";
+        const std::vector<float> got = hdr.download_floats();
+        // Half floats: 11 significant bits, and a driver may convert toward zero: two units in the last place.
+        const double tolerance = format == gl::PixelFormat::rgba16f ? 2.0 / 1024 : 1e-6;
+        for (std::size_t p = 0; p < got.size(); ++p) {
+            const double want = p % 4 == 3 ? base[p] : base[p] + scale * alone[p];
+            ASSERT_NEAR(got[p], want, tolerance * std::abs(want) + 1e-30) << p;
+        }
+    }
+    EXPECT_EQ(veil.kernel_builds(), 1);
+    gl::Texture2D small(8, 8, gl::PixelFormat::rgba16f);
+    EXPECT_THROW(veil.apply(small, nullptr, 1.0, fr.f, obs), std::invalid_argument);
+    EXPECT_TRUE(GpuVeilingGlare::unsupported_reason(1920, 1080).empty() ||
+                GpuVeilingGlare::unsupported_reason(1920, 1080).find("4096") != std::string::npos);
+    EXPECT_NE(GpuVeilingGlare::unsupported_reason(5000, 100), "");
+}
+
+}  // namespace
+}  // namespace atonlab::test
