@@ -59,10 +59,10 @@ RenderedFrame render_frame(stimuli::Pipeline& pipeline, const stimuli::Scene& sc
     for (const auto& g : renderer.glare().report()) {
         const std::string line = fmt::format(
             "spd={} pupil_mm={:.3f} kernel_px={} radius_deg={:.3f} window={} window_cut_rgb=[{:.4f}, {:.4f}, {:.4f}] "
-            "area_layers={} area_max_radius_px={:.1f}",
+            "area_layers={} area_max_radius_px={:.1f} psf_fft={}",
             g.spd.empty() ? "d65" : g.spd, g.pupil_mm, g.kernel_size_px, g.radius_deg,
             stimuli::glare_window_name(scene.glare.window), g.window_cut.r, g.window_cut.g, g.window_cut.b,
-            g.area_layers, g.area_max_radius_px);
+            g.area_layers, g.area_max_radius_px, g.psf_fft ? stimuli::placement_name(*g.psf_fft) : "none");
         const std::string spd = g.spd.empty() ? "d65" : g.spd;
         meta.strings[g.model == scene.glare.model
                          ? fmt::format("glare_{}", spd)
@@ -72,9 +72,10 @@ RenderedFrame render_frame(stimuli::Pipeline& pipeline, const stimuli::Scene& sc
     if (const stimuli::VeilReport& v = renderer.veil_report(); v.applied) {
         // The `cie` model: what the frame-sized convolution carried beyond the frame.
         const std::string line = fmt::format(
-            "cie_age_years={} cie_pigmentation={} outside_frame_rgb=[{:.4f}, {:.4f}, {:.4f}] convolution_ms={:.0f}",
+            "cie_age_years={} cie_pigmentation={} outside_frame_rgb=[{:.4f}, {:.4f}, {:.4f}] convolution_ms={:.0f} "
+            "placement={}",
             v.observer.age_years, v.observer.pigmentation, v.outside_frame.r, v.outside_frame.g, v.outside_frame.b,
-            v.cpu_ms);
+            v.cpu_ms, stimuli::placement_name(v.placement));
         const std::string_view cie = stimuli::glare_model_name(stimuli::GlareModel::cie);
         meta.strings[fmt::format("glare_{}", cie)] = line;
         glare_note += fmt::format("  glare ({}): {}\n", cie, line);

@@ -1,6 +1,7 @@
 #include "atonlab/stimuli/frame_renderer.h"
 
 #include <epoxy/gl.h>
+#include <fmt/format.h>
 
 #include <array>
 #include <bit>
@@ -15,6 +16,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/disc.h"
 #include "atonlab/stimuli/display_threshold.h"
 #include "atonlab/stimuli/footprint.h"
@@ -100,6 +102,7 @@ struct FrameRenderer::Impl {
     int light_count = 0;
     GlareStage glare;
     VeilingGlare veil;
+    GpuVeilingGlare gpu_veil;
     VeilReport veil_report;
     FrameOptions options;
     double pre_exposure = 1.0;
@@ -274,15 +277,41 @@ void FrameRenderer::Impl::upload_light_tables(const Scene& scene, const GpuLight
     draws.bind_storage(3);
 }
 
+namespace {
+
+// The GPU where the placement says so and this GPU's workgroups hold the
+// frame's transform lengths; a forced GPU placement that cannot is an error.
+ComputePlacement veil_placement(const Scene& scene, int width, int height) {
+    const ComputePlacement where = resolve_placement(scene.glare.placement);
+    if (where != ComputePlacement::gpu) return where;
+    const std::string why = GpuVeilingGlare::unsupported_reason(width, height);
+    if (why.empty()) return where;
+    if (scene.glare.placement == ComputePlacement::gpu)
+        throw InputError(SourceLocation{"", 0, 0, "placement"},
+                         fmt::format("placement = \"gpu\": the `cie` veil cannot run on this GPU: {}; use "
+                                     "\"automatic\" or \"cpu\".",
+                                     why));
+    return ComputePlacement::cpu;
+}
+
+}  // namespace
+
 // The `cie` veil: the veil lights' direct images (already drawn into the glare
 // buffer, cd/m²) convolved with the CIE GSF; the result is the glare buffer
 // of the LDR path, or is added to the HDR frame.
 void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjection& P, bool ldr) {
     const auto pre = static_cast<float>(pre_exposure);
-    std::vector<float> light = glare_only.download_floats();
-    veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
+    const ComputePlacement where = veil_placement(scene, P.width_px, P.height_px);
+    veil_report.placement = where;
     veil_report.applied = true;
     veil_report.observer = scene.glare.cie;
+    if (where == ComputePlacement::gpu) {
+        veil_report.outside_frame =
+            gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure, P.focal_px, scene.glare.cie);
+        return;
+    }
+    std::vector<float> light = glare_only.download_floats();
+    veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
     if (ldr) {
         glare_only.upload(light.data());
     } else {
@@ -291,6 +320,24 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
             if (i % 4 != 3) frame[i] += light[i] * pre;
         hdr.upload(frame.data());
     }
+}
+
+
+FramePlacements frame_placements(const Scene& scene, int width, int height) {
+    FramePlacements out;
+    for (const Light& l : scene.lights) {
+        const GlareModel model = light_glare_model(scene, l);
+        if (model == GlareModel::cie && !out.veil) out.veil = veil_placement(scene, width, height);
+        GlareSettings g = scene.glare;
+        g.model = model;
+        if (auto p = glare_model_type(model).psf_fft_placement(g))
+            out.psf_fft = out.psf_fft == ComputePlacement::cpu ? ComputePlacement::cpu : *p;
+    }
+    return out;
+}
+
+std::string_view placement_name(const std::optional<ComputePlacement>& p) {
+    return p ? placement_name(*p) : "none";
 }
 
 FrameRenderer::FrameRenderer() : impl_(std::make_unique<Impl>()) {}

@@ -125,8 +125,12 @@ struct GlareStage::Impl {
     unsigned envelope_stride = 0;
     GlareBuildCounts counts;
 
+    ComputePlacement placement = ComputePlacement::automatic;  // the scene's [glare] placement, this frame
+
     GpuPsfGenerator& generator_for(int n) {
-        if (!generator || generator->size() != n) generator = std::make_unique<GpuPsfGenerator>(n);
+        if (!generator || generator->size() != n ||
+            generator->fft_placement() != resolve_placement(placement))
+            generator = std::make_unique<GpuPsfGenerator>(n, TwiddleSource::table_from_double, placement);
         return *generator;
     }
 
@@ -142,6 +146,7 @@ struct GlareStage::Impl {
         g.report.pupil_mm = pupil_mm;
         GlareModelKernel k = glare_model_type(g.model).billboard_kernel(
             {gs, scene, samples, ppd, pupil_mm, time_s, [this](int n) -> GpuPsfGenerator& { return generator_for(n); }});
+        if (k.psf) g.report.psf_fft = glare_model_type(g.model).psf_fft_placement(gs);
         g.psf = std::move(k.psf);
         g.kernel = std::move(k.kernel);
         const double radius = k.radius_deg;
@@ -276,6 +281,7 @@ const GlareKernel* GlareStage::kernel(std::size_t group) const {
 double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double time_s) {
     Impl& m = *impl_;
     const GlareSettings& gs = scene.glare;
+    m.placement = gs.placement;
     m.order.clear();
     m.reports.clear();
     m.light_groups.assign(scene.lights.size(), 0u);

@@ -69,7 +69,7 @@ inline constexpr std::string_view kTonemapKeys[] = {
     "ldr_glare"};
 /// The [glare] keys every model shares (the glare stage's); glare_keys() adds each model's own.
 inline constexpr std::string_view kSharedGlareKeys[] = {"psf_size", "spectral_samples", "window", "radius_deg",
-                                                        "area_layers"};
+                                                        "area_layers", "placement"};
 /// The keys [eye] and [glare] take: their own, then each glare model's in the registry's order.
 KeyList eye_keys();
 KeyList glare_keys();

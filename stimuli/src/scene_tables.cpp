@@ -186,6 +186,13 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
         g.radius_deg = *r;
     }
     g.area_layers = s.integer("area_layers", 2, 256).value_or(g.area_layers);
+    if (auto p = s.string("placement")) {
+        if (auto v = placement_from_name(*p))
+            g.placement = *v;
+        else
+            s.fail(s.get("placement"), "placement",
+                   fmt::format("unknown placement \"{}\"; it must be \"automatic\", \"gpu\" or \"cpu\".", text::echo(*p)));
+    }
     // Each model's own keys (glare_models/): every model's, whichever the scene uses, since a light may pick its own.
     for (const GlareModelType* m : glare_models()) m->read_glare_keys(doc, s, g, pupil_mm);
 }

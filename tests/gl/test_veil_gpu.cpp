@@ -13,6 +13,7 @@
 
 #include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/cpu_threads.h"
+#include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/objects.h"
 #include "atonlab/stimuli/veiling_glare.h"
 #include "gl_test_support.h"
@@ -161,6 +162,74 @@ TEST_F(VeilGpu, AddsToAnHdrTargetOfEitherFormatRunsNoCpuFftAfterItsBuildAndRefus
     EXPECT_TRUE(GpuVeilingGlare::unsupported_reason(1920, 1080).empty() ||
                 GpuVeilingGlare::unsupported_reason(1920, 1080).find("4096") != std::string::npos);
     EXPECT_NE(GpuVeilingGlare::unsupported_reason(5000, 100), "");
+}
+
+// A red and a green light (IALA-like linear RGB per cd) over a dim night sky,
+// rendered through the frame renderer with the veil forced onto the GPU and
+// onto the CPU: the same frame, the GPU's recorded as such; automatic picks the
+// CPU on a software rasteriser and the GPU elsewhere.
+Scene night_scene(ComputePlacement placement) {
+    Scene s;
+    s.display = {256, 144, 0.5, 0.9};
+    s.environment.background = Background::uniform;
+    s.environment.luminance_cd_m2 = 0.001;  // a night sky
+    s.adaptation_cd_m2 = 0.01;
+    s.glare.model = GlareModel::cie;
+    s.glare.cie = {40, 0.5};
+    s.glare.placement = placement;
+    Light red, green;
+    red.position_m = {-40.0, 2.0, -1000.0};
+    red.intensity_cd = 200.0;
+    red.rgb_per_cd = {1.0 / 0.2126, 0.0, 0.0};  // pure Rec.709 red, Y = 1
+    green.position_m = {60.0, -5.0, -1500.0};
+    green.intensity_cd = 300.0;
+    green.rgb_per_cd = {0.0, 1.0 / 0.7152, 0.0};
+    s.lights = {red, green};
+    return s;
+}
+
+TEST_F(VeilGpu, ANightFrameOfARedAndAGreenLightIsTheSameFrameOnTheGpuAndTheCpu) {
+    FrameRenderer gpu_renderer, cpu_renderer, auto_renderer;
+    gpu_renderer.render(night_scene(ComputePlacement::gpu), 0.0);
+    cpu_renderer.render(night_scene(ComputePlacement::cpu), 0.0);
+    auto_renderer.render(night_scene(ComputePlacement::automatic), 0.0);
+    EXPECT_EQ(gpu_renderer.veil_report().placement, ComputePlacement::gpu);
+    EXPECT_EQ(cpu_renderer.veil_report().placement, ComputePlacement::cpu);
+    EXPECT_EQ(auto_renderer.veil_report().placement, software_renderer() ? ComputePlacement::cpu : ComputePlacement::gpu);
+    const Scene scene = night_scene(ComputePlacement::gpu);
+    const FramePlacements where = frame_placements(scene, scene.display.width_px, scene.display.height_px);
+    EXPECT_EQ(where.veil, ComputePlacement::gpu);
+    EXPECT_FALSE(where.psf_fft.has_value());  // `cie` has no PSF
+    const ImageRGBA32F a = gpu_renderer.read_hdr(), b = cpu_renderer.read_hdr();
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(gpu_renderer.veil_report().outside_frame[c], cpu_renderer.veil_report().outside_frame[c], 1e-6);
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    double worst = 0, red_veil = 0, green_in_red = 0;
+    for (std::size_t p = 0; p < a.rgba.size(); ++p) {
+        if (p % 4 == 3) continue;
+        // The sky (0.001 cd/m²) is in both: relative to the pixel itself.
+        worst = std::max(worst, std::abs(a.rgba[p] - static_cast<double>(b.rgba[p])) / std::abs(b.rgba[p]));
+    }
+    // The red light's veil stays red: alone in the frame, a pixel 2° to its
+    // right holds red light far above the sky and green and blue at the sky's.
+    Scene red_only = night_scene(ComputePlacement::gpu);
+    red_only.lights.pop_back();
+    gpu_renderer.render(red_only, 0.0);
+    const ImageRGBA32F r = gpu_renderer.read_hdr();
+    const CameraProjection& P = gpu_renderer.projection();
+    const double f = P.focal_px;
+    const int ri = static_cast<int>(std::lround(P.width_px / 2.0 - 40.0 / 1000.0 * f + 2.0 * kDeg * f));
+    const int rj = static_cast<int>(std::lround(P.height_px / 2.0 - 2.0 / 1000.0 * f));
+    const float* px = r.pixel(ri, rj);
+    const float* sky = r.pixel(P.width_px - 1, 0);
+    red_veil = px[0] - sky[0];
+    green_in_red = std::max(std::abs(px[1] - sky[1]), std::abs(px[2] - sky[2]));
+    std::printf("GPU vs CPU frame: worst %.2e relative; 2° right of the red light alone: red veil %.3g cd/m², "
+                "green or blue beyond the sky %.3g\n",
+                worst, red_veil, green_in_red);
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_GT(red_veil, 0.01 * sky[0]);
+    EXPECT_LT(green_in_red, 1e-4 * red_veil);
 }
 
 }  // namespace

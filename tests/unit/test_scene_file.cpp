@@ -426,6 +426,12 @@ TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
     EXPECT_EQ(scene.glare.psf_size, 256);
     EXPECT_EQ(scene.glare.radius_deg, 2.5);
     EXPECT_EQ(scene.glare.spencer_vision, SpencerVision::mesopic);
+    EXPECT_EQ(scene.glare.placement, ComputePlacement::automatic);  // not given
+    for (auto [name, want] : {std::pair{"gpu", ComputePlacement::gpu}, std::pair{"cpu", ComputePlacement::cpu},
+                              std::pair{"automatic", ComputePlacement::automatic}})
+        EXPECT_EQ(parse_scene(std::string(kMinimal) + "[glare]\nplacement = \"" + name + "\"\n", "p.toml").glare.placement,
+                  want)
+            << name;
     EXPECT_FALSE(scene.glare.eye.gratings.enabled);
     EXPECT_FALSE(scene.glare.eye.halo_radius_deg.has_value());
     EXPECT_EQ(scene.glare.eye.seed, 7u);
@@ -541,6 +547,7 @@ TEST(SceneFileGlare, BadGlareInputNamesTheKey) {
     const std::string glare = std::string(kMinimal) + "[glare]\n";
     expect_error_at(glare + "psf_size = 300\n", 7, "glare.psf_size", "power of two");
     expect_error_at(glare + "window = \"box\"\n", 7, "glare.window", "unknown glare window");
+    expect_error_at(glare + "placement = \"tpu\"\n", 7, "glare.placement", "\"automatic\", \"gpu\" or \"cpu\"");
     expect_error_at(glare + "spencer_vision = \"owl\"\n", 7, "glare.spencer_vision", "unknown vision");
     expect_error_at(glare + "aperture_image = \"no-such-lashes.png\"\n", 7, "glare.aperture_image", "does not exist");
     expect_error_at(glare + "grating_count = -1\n", 7, "glare.grating_count", "between");

@@ -61,7 +61,8 @@ std::string view_glare(const s::Scene& sc, const std::string& light) {
 
 std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, const p::ScheduledTrial& t,
                           const std::vector<double>& frame_times, const std::optional<FramesShown>& frames_shown,
-                          const std::vector<std::string>& view_glares) {
+                          const std::vector<std::string>& view_glares,
+                          const std::vector<s::FramePlacements>& placements) {
     const p::Stimulus& stim = t.stimulus;
     Json j;
     j["task"] = std::string(p::to_string(c.task));
@@ -79,6 +80,13 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
         frame["role"] = fr.role ? std::string(p::to_string(*fr.role)) : std::string("both");
         frame["time_s"] = f < frame_times.size() ? frame_times[f] : 0.0;
         frame["overrides"] = fr.override_texts();
+        if (f < placements.size()) {
+            // Where its glare arithmetic ran (placement.h): "gpu", "cpu" or "none".
+            Json where;
+            where["veil"] = std::string(s::placement_name(placements[f].veil));
+            where["psf_fft"] = std::string(s::placement_name(placements[f].psf_fft));
+            frame["placement"] = std::move(where);
+        }
         frames.push_back(std::move(frame));
     }
     j["frames"] = std::move(frames);
@@ -134,11 +142,13 @@ st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTria
                              const SessionObserver& observer, StimulusRenderer& renderer) {
     const p::Condition& c = protocol.blocks[t.block].conditions[t.condition];
     std::vector<double> frame_times;
+    std::vector<s::FramePlacements> placements;
     std::vector<std::string> view_glares(t.stimulus.views.size());
     for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
         const auto scene = renderer.scene(t.stimulus.frames[f].overrides);
         const s::Scene& sc = *scene;
         frame_times.push_back(brightest_moment_s(sc, judged_lights(t.stimulus, f), protocol.timing.stimulus_s));
+        placements.push_back(s::frame_placements(sc, sc.display.width_px, sc.display.height_px));
         for (std::size_t v = 0; v < t.stimulus.views.size(); ++v)
             if (t.stimulus.views[v].frame == f) view_glares[v] = view_glare(sc, t.stimulus.views[v].light);
     }
@@ -149,7 +159,7 @@ st::TrialRecord trial_record(const p::Protocol& protocol, const p::ScheduledTria
     tr.procedure_id = t.procedure_id;
     tr.level = t.proposal.level;
     tr.test_on_left = t.proposal.test_on_left;
-    tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.frames, view_glares);
+    tr.stimulus_json = stimulus_json(protocol, c, t, frame_times, shown.frames, view_glares, placements);
     tr.response = counted ? std::string(p::response_word(*shown.response))
                           : std::string(shown.end == TrialEnd::timeout ? p::kTimeoutWord : p::kMissedWord);
     if (t.task == p::Task::Adjust) tr.response_value = t.stimulus.scene_value;

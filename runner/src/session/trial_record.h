@@ -10,6 +10,7 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/store/records.h"
 #include "session/session_observer.h"
@@ -23,11 +24,13 @@ namespace atonlab::runner {
 /// alternating light, whose channels are "NAME/W", ...).
 std::string view_glare(const stimuli::Scene& sc, const std::string& light);
 
-/// The stimulus column: task, level, scene, frames (role, time, overrides),
-/// views (frame, light, role, glare), timing asked for and what the flips gave.
+/// The stimulus column: task, level, scene, frames (role, time, overrides,
+/// where the glare arithmetic ran), views (frame, light, role, glare), timing
+/// asked for and what the flips gave.
 std::string stimulus_json(const protocols::Protocol& protocol, const protocols::Condition& c,
                           const protocols::ScheduledTrial& t, const std::vector<double>& frame_times,
-                          const std::optional<FramesShown>& frames_shown, const std::vector<std::string>& view_glares);
+                          const std::optional<FramesShown>& frames_shown, const std::vector<std::string>& view_glares,
+                          const std::vector<stimuli::FramePlacements>& placements);
 
 /// The procedure's state after the trial, who answered, and what: `answer` is
 /// the answer given (kept for a "missed" trial, whose response column says it

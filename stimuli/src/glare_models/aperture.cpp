@@ -108,6 +108,11 @@ public:
         return fft_glare_radius_deg(g, dpt);
     }
 
+    /// One FFT of the aperture's plane, in the glare stage's PSF generator.
+    std::optional<ComputePlacement> psf_fft_placement(const GlareSettings& g) const override {
+        return resolve_placement(g.placement);
+    }
+
     GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const override {
         const GlareSettings& gs = r.glare;
         if (!is_power_of_two(gs.psf_size))

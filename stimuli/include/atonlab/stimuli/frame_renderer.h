@@ -15,6 +15,8 @@
 // any displayed code by threshold_codes, and billboard tails below it.
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string_view>
 #include <span>
 #include <vector>
 
@@ -111,6 +113,20 @@ struct FrameTimings {
     double total_cpu_ms = 0;          ///< render() from entry to return (GPU work may still run)
     double gpu_ms() const { return background_gpu_ms + light_eval_gpu_ms + lights_draw_gpu_ms; }
 };
+
+/// Where a frame of a scene runs its glare arithmetic (placement.h), resolved
+/// for the current GL context: what FrameRenderer::render does, and what a
+/// trial records.
+struct FramePlacements {
+    std::optional<ComputePlacement> veil;     ///< the `cie` veil's convolution; nullopt: no `cie` light
+    std::optional<ComputePlacement> psf_fft;  ///< the PSF models' FFTs (cpu if any runs there); nullopt: none
+};
+/// Throws InputError (key "placement") where `placement = "gpu"` is asked for
+/// and this GPU's workgroups cannot hold the veil's transforms of a
+/// width × height frame (GpuVeilingGlare::unsupported_reason); automatic takes
+/// the CPU there.
+FramePlacements frame_placements(const Scene& scene, int width, int height);
+std::string_view placement_name(const std::optional<ComputePlacement>& p);  ///< "none" for nullopt
 
 class FrameRenderer {
 public:

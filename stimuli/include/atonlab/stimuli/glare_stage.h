@@ -5,6 +5,7 @@
 // each visible light's glare in place of its direct image. Caches everything
 // that did not change since the last frame. Needs a current GL 4.5 context.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct GlareGroupReport {
     int area_layers = 1;
     double area_max_radius_px = 0;
     double kernel_peak = 0;  ///< the kernel's largest texel value (any channel; fraction of the light's energy)
+    /// Where its PSF's FFTs ran (gpu or cpu; the two-scale eye's and the
+    /// anchored and exact spectral paths' are always the CPU's); nullopt: no
+    /// PSF (gaussian-bloom, spencer, an interpolated kernel).
+    std::optional<ComputePlacement> psf_fft;
 };
 
 /// How often the stage rebuilt what it caches (since it was made): the glare

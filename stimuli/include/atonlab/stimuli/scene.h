@@ -14,6 +14,7 @@
 #include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/display/geometry.h"
 #include "atonlab/stimuli/eye_model.h"
+#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/output_settings.h"
@@ -119,6 +120,10 @@ struct GlareSettings {
     double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
     bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
     CieObserver cie;                    ///< cie: the observer's age and ocular pigmentation
+    /// Where the `cie` veil's convolution and a one-scale PSF's FFT run
+    /// (placement.h): automatic = the GPU on a hardware driver, the CPU on a
+    /// software rasteriser.
+    ComputePlacement placement = ComputePlacement::automatic;
     /// The PSF cache's pupil step (mm), when given: the kernel is computed for
     /// the pupil diameter rounded to a multiple of this step, so a pupil that
     /// moves by less (hippus, a drifting adaptation level) reuses the cached

@@ -39,6 +39,14 @@ public:
         return pupil_diameter_mm_at(eye, time_s);
     }
 
+    /// The GPU generator's only for the `rescaled` path of a one-scale eye; the
+    /// two-scale eye's parts and the anchored and exact paths are built in
+    /// double with FFTW (docs/pipeline.md "A frame's budget").
+    std::optional<ComputePlacement> psf_fft_placement(const GlareSettings& g) const override {
+        if (g.spectral_path == SpectralPath::rescaled && !has_two_scales(g.eye)) return resolve_placement(g.placement);
+        return ComputePlacement::cpu;
+    }
+
     GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const override {
         const GlareSettings& gs = r.glare;
         EyeModel eye = gs.eye;

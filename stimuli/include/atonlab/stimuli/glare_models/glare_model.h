@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/glare_models/glare_model_list.h"
 #include "atonlab/stimuli/psf.h"
 
@@ -102,6 +103,11 @@ public:
     /// vision class its adaptation implies); empty for none. A change of it
     /// rebuilds the kernel, so a model must name only what it reads.
     virtual std::string kernel_scene_key(const Scene&) const { return {}; }
+
+    /// Where its billboard PSF's FFTs run with these settings (placement.h;
+    /// automatic resolved for the current GL context); nullopt for a model
+    /// without a PSF. The glare stage reports it and a trial records it.
+    virtual std::optional<ComputePlacement> psf_fft_placement(const GlareSettings&) const { return std::nullopt; }
 
     /// The glare stage's kernel for a billboard (path() == billboard only).
     virtual GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const;
