@@ -288,7 +288,7 @@ ComputePlacement veil_placement(const Scene& scene, int width, int height) {
     if (why.empty()) return where;
     if (scene.glare.placement == ComputePlacement::gpu)
         throw InputError(SourceLocation{"", 0, 0, "placement"},
-                         fmt::format("placement = \"gpu\": the `cie` veil cannot run on this GPU: {}; use "
+                         fmt::format("placement = \"gpu\": the whole-frame veil cannot run on this GPU: {}; use "
                                      "\"automatic\" or \"cpu\".",
                                      why));
     return ComputePlacement::cpu;

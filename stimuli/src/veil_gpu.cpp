@@ -174,7 +174,7 @@ std::string GpuVeilingGlare::unsupported_reason(int w, int h) {
 void GpuVeilingGlare::Impl::build(int w, int h, double f, const CieObserver& obs) {
     const CieGlareSpread gsf = cie_glare_spread(obs);  // validates the observer first
     if (const std::string why = unsupported_reason(w, h); !why.empty())
-        throw std::runtime_error("the `cie` veil cannot run on the GPU here: " + why);
+        throw std::runtime_error("the whole-frame veil cannot run on the GPU here: " + why);
     ready = false;
     width = w;
     height = h;

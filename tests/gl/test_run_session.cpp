@@ -205,6 +205,10 @@ TEST_F(run, TrialsAreTheSchedulesAndEachIsStoredWithItsStimulus) {
         for (const auto& frame : next->stimulus.frames)
             for (const std::string& o : frame.override_texts())
                 EXPECT_NE(t.stimulus_json.find("\"" + json_escaped(o) + "\""), std::string::npos) << o;
+        // Where each frame's glare ran: the default two-scale eye's PSF on the
+        // CPU on every driver; the bloom frame has no PSF; no `cie` veil.
+        EXPECT_NE(t.stimulus_json.find(R"("placement":{"veil":"none","psf_fft":"cpu"})"), std::string::npos);
+        EXPECT_NE(t.stimulus_json.find(R"("placement":{"veil":"none","psf_fft":"none"})"), std::string::npos);
         EXPECT_TRUE(t.response == "left" || t.response == "right") << t.response;
         // Two intervals of 0.5 s with 0.5 s between, then the model's answer.
         EXPECT_GE(t.response_time_s, 1.5);

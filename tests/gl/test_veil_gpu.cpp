@@ -32,10 +32,12 @@ struct Frame {
     double f = 12.0 / kDeg;
     std::vector<float> rgba;
     Frame() : rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4, 0.0f) {}
-    float& at(int i, int j, int c) {
-        return rgba[(static_cast<std::size_t>(j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(i)) * 4 +
-                    static_cast<std::size_t>(c)];
+    std::size_t index(int i, int j, int c) const {
+        return (static_cast<std::size_t>(j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(i)) * 4 +
+               static_cast<std::size_t>(c);
     }
+    float& at(int i, int j, int c) { return rgba[index(i, j, c)]; }
+    float at(int i, int j, int c) const { return rgba[index(i, j, c)]; }
     void add_light(int i, int j, double e_lux, const double (&colour)[3]) {
         const double omega = frame_pixel_solid_angle_sr(i, j, w, h, f);
         for (int c = 0; c < 3; ++c) at(i, j, c) += static_cast<float>(e_lux * colour[c] / omega);
@@ -50,17 +52,31 @@ std::vector<float> gpu_veil(const Frame& in, GpuVeilingGlare& veil, glm::dvec3& 
     return t.download_floats();
 }
 
+/// One frame's veil both ways: the CPU's double-precision path (`method`) and the GPU's.
+struct BothWays {
+    Frame cpu;
+    glm::dvec3 out_cpu, out_gpu;
+    std::vector<float> gpu;
+    int gpu_builds = 0;
+};
+BothWays both_ways(const Frame& fr, const CieObserver& obs, VeilMethod method) {
+    BothWays r{fr, {}, {}, {}, 0};
+    VeilingGlare reference;
+    r.out_cpu = reference.apply(r.cpu.rgba, r.cpu.w, r.cpu.h, r.cpu.f, obs, method);
+    GpuVeilingGlare veil;
+    r.gpu = gpu_veil(fr, veil, r.out_gpu, obs);
+    r.gpu_builds = veil.kernel_builds();
+    return r;
+}
+
 TEST_F(VeilGpu, OnePixelLightMatchesTheDoublePrecisionReferenceFromOneToFifteenDegrees) {
     Frame fr;
     const int ci = fr.w / 2, cj = fr.h / 2;
     fr.add_light(ci, cj, 2.0, {1.0, 1.0, 1.0});
-    const CieObserver obs{25, 0.5};
-    Frame cpu = fr;
-    VeilingGlare reference;
-    const glm::dvec3 out_cpu = reference.apply(cpu.rgba, cpu.w, cpu.h, cpu.f, obs, VeilMethod::direct);
-    GpuVeilingGlare veil;
-    glm::dvec3 out_gpu;
-    const std::vector<float> gpu = gpu_veil(fr, veil, out_gpu, obs);
+    const BothWays r = both_ways(fr, {25, 0.5}, VeilMethod::direct);
+    const Frame& cpu = r.cpu;
+    const std::vector<float>& gpu = r.gpu;
+    const glm::dvec3 &out_cpu = r.out_cpu, &out_gpu = r.out_gpu;
     for (int degrees : {1, 2, 5, 10, 15}) {
         const int dx = static_cast<int>(std::lround(fr.f * std::tan(degrees * kDeg)));
         for (int c = 0; c < 3; ++c) {
@@ -90,7 +106,7 @@ TEST_F(VeilGpu, OnePixelLightMatchesTheDoublePrecisionReferenceFromOneToFifteenD
                 out_cpu.g, out_gpu.g);
     EXPECT_LT(worst, 1e-4);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(out_gpu[c], out_cpu[c], 1e-6) << "channel " << c;
-    EXPECT_EQ(veil.kernel_builds(), 1);
+    EXPECT_EQ(r.gpu_builds, 1);
 }
 
 TEST_F(VeilGpu, ManyColouredLightsMatchTheCpuFftPixelByPixelAndKeepTheirEnergy) {
@@ -101,13 +117,10 @@ TEST_F(VeilGpu, ManyColouredLightsMatchTheCpuFftPixelByPixelAndKeepTheirEnergy) 
         const int i = k == 0 ? 0 : (37 * k + 11) % fr.w, j = k == 0 ? fr.h - 1 : (53 * k + 7) % fr.h;
         fr.add_light(i, j, 0.5 + 0.25 * (k % 7), {1.0, 0.3 + 0.1 * (k % 5), k % 3 == 0 ? 0.0 : 0.7});
     }
-    const CieObserver obs{62, 1.0};
-    Frame cpu = fr;
-    VeilingGlare reference;
-    const glm::dvec3 out_cpu = reference.apply(cpu.rgba, cpu.w, cpu.h, cpu.f, obs, VeilMethod::fft);
-    GpuVeilingGlare veil;
-    glm::dvec3 out_gpu;
-    const std::vector<float> gpu = gpu_veil(fr, veil, out_gpu, obs);
+    const BothWays r = both_ways(fr, {62, 1.0}, VeilMethod::fft);
+    const Frame& cpu = r.cpu;
+    const std::vector<float>& gpu = r.gpu;
+    const glm::dvec3 &out_cpu = r.out_cpu, &out_gpu = r.out_gpu;
     float peak = 0;
     for (float v : cpu.rgba) peak = std::max(peak, v);
     double worst = 0, energy_cpu = 0, energy_gpu = 0;
