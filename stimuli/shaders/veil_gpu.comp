@@ -80,11 +80,12 @@ void main() {
 
 #ifdef VEIL_MULTIPLY
 layout(std430, binding = 6) readonly buffer KernelSpectrum { float k_hat[]; };  // Mx × My
-uniform uint count;  // Mx · My
 
+// One row of workgroups per image row (Mx · My / 256 groups in one dimension
+// would pass GL's guaranteed 65535 at 4096 × 4096).
 void main() {
-    const uint i = gl_GlobalInvocationID.x;
-    if (i >= count) return;
+    if (gl_GlobalInvocationID.x >= pitch) return;
+    const uint i = gl_GlobalInvocationID.y * pitch + gl_GlobalInvocationID.x;
     const float k = k_hat[i];
     const vec2 x = rg[i] * k, y = b[i] * k;
     rg[i] = vec2(x.x, -x.y);
@@ -99,14 +100,18 @@ uniform float scale;  // VEIL_ADD: the HDR target's pre-exposure
 
 const int R = VEIL_NEAR_RADIUS;
 const int TILE = 16 + 2 * R;
-shared vec3 tile[TILE * TILE];
+// One float array per channel: a vec3 array is padded to vec4 (R = 16: 36 KiB, past GL's guaranteed 32).
+shared float tile_r[TILE * TILE], tile_g[TILE * TILE], tile_b[TILE * TILE];
 
 void main() {
     const ivec2 origin = ivec2(gl_WorkGroupID.xy) * 16 - R;
     for (uint k = gl_LocalInvocationIndex; k < uint(TILE * TILE); k += 256u) {
         const ivec2 s = origin + ivec2(int(k) % TILE, int(k) / TILE);
         const bool inside = all(greaterThanEqual(s, ivec2(0))) && all(lessThan(s, frame_size));
-        tile[k] = inside ? e_copy[s.y * frame_size.x + s.x].rgb : vec3(0.0);
+        const vec3 e = inside ? e_copy[s.y * frame_size.x + s.x].rgb : vec3(0.0);
+        tile_r[k] = e.r;
+        tile_g[k] = e.g;
+        tile_b[k] = e.b;
     }
     barrier();
     const ivec2 q = ivec2(gl_GlobalInvocationID.xy);
@@ -114,8 +119,10 @@ void main() {
     const ivec2 l = ivec2(gl_LocalInvocationID.xy) + R;
     vec3 near = vec3(0.0);
     for (int dy = -R; dy <= R; ++dy)
-        for (int dx = -R; dx <= R; ++dx)
-            near += tile[(l.y - dy) * TILE + (l.x - dx)] * k_near[abs(dy) * (R + 1) + abs(dx)];
+        for (int dx = -R; dx <= R; ++dx) {
+            const int t = (l.y - dy) * TILE + (l.x - dx);
+            near += vec3(tile_r[t], tile_g[t], tile_b[t]) * k_near[abs(dy) * (R + 1) + abs(dx)];
+        }
     const uint z = uint(q.y) * pitch + uint(q.x);
     const vec3 far = vec3(rg[z].x, -rg[z].y, b[z].x);
     const vec3 luminance = max(far + near, vec3(0.0)) / omega[q.y * frame_size.x + q.x];

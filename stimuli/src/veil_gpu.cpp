@@ -306,8 +306,8 @@ glm::dvec3 GpuVeilingGlare::apply(gl::Texture2D& light, gl::Texture2D* add_to, d
     m.blue.bind_storage(1);
     m.k_hat.bind_storage(6);
     m.multiply.use();
-    m.multiply.set("count", static_cast<unsigned>(m.mx) * static_cast<unsigned>(m.my));
-    ATONLAB_GL_CHECK(glDispatchCompute(groups(m.mx * m.my, 256), 1, 1));
+    m.multiply.set("pitch", static_cast<unsigned>(m.mx));
+    ATONLAB_GL_CHECK(glDispatchCompute(groups(m.mx, 256), static_cast<GLuint>(m.my), 1));
     storage_barrier();
     m.transform(m.rg, false);
     m.transform(m.blue, false);
