@@ -104,8 +104,12 @@ private:
 /// 15°; measured ≤ 7e-6 there at 1920×1080 and 421×221, and 4.6e-4 at 28°,
 /// where the FFT's rounding floor meets a veil still falling as θ⁻²).
 /// The outside fraction is Σ e·S / Σ e, S the share of a light at each pixel
-/// that the frame keeps (from the kernel in double, once per build). Needs a
-/// current GL 4.5 context for its whole life.
+/// that the frame keeps (from the kernel in double, once per build); reading
+/// its per-workgroup partial sums back waits for the frame's veil. At
+/// 1920×1080 the transforms are 4096 × 4096: about 0.4 GB of GPU buffers, and
+/// a build (the kernel's quadrant and its far part's spectrum by FFTW double)
+/// of a few seconds on the 2-core VM, once per size, focal length and
+/// observer. Needs a current GL 4.5 context for its whole life.
 class GpuVeilingGlare {
 public:
     /// The near window's half-width (px): (2R + 1)² taps per pixel. The FFT's
