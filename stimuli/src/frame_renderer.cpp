@@ -99,6 +99,7 @@ struct FrameRenderer::Impl {
     gl::Framebuffer fbo, glare_fbo;
     gl::Buffer lights, profiles, knots, draws;
     gl::Buffer no_envelope{sizeof(float), nullptr, gl::BufferUsage::static_draw};
+    const gl::Buffer* envelope_in_use = &no_envelope;  // at storage binding 4 this frame (light_eval.comp)
     int light_count = 0;
     GlareStage glare;
     VeilingGlare veil;
@@ -308,6 +309,15 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
     if (where == ComputePlacement::gpu) {
         veil_report.outside_frame =
             gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure, P.focal_px, scene.glare.cie);
+        // The veil's passes took storage bindings 0-7 and texture unit 0: give
+        // the frame's back (the LDR path draws its billboards after the veil,
+        // reading `draws` at binding 3).
+        lights.bind_storage(0);
+        profiles.bind_storage(1);
+        knots.bind_storage(2);
+        draws.bind_storage(3);
+        envelope_in_use->bind_storage(4);
+        depth.bind(0);
         return;
     }
     std::vector<float> light = glare_only.download_floats();
@@ -422,7 +432,8 @@ void FrameRenderer::render(const Scene& scene, double time_s) {
     m.upload_light_tables(scene, tables);
     const bool skips = !invisible.empty();
     const bool crop = skips && any_billboard && m.options.skips.crop_billboards && m.glare.envelope_stride() > 0;
-    (any_billboard && m.glare.envelope_stride() > 0 ? m.glare.envelope_buffer() : m.no_envelope).bind_storage(4);
+    m.envelope_in_use = any_billboard && m.glare.envelope_stride() > 0 ? &m.glare.envelope_buffer() : &m.no_envelope;
+    m.envelope_in_use->bind_storage(4);
     if (m.light_count == 0 && m.timed) {
         begin(1);
         end(1);
