@@ -26,6 +26,7 @@
 #include "atonlab/stimuli/cpu_threads.h"
 #include "atonlab/stimuli/error.h"
 #include "fftw_planner.h"
+#include "gpu_fft_lines.h"
 #include "gl_enums.h"
 
 namespace atonlab::stimuli {
@@ -237,9 +238,11 @@ int log2_of(int n) {
     return k;
 }
 
-/// The twiddle table W_N^k = e^{-2πik/N} = (cos, -sin)(2πk/N) for k < N/2,
-/// evaluated in double and rounded once to float.
-std::vector<float> twiddle_table(int n) {
+}  // namespace
+
+namespace detail {
+
+std::vector<float> fft_twiddle_table(int n) {
     std::vector<float> table(static_cast<std::size_t>(n));  // n/2 vec2
     for (int k = 0; k < n / 2; ++k) {
         const double angle = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
@@ -249,7 +252,19 @@ std::vector<float> twiddle_table(int n) {
     return table;
 }
 
-}  // namespace
+gl::Program fft_line_program(int n, int pitch, bool columns, TwiddleSource twiddles) {
+    const std::string n_def = fmt::format("FFT_N {}u", n);
+    const std::string log2_def = fmt::format("FFT_LOG2N {}u", log2_of(n));
+    const std::string threads_def = fmt::format("FFT_THREADS {}", std::min(n / 2, kGpuFftMaxThreads));
+    const std::string pitch_def = fmt::format("FFT_PITCH {}u", pitch);
+    const std::string_view twiddle_def =
+        twiddles == TwiddleSource::table_from_double ? "FFT_TWIDDLE_TABLE 1" : "FFT_TWIDDLE_SINCOS 1";
+    return gl::Program::build({{gl::ShaderStage::compute, "fft_rows.comp"}},
+                              {n_def, log2_def, threads_def, twiddle_def, pitch_def,
+                               columns ? "FFT_COLUMNS 1" : "FFT_ROWS 1"});
+}
+
+}  // namespace detail
 
 struct GpuFft::Impl {
     int n = 0;
@@ -264,17 +279,10 @@ GpuFft::GpuFft(int n, TwiddleSource twiddles) {
     auto impl = std::make_unique<Impl>();
     impl->n = n;
     impl->twiddles = twiddles;
-    const std::string n_def = fmt::format("FFT_N {}u", n);
-    const std::string log2_def = fmt::format("FFT_LOG2N {}u", log2_of(n));
-    const std::string threads_def = fmt::format("FFT_THREADS {}", std::min(n / 2, kGpuFftMaxThreads));
-    const std::string_view twiddle_def =
-        twiddles == TwiddleSource::table_from_double ? "FFT_TWIDDLE_TABLE 1" : "FFT_TWIDDLE_SINCOS 1";
-    impl->rows =
-        gl::Program::build({{gl::ShaderStage::compute, "fft_rows.comp"}}, {n_def, log2_def, threads_def, twiddle_def});
-    impl->columns = gl::Program::build({{gl::ShaderStage::compute, "fft_rows.comp"}},
-                                       {n_def, log2_def, threads_def, twiddle_def, "FFT_COLUMNS 1"});
+    impl->rows = detail::fft_line_program(n, n, false, twiddles);
+    impl->columns = detail::fft_line_program(n, n, true, twiddles);
     if (twiddles == TwiddleSource::table_from_double)
-        impl->twiddle_table = gl::Buffer::from(std::span<const float>(twiddle_table(n)));
+        impl->twiddle_table = gl::Buffer::from(std::span<const float>(detail::fft_twiddle_table(n)));
     impl_ = std::move(impl);
 }
 

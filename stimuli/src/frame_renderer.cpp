@@ -123,6 +123,7 @@ struct FrameRenderer::Impl {
     void draw_discs(const Scene& scene, const CameraProjection& P);
     void upload_light_tables(const Scene& scene, const GpuLightTables& tables);
     void convolve_veil(const Scene& scene, const CameraProjection& P, bool ldr);
+    void bind_light_tables() const;
 
     void resize(int w, int h) {
         const gl::PixelFormat format = pixel_format(options.hdr_format);
@@ -272,6 +273,11 @@ void FrameRenderer::Impl::upload_light_tables(const Scene& scene, const GpuLight
            gl::BufferUsage::stream_draw);
     upload(draws, nullptr, std::max<std::size_t>(1, scene.lights.size()) * kDrawFloats * sizeof(float),
            gl::BufferUsage::dynamic_read);
+    bind_light_tables();
+}
+
+// The frame's storage bindings 0-3 (light_eval.comp, the direct images, the billboards).
+void FrameRenderer::Impl::bind_light_tables() const {
     lights.bind_storage(0);
     profiles.bind_storage(1);
     knots.bind_storage(2);
@@ -312,10 +318,7 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
         // The veil's passes took storage bindings 0-7 and texture unit 0: give
         // the frame's back (the LDR path draws its billboards after the veil,
         // reading `draws` at binding 3).
-        lights.bind_storage(0);
-        profiles.bind_storage(1);
-        knots.bind_storage(2);
-        draws.bind_storage(3);
+        bind_light_tables();
         envelope_in_use->bind_storage(4);
         depth.bind(0);
         return;

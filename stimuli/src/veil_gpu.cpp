@@ -19,6 +19,7 @@
 #include "atonlab/stimuli/veiling_glare.h"
 #include "fftw_planner.h"
 #include "gl_enums.h"
+#include "gpu_fft_lines.h"
 
 namespace atonlab::stimuli {
 
@@ -26,19 +27,12 @@ namespace {
 
 constexpr int kMinLength = 16;     // fft_rows.comp's smallest line
 constexpr int kMaxLength = 4096;   // a line of 4096 vec2 is 32 KiB of shared memory, GL's guaranteed minimum
-constexpr int kFftThreads = 256;   // as GpuFft (fft.cpp)
 constexpr int kR = GpuVeilingGlare::kNearRadiusPx;
 
 int power_of_two_at_least(int m) {
     int n = kMinLength;
     while (n < m) n *= 2;
     return n;
-}
-
-int log2_of(int n) {
-    int k = 0;
-    while ((1 << k) < n) ++k;
-    return k;
 }
 
 /// The longest line fft_rows.comp can hold on this context: n vec2 in a workgroup's shared memory.
@@ -48,17 +42,6 @@ int longest_line() {
     int n = kMinLength;
     while (n * 2 <= kMaxLength && static_cast<long>(n) * 2 * 8 <= bytes) n *= 2;
     return n;
-}
-
-/// W_N^k for k < N/2 in double, rounded once to float (as GpuFft's table).
-std::vector<float> twiddles(int n) {
-    std::vector<float> t(static_cast<std::size_t>(n));
-    for (int k = 0; k < n / 2; ++k) {
-        const double a = 2.0 * std::numbers::pi * k / n;
-        t[static_cast<std::size_t>(2 * k)] = static_cast<float>(std::cos(a));
-        t[static_cast<std::size_t>(2 * k + 1)] = static_cast<float>(-std::sin(a));
-    }
-    return t;
 }
 
 unsigned groups(int count, int size) {
@@ -206,18 +189,10 @@ void GpuVeilingGlare::Impl::build(int w, int h, double f, const CieObserver& obs
     partials = gl::Buffer(pack_groups * 2 * 4 * sizeof(float), nullptr, gl::BufferUsage::dynamic_read);
     k_hat = gl::Buffer::from(std::span<const float>(far_spectrum(quadrant, mx, my)));
     k_near = gl::Buffer::from(std::span<const float>(near));
-    row_twiddles = gl::Buffer::from(std::span<const float>(twiddles(mx)));
-    column_twiddles = gl::Buffer::from(std::span<const float>(twiddles(my)));
-
-    const std::string pitch = fmt::format("FFT_PITCH {}u", mx);
-    const std::string threads_rows = fmt::format("FFT_THREADS {}", std::min(mx / 2, kFftThreads));
-    const std::string threads_columns = fmt::format("FFT_THREADS {}", std::min(my / 2, kFftThreads));
-    rows = gl::Program::build({{gl::ShaderStage::compute, "fft_rows.comp"}},
-                              {fmt::format("FFT_N {}u", mx), fmt::format("FFT_LOG2N {}u", log2_of(mx)), threads_rows,
-                               "FFT_TWIDDLE_TABLE 1", pitch});
-    columns = gl::Program::build({{gl::ShaderStage::compute, "fft_rows.comp"}},
-                                 {fmt::format("FFT_N {}u", my), fmt::format("FFT_LOG2N {}u", log2_of(my)),
-                                  threads_columns, "FFT_TWIDDLE_TABLE 1", pitch, "FFT_COLUMNS 1"});
+    row_twiddles = gl::Buffer::from(std::span<const float>(detail::fft_twiddle_table(mx)));
+    column_twiddles = gl::Buffer::from(std::span<const float>(detail::fft_twiddle_table(my)));
+    rows = detail::fft_line_program(mx, mx, false, TwiddleSource::table_from_double);
+    columns = detail::fft_line_program(my, mx, true, TwiddleSource::table_from_double);
     if (!pack) pack = gl::Program::build({{gl::ShaderStage::compute, "veil_gpu.comp"}}, {"VEIL_PACK 1"});
     if (!multiply) multiply = gl::Program::build({{gl::ShaderStage::compute, "veil_gpu.comp"}}, {"VEIL_MULTIPLY 1"});
     ready = true;
