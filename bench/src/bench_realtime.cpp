@@ -21,6 +21,7 @@
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/glare_stage.h"
+#include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/pupil_kernel_cache.h"
 #include "atonlab/stimuli/spectral_path.h"
 #include "atonlab/stimuli/veiling_glare.h"
@@ -254,6 +255,30 @@ void bench_psf_rebuild(Bench& b) {
         r.note = fmt::format("default eye at 6 mm; process CPU {:.0f} ms per run", cpu);
         b.add(r);
     }
+    // The GPU placement (GpuPsfGenerator::generate_anchored: pupil planes on
+    // the CPU, the rest in compute shaders with the GPU's fp32 FFT), read
+    // back; its error against the CPU's PSF is the placement's (issue 27: ≤ 1e-5).
+    GpuPsfGenerator gen(n, TwiddleSource::table_from_double, PsfFftPlacement::gpu);
+    RgbPsf psf;
+    const Timing t = measure(
+        [&] {
+            gen.generate_anchored(eye, samples, anchors);
+            psf = gen.read_rgb();
+            const PsfGpuTimings g = gen.timings();
+            return g.fft_ms + g.mono_ms + g.spectral_ms;
+        },
+        b.spec(5, false));
+    const PsfGpuTimings g = gen.timings();
+    Row r;
+    r.bench = "psf_rebuild";
+    r.setting = fmt::format("anchored, N = {}, GPU (fp32 FFT)", n);
+    r.is_default = false;
+    r.time = t;
+    r.error = relative_l2(psf, one_thread);
+    r.metric = "relative L2 of the RGB PSF vs the one-thread CPU PSF";
+    r.note = fmt::format("default eye at 6 mm; the placement on a hardware driver; pupil planes on the CPU {:.0f} ms",
+                         g.upload_ms);
+    b.add(r);
 }
 
 void bench_moving_pupil(Bench& b) {

@@ -7,6 +7,9 @@
 layout(local_size_x = 256) in;
 
 uniform uint n;  // texels per side of the level written
+#if defined(OP_SCALE_RGB)
+uniform vec3 luminance_weights;  // Y of linear Rec.709 R, G, B
+#endif
 
 layout(std430, binding = 0) buffer Spectrum { vec2 field[]; };
 layout(std430, binding = 1) buffer Mono { float mono[]; };
@@ -29,7 +32,9 @@ void main() {
     uint b = (2u * y) * m + 2u * x;
     level1[i] = 0.25 * (mono[b] + mono[b + 1u] + mono[b + m] + mono[b + m + 1u]);
 #elif defined(OP_SCALE_RGB)
-    double y_sum = 0.2126LF * sums.x + 0.7152LF * sums.y + 0.0722LF * sums.z;
+    // Y's row of Rec.709 → XYZ as display::luminance_of_linear_rgb has it (the
+    // rounded 0.2126/0.7152/0.0722 would leave a red light's sum 1.8e-4 off).
+    double y_sum = dot(dvec3(luminance_weights), sums.xyz);
     rgb[i] = vec4(dvec4(rgb[i]) / y_sum);
 #endif
 }

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "atonlab/stimuli/error.h"
+#include "psf_binning.h"
 
 namespace atonlab::stimuli {
 
@@ -79,13 +80,10 @@ double sum_of(const std::vector<double>& v) {
     return s;
 }
 
-// The coarse texels (index, share of the fine texel) that fine texel k
-// overlaps on one axis: its square [u - r/2, u + r/2] in coarse units, u its
-// centre, against coarse texel m's [m - 1/2, m + 1/2].
-struct AxisShare {
-    int first = 0;
-    std::vector<double> share;
-};
+}  // namespace
+
+namespace detail {
+
 std::vector<AxisShare> axis_shares(int n_fine, int n_coarse, double ratio) {
     std::vector<AxisShare> out(static_cast<std::size_t>(n_fine));
     for (int k = 0; k < n_fine; ++k) {
@@ -101,17 +99,17 @@ std::vector<AxisShare> axis_shares(int n_fine, int n_coarse, double ratio) {
     return out;
 }
 
-}  // namespace
+}  // namespace detail
 
 void bin_into(const MonoPsf& fine, double weight, MonoPsf& coarse) {
     const double ratio = fine.degrees_per_texel / coarse.degrees_per_texel;
-    const std::vector<AxisShare> shares = axis_shares(fine.n, coarse.n, ratio);
+    const std::vector<detail::AxisShare> shares = detail::axis_shares(fine.n, coarse.n, ratio);
     for (int y = 0; y < fine.n; ++y) {
-        const AxisShare& sy = shares[static_cast<std::size_t>(y)];
+        const detail::AxisShare& sy = shares[static_cast<std::size_t>(y)];
         for (int x = 0; x < fine.n; ++x) {
             const double v = weight * fine.at(x, y);
             if (v == 0) continue;
-            const AxisShare& sx = shares[static_cast<std::size_t>(x)];
+            const detail::AxisShare& sx = shares[static_cast<std::size_t>(x)];
             for (std::size_t b = 0; b < sy.share.size(); ++b) {
                 const int cy = sy.first + static_cast<int>(b);
                 if (cy < 0 || cy >= coarse.n) continue;  // beyond the coarse grid: cannot happen for ratio ≤ 1

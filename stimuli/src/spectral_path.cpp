@@ -13,6 +13,7 @@
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/error.h"
 #include "parallel.h"
+#include "spectral_terms.h"
 
 namespace atonlab::stimuli {
 
@@ -23,66 +24,13 @@ double sample_weight(const glm::dvec3& xyz) {
     return std::abs(xyz.x) + std::abs(xyz.y) + std::abs(xyz.z);
 }
 
-/// Lanczos-3 weights of one axis (windowed sinc, 6 taps): for output index i,
-/// the source coordinate c + (i − c)·ratio, its first tap and the 6 weights
-/// (normalised to sum 1, so a constant stays constant). |F|² is band-limited
-/// (the pupil's autocorrelation spans at most the plane's half width), which a
-/// windowed sinc reproduces far better than bilinear lookups: at the default
-/// eye's sampling (3 texels to the first Airy zero) bilinear lookups alone
-/// leave 2% (relative L2) of the exact path, Lanczos-3 a few tenths of that.
-constexpr int kTaps = 6;
-constexpr double kLobes = kTaps / 2;
-/// Anchors per sample between the outer anchors: 4, cubic in 1/λ (quadratic
-/// left 0.0044 with the default eye at N = 512, cubic 0.0032).
-constexpr std::size_t kOrder = 4;
-struct Taps {
-    std::vector<int> first;
-    std::vector<double> weight;  // kTaps per output index
-};
-Taps taps(int n, double ratio) {
-    Taps t;
-    t.first.resize(static_cast<std::size_t>(n));
-    t.weight.resize(static_cast<std::size_t>(n) * kTaps);
-    const double c = n / 2;
-    for (int i = 0; i < n; ++i) {
-        const double s = c + (i - c) * ratio;
-        const int first = static_cast<int>(std::floor(s)) - kTaps / 2 + 1;
-        t.first[static_cast<std::size_t>(i)] = first;
-        double sum = 0;
-        double* w = &t.weight[static_cast<std::size_t>(i) * kTaps];
-        // The taps' distances d0 − k share their sines: sin π(d0 − k) =
-        // (−1)^k sin πd0, and sin π(d0 − k)/3 by the angle difference.
-        const double d0 = s - first;
-        const double sin_d0 = std::sin(std::numbers::pi * d0);
-        const double sin_w = std::sin(std::numbers::pi * d0 / kLobes), cos_w = std::cos(std::numbers::pi * d0 / kLobes);
-        for (int k = 0; k < kTaps; ++k) {
-            const double d = d0 - k;
-            if (std::abs(d) >= kLobes) {
-                w[k] = 0.0;
-            } else if (std::abs(d) < 1e-12) {
-                w[k] = 1.0;
-            } else {
-                const double a = std::numbers::pi * k / kLobes;
-                const double sin_pd = (k % 2 == 0 ? 1.0 : -1.0) * sin_d0;
-                const double sin_pd3 = sin_w * std::cos(a) - cos_w * std::sin(a);
-                const double pd = std::numbers::pi * d;
-                w[k] = sin_pd / pd * (sin_pd3 / (pd / kLobes));
-            }
-            sum += w[k];
-        }
-        for (int k = 0; k < kTaps; ++k) w[k] /= sum;
-    }
-    return t;
-}
+constexpr int kTaps = detail::kLanczosTaps;
 
-/// One term of a sample: an anchor's PSF rescaled by `ratio` (eq 4.9's lookup)
-/// times `scale` (the Lagrange weight and the gain (λk/λ)²).
-struct Term {
-    std::size_t anchor;
-    double ratio;
-    float scale;
-    Taps taps;            // Lanczos-3 weights for `ratio` (both axes alike)
-    std::vector<float> w;  // taps.weight in fp32
+/// A term as the CPU sums it: the recipe's term (spectral_terms.h) with its
+/// taps in fp32, tap-major for the x pass, and the runs along which the taps
+/// read contiguous source texels.
+struct Term : detail::SpectralTerm {
+    std::vector<float> w;   // taps.weight in fp32
     std::vector<float> wx;  // the same tap-major (kTaps planes of n), for the x pass
     /// Runs [x0, x1) of interior texels whose first tap is x + shift: along
     /// such a run the taps read contiguous source texels, which vectorises.
@@ -277,20 +225,59 @@ std::vector<double> spectral_anchor_wavelengths(const SpectralSamples& samples, 
     return out;
 }
 
-namespace {
+namespace detail {
 
-void add_bands(BandSpace& ws, const std::vector<std::vector<float>>& source, const std::vector<Sample>& terms, int n,
-               int first_band, int end_band, RgbPsf& out);
+LanczosTaps lanczos_taps(int n, double ratio) {
+    // |F|² is band-limited (the pupil's autocorrelation spans at most the
+    // plane's half width), which a windowed sinc reproduces far better than
+    // bilinear lookups: at the default eye's sampling (3 texels to the first
+    // Airy zero) bilinear lookups alone leave 2% (relative L2) of the exact
+    // path, Lanczos-3 a few tenths of that.
+    constexpr double kLobes = kLanczosTaps / 2;
+    LanczosTaps t;
+    t.first.resize(static_cast<std::size_t>(n));
+    t.weight.resize(static_cast<std::size_t>(n) * kLanczosTaps);
+    const double c = n / 2;
+    for (int i = 0; i < n; ++i) {
+        const double s = c + (i - c) * ratio;
+        const int first = static_cast<int>(std::floor(s)) - kLanczosTaps / 2 + 1;
+        t.first[static_cast<std::size_t>(i)] = first;
+        double sum = 0;
+        double* w = &t.weight[static_cast<std::size_t>(i) * kLanczosTaps];
+        // The taps' distances d0 − k share their sines: sin π(d0 − k) =
+        // (−1)^k sin πd0, and sin π(d0 − k)/3 by the angle difference.
+        const double d0 = s - first;
+        const double sin_d0 = std::sin(std::numbers::pi * d0);
+        const double sin_w = std::sin(std::numbers::pi * d0 / kLobes), cos_w = std::cos(std::numbers::pi * d0 / kLobes);
+        for (int k = 0; k < kLanczosTaps; ++k) {
+            const double d = d0 - k;
+            if (std::abs(d) >= kLobes) {
+                w[k] = 0.0;
+            } else if (std::abs(d) < 1e-12) {
+                w[k] = 1.0;
+            } else {
+                const double a = std::numbers::pi * k / kLobes;
+                const double sin_pd = (k % 2 == 0 ? 1.0 : -1.0) * sin_d0;
+                const double sin_pd3 = sin_w * std::cos(a) - cos_w * std::sin(a);
+                const double pd = std::numbers::pi * d;
+                w[k] = sin_pd / pd * (sin_pd3 / (pd / kLobes));
+            }
+            sum += w[k];
+        }
+        for (int k = 0; k < kLanczosTaps; ++k) w[k] /= sum;
+    }
+    return t;
+}
 
-/// spectral_psf_from_anchors() on the anchors' PSFs already in ws.source
-/// (fp32, unit sum, on λ0's grid) at wavelengths `anchor_nm` (ascending).
-RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::vector<double>& anchor_nm,
-                    const SpectralSamples& samples) {
-    const auto un = static_cast<std::size_t>(n);
+std::vector<SpectralSample> spectral_recipe(const std::vector<double>& anchor_nm, const SpectralSamples& samples,
+                                            int n) {
+    // Anchors per sample between the outer anchors: 4, cubic in 1/λ (quadratic
+    // left 0.0044 with the default eye at N = 512, cubic 0.0032).
+    constexpr std::size_t kOrder = 4;
     const std::size_t k = anchor_nm.size();
     double brightest = 0;
     for (const auto& w : samples.xyz_weight) brightest = std::max(brightest, sample_weight(w));
-    std::vector<Sample> terms;
+    std::vector<SpectralSample> recipe;
     for (std::size_t s = 0; s < samples.wavelength_nm.size(); ++s) {
         const double lambda = samples.wavelength_nm[s];
         // The (up to) kOrder anchors nearest in 1/λ, and their Lagrange weights in 1/λ.
@@ -310,7 +297,7 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
         const double weight = sample_weight(samples.xyz_weight[s]);
         const bool faint = weight < 0.01 * brightest, weak = weight < 0.25 * brightest;
         near.resize(std::min<std::size_t>(k, tail ? (faint ? 1 : 2) : (weak ? 2 : kOrder)));
-        Sample sample{glm::vec3(samples.xyz_weight[s]), {}};
+        SpectralSample sample{glm::vec3(samples.xyz_weight[s]), {}};
         for (std::size_t i : near) {
             double share = 1;
             for (std::size_t j : near)
@@ -320,9 +307,34 @@ RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::v
             if (share == 0) continue;
             // K2012 eq 4.9 from the anchor λk: F_λ(x) = F_λk(x λk/λ) (λk/λ)².
             const double ratio = anchor_nm[i] / lambda;
-            Term t{i, ratio, static_cast<float>(share * ratio * ratio), {}, {}, {}, {}, {}};
-            if (ratio != 1.0) {
-                t.taps = taps(n, ratio);
+            SpectralTerm t{i, ratio, static_cast<float>(share * ratio * ratio), {}};
+            if (ratio != 1.0) t.taps = lanczos_taps(n, ratio);
+            sample.terms.push_back(std::move(t));
+        }
+        recipe.push_back(std::move(sample));
+    }
+    return recipe;
+}
+
+}  // namespace detail
+
+namespace {
+
+void add_bands(BandSpace& ws, const std::vector<std::vector<float>>& source, const std::vector<Sample>& terms, int n,
+               int first_band, int end_band, RgbPsf& out);
+
+/// spectral_psf_from_anchors() on the anchors' PSFs already in ws.source
+/// (fp32, unit sum, on λ0's grid) at wavelengths `anchor_nm` (ascending).
+RgbPsf from_sources(Workspace& ws, int n, double degrees_per_texel, const std::vector<double>& anchor_nm,
+                    const SpectralSamples& samples) {
+    const auto un = static_cast<std::size_t>(n);
+    std::vector<Sample> terms;
+    for (detail::SpectralSample& r : detail::spectral_recipe(anchor_nm, samples, n)) {
+        Sample sample{r.xyz, {}};
+        for (detail::SpectralTerm& rt : r.terms) {
+            Term t;
+            static_cast<detail::SpectralTerm&>(t) = std::move(rt);
+            if (t.ratio != 1.0) {
                 t.w.assign(t.taps.weight.begin(), t.taps.weight.end());
                 prepare_x_pass(t, n);
             }

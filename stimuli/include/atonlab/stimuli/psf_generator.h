@@ -15,7 +15,10 @@ namespace atonlab::stimuli {
 
 /// GPU time of the last generate() per stage (ms), from timer queries (fft_ms:
 /// the CPU's steady clock when the FFT ran on the CPU; for a two-scale eye, the
-/// CPU's whole mono PSF: pupil planes, FFTs and binning).
+/// CPU's whole mono PSF: pupil planes, FFTs and binning). generate_anchored():
+/// upload_ms the CPU's pupil planes and their upload (steady clock), fft_ms
+/// every anchor's transforms, mono_ms their |F|², binning and unit sums,
+/// spectral_ms the samples from the anchors and the unit luminance.
 struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
 };
@@ -50,6 +53,15 @@ public:
     /// (mono_psf_reference: two FFTW transforms and the core's binning) and
     /// uploads the result.
     void generate(const EyeModel& eye, const SpectralSamples& samples, double time_s = 0.0);
+    /// The anchored spectral path (spectral_path.h, the default) of an eye at
+    /// time_s, the GPU twin of spectral_psf_anchored(): each anchor's pupil
+    /// plane (a two-scale eye: its core and scatter fields, pupil_parts) drawn
+    /// on the CPU in double, all anchors at once on the cores; here its
+    /// transform(s) (the GPU's fp32 FFT, or FFTW double as placed), |F|², the
+    /// core binned by area onto the scatter's grid, unit sum; then every sample
+    /// from its anchors by Lanczos-3 and XYZ → RGB (psf_anchored.comp). One
+    /// GPU wait: none until read_rgb(). `anchors` as spectral_anchor_wavelengths().
+    void generate_anchored(const EyeModel& eye, const SpectralSamples& samples, int anchors, double time_s = 0.0);
     MonoPsf read_mono() const;
     RgbPsf read_rgb() const;
     PsfGpuTimings timings() const;

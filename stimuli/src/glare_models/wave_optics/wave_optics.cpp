@@ -39,11 +39,19 @@ public:
         return pupil_diameter_mm_at(eye, time_s);
     }
 
-    /// The GPU generator's only for the `rescaled` path of a one-scale eye; the
-    /// two-scale eye's parts and the anchored and exact paths are built in
-    /// double with FFTW (docs/pipeline.md "A frame's budget").
+    /// The anchored path (the default) as placed: the GPU generator's
+    /// generate_anchored() or spectral_psf_anchored() on the CPU; the
+    /// `rescaled` path's FFT as placed for a one-scale eye (a two-scale eye's
+    /// parts on the CPU); the exact path on the CPU (docs/pipeline.md "Placement").
     std::optional<ComputePlacement> psf_fft_placement(const GlareSettings& g) const override {
-        if (g.spectral_path == SpectralPath::rescaled && !has_two_scales(g.eye)) return resolve_placement(g.placement);
+        switch (g.spectral_path) {
+            case SpectralPath::anchored:
+                return resolve_placement(g.placement);
+            case SpectralPath::rescaled:
+                return has_two_scales(g.eye) ? ComputePlacement::cpu : resolve_placement(g.placement);
+            case SpectralPath::exact:
+                break;
+        }
         return ComputePlacement::cpu;
     }
 
@@ -56,8 +64,14 @@ public:
         eye.validate(gs.psf_size);
         GlareModelKernel k;
         switch (gs.spectral_path) {
-            case SpectralPath::anchored:  // docs/glare.md "The spectral path": FFTW on the CPU
-                k.psf = spectral_psf_anchored(eye, gs.psf_size, r.samples, gs.spectral_anchors, r.time_s);
+            case SpectralPath::anchored:  // docs/glare.md "The spectral path", on the GPU or the CPU as placed
+                if (resolve_placement(gs.placement) == ComputePlacement::gpu) {
+                    GpuPsfGenerator& gen = r.gpu(gs.psf_size);
+                    gen.generate_anchored(eye, r.samples, gs.spectral_anchors, r.time_s);
+                    k.psf = gen.read_rgb();
+                } else {
+                    k.psf = spectral_psf_anchored(eye, gs.psf_size, r.samples, gs.spectral_anchors, r.time_s);
+                }
                 break;
             case SpectralPath::exact:
                 k.psf = spectral_psf_exact(eye, gs.psf_size, r.samples, r.time_s);
