@@ -29,6 +29,7 @@ std::vector<SimulatorFrame> run_simulator_sequence(const SimulatorSequence& q, b
     scene.glare.model = q.glare;
     scene.glare.eye.hippus.enabled = q.hippus;
     if (q.psf_size > 0) scene.glare.psf_size = q.psf_size;
+    scene.glare.placement = q.placement;
 
     Pipeline pipeline;
     FrameOptions options;

@@ -76,6 +76,23 @@ TEST_F(SimulatorFrames, MovingPupilBuildsPerGridPupilAndIdleFramesRunNoCpuTransf
     EXPECT_GE(idle, static_cast<int>(frames.size()) - bound - 1);
 }
 
+TEST_F(SimulatorFrames, OnTheGpuPlacementNoFrameRunsACpuTransform) {
+    // Issue 27 item 4: placed on the GPU (as automatic is on a hardware
+    // driver), the moving pupil's PSF builds transform on the GPU too
+    // (GpuPsfGenerator::generate_anchored); the pupil planes stay on the CPU.
+    SimulatorSequence q = short_sequence();
+    q.frames = 30;  // 2 s of the sweep: the pupil crosses several grid pupils
+    q.placement = ComputePlacement::gpu;
+    const std::vector<SimulatorFrame> frames = bench::run_simulator_sequence(q, false);
+    ASSERT_EQ(frames.size(), 30u);
+    int builds = 0;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        builds += frames[i].psf_builds;
+        EXPECT_EQ(frames[i].cpu_ffts, 0u) << "frame " << i << " (" << frames[i].psf_builds << " PSFs built)";
+    }
+    EXPECT_GT(builds, 1) << "the sequence must build PSFs for this to say anything";
+}
+
 TEST_F(SimulatorFrames, CieVeilOfFewLightsIsSummedWithoutTransforms) {
     // 12 lights light far fewer than kVeilDirectMaxLitPixels pixels: the direct sum.
     SimulatorSequence q = short_sequence();

@@ -27,6 +27,9 @@ struct SimulatorSequence {
     bool hippus = true;             ///< K2012 eq 4.7 on top of the pupil's drift
     stimuli::GlareModel glare = stimuli::GlareModel::wave_optics;  ///< the eye's model for every light
     int psf_size = 0;               ///< 0: the default N
+    /// Where the PSF's FFTs and the `cie` veil run ([glare] placement):
+    /// automatic is the GPU on a hardware driver, the CPU on llvmpipe.
+    stimuli::ComputePlacement placement = stimuli::ComputePlacement::automatic;
 };
 
 /// One frame's time and work.
