@@ -11,7 +11,7 @@
 #   bash bench/device/run.sh                              # on the device machine
 #   ATONLAB_DEVICE_DRY_RUN=1 ATONLAB_DEVICE_BUILD_DIR=build bash bench/device/run.sh
 #       # anywhere: llvmpipe, the quick bench, the GL tests' simulator, bench and
-#       # moving-pupil suites only, in the existing build/
+#       # moving-pupil and GPU-PSF suites only, in the existing build/
 #
 # Needs the build dependencies of scripts/setup.sh already installed (a device
 # machine may have no package archive; the script says what is missing
@@ -76,7 +76,7 @@ gl_filter='^GL\.'
 if [ "$dry_run" = 1 ]; then
   egl_device=software
   bench_args=(--quick)
-  gl_filter='^GL\.(SimulatorFrames|MovingPupil|bench)\.'
+  gl_filter='^GL\.(SimulatorFrames|MovingPupil|PsfAnchoredGpu|bench)\.'
 fi
 
 # A build folder configured already keeps its settings (ATONLAB_DEVICE_BUILD_DIR=build reuses
