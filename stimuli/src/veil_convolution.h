@@ -5,7 +5,11 @@
 //    mx × my ≥ (2W − 1) × (2H − 1), done as 1-D transforms so that the zero
 //    rows are skipped (only the frame's H rows are transformed along x, and
 //    only its H rows transformed back) and the rows and columns are shared
-//    among the cores; plans made once per frame size and reused;
+//    among the cores; along y a few columns at a time, copied into a block
+//    that stays in the core's cache for the forward transform, the kernel's
+//    product and the inverse; one 1-D plan per transform shape (FFTW_ESTIMATE:
+//    the same bits every time, for every thread count) on lengths FFTW_ESTIMATE
+//    plans well (fftw_size_at_least); plans made once per frame size;
 //  - veil_direct_sum: Σ over the lit pixels p of e(p) K(q − p) for every
 //    pixel q, exact, O(W·H × lit pixels), rows shared among the cores.
 #include <fftw3.h>
@@ -28,14 +32,26 @@ public:
     /// e (h × w illuminances, row-major, lux) convolved with the kernel, in place.
     void convolve(std::vector<double>& e);
 
+    /// Columns gathered together along y: a block of 8 columns of my complex
+    /// doubles (288 KiB at 1080 rows, my = 2304) stays in a core's L2 cache.
+    static constexpr int kBlockColumns = 8;
+
 private:
     void destroy();
-    int w_ = 0, h_ = 0, mx_ = 0, my_ = 0, cols_ = 0;
-    double* rows_ = nullptr;          // h × mx reals (the frame's rows, padded along x)
-    fftw_complex* spec_ = nullptr;    // my × cols (cols = mx/2 + 1)
-    std::vector<double> kernel_hat_;  // my × cols: the kernel's spectrum (real: K is even in x and y)
-    std::vector<fftw_plan> row_forward_, column_forward_, column_inverse_, row_inverse_;  // one per worker
-    std::vector<int> row_chunk_, column_chunk_;  // worker t: [chunk[t], chunk[t + 1])
+    void column_block(int worker, int first_column);
+    int w_ = 0, h_ = 0, mx_ = 0, my_ = 0, cols_ = 0, half_ = 0;
+    /// Row strides (elements) of rows_ and spec_: every row starts on a 32-byte
+    /// boundary, as the arrays the plans were measured on (FFTW's new-array execute).
+    std::size_t row_stride_ = 0, spec_stride_ = 0, column_stride_ = 0;  // column_stride_: in a block
+    double* rows_ = nullptr;        // h rows of mx reals (the frame's rows, padded along x)
+    fftw_complex* spec_ = nullptr;  // h rows of cols = mx/2 + 1: the frame's rows transformed along x
+    /// The kernel's spectrum, real (K is even in x and y) and even along y:
+    /// column c's frequencies 0 … my/2 at [c · half, (c + 1) · half), half = my/2 + 1.
+    std::vector<double> kernel_hat_;
+    /// One row r2c and c2r, one column forward and back.
+    fftw_plan row_forward_ = nullptr, row_inverse_ = nullptr, column_forward_ = nullptr, column_inverse_ = nullptr;
+    std::vector<fftw_complex*> block_;          // one per worker: kBlockColumns columns of my, each contiguous
+    std::vector<int> row_chunk_, block_chunk_;  // worker t: [chunk[t], chunk[t + 1]) rows or column blocks
 };
 
 /// A pixel with light: its column i, row j and illuminance per channel (lux).
@@ -48,7 +64,8 @@ struct LitPixel {
 /// over the lit pixels. `kernel` is the frame's quadrant (w × h).
 void veil_direct_sum(const VeilKernelQuadrant& kernel, const std::vector<LitPixel>& lit, std::vector<double> (&out)[3]);
 
-/// The smallest n ≥ m whose prime factors are 2, 3, 5 and 7 (FFTW's fast sizes).
+/// The transform length for m samples: the smallest 2^a · q ≥ m, q ∈ {1, 3, 5, 7, 9}
+/// (the lengths FFTW_ESTIMATE's plans run fastest).
 int fftw_size_at_least(int m);
 
 }  // namespace atonlab::stimuli::detail

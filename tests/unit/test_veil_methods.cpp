@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "atonlab/stimuli/cie_glare.h"
@@ -28,10 +29,10 @@ struct Frame {
     }
 };
 
-// A 301×201 frame at 12 px per degree with `count` lights of different colours
-// and illuminances spread over it (one in the centre pixel).
-Frame lights_frame(int count) {
-    Frame fr{301, 201, 12.0 / kDeg, {}};
+// A w×h frame (301×201 unless said) at 12 px per degree with `count` lights of
+// different colours and illuminances spread over it (one in the centre pixel).
+Frame lights_frame(int count, int w = 301, int h = 201) {
+    Frame fr{w, h, 12.0 / kDeg, {}};
     fr.rgba.assign(static_cast<std::size_t>(fr.w) * fr.h * 4, 0.0f);
     for (int k = 0; k < count; ++k) {
         const int i = k == 0 ? fr.w / 2 : (37 * k + 11) % fr.w, j = k == 0 ? fr.h / 2 : (53 * k + 7) % fr.h;
@@ -43,28 +44,45 @@ Frame lights_frame(int count) {
     return fr;
 }
 
+// The worst per-pixel |direct − FFT| / (|direct| + 1e-12 of the peak).
+double direct_vs_fft(Frame a, glm::dvec3* out_direct = nullptr, glm::dvec3* out_fft = nullptr) {
+    Frame b = a;
+    VeilingGlare veil;
+    const glm::dvec3 d = veil.apply(a.rgba, a.w, a.h, a.f, {25, 0.5}, VeilMethod::direct);
+    EXPECT_EQ(veil.last_method(), VeilMethod::direct);
+    const glm::dvec3 f = veil.apply(b.rgba, b.w, b.h, b.f, {25, 0.5}, VeilMethod::fft);
+    EXPECT_EQ(veil.last_method(), VeilMethod::fft);
+    EXPECT_EQ(veil.kernel_builds(), 1);  // both read the one kernel
+    if (out_direct) *out_direct = d;
+    if (out_fft) *out_fft = f;
+    float peak = 0;
+    for (float v : a.rgba) peak = std::max(peak, v);
+    double worst = 0;
+    for (std::size_t p = 0; p < a.rgba.size(); ++p) {
+        if (p % 4 == 3) continue;
+        const double diff = std::abs(static_cast<double>(a.rgba[p]) - b.rgba[p]);
+        worst = std::max(worst, diff / (std::abs(static_cast<double>(a.rgba[p])) + 1e-12 * peak));
+    }
+    return worst;
+}
+
+TEST(VeilMethods, OddTransformLengthsAndFramesNarrowerThanAColumnBlockAgreeToo) {
+    // 4×5 px: transform lengths 7 × 9 (odd: the rows and columns padded to
+    // keep every one aligned as the plans'), 4 spectrum columns (one partial
+    // block of the FFT's column pass); 13×3 and 1×1 likewise small and odd.
+    for (const auto& [w, h] : {std::pair{4, 5}, std::pair{13, 3}, std::pair{1, 1}, std::pair{17, 2}}) {
+        EXPECT_LT(direct_vs_fft(lights_frame(std::min(3, w * h), w, h)), 1e-6) << w << "×" << h;
+    }
+}
+
 TEST(VeilMethods, DirectSumEqualsTheFftPixelByPixel) {
     for (int count : {1, 7, 40}) {
-        Frame a = lights_frame(count), b = a;
-        VeilingGlare veil;
-        const glm::dvec3 out_direct = veil.apply(a.rgba, a.w, a.h, a.f, {25, 0.5}, VeilMethod::direct);
-        EXPECT_EQ(veil.last_method(), VeilMethod::direct);
-        const glm::dvec3 out_fft = veil.apply(b.rgba, b.w, b.h, b.f, {25, 0.5}, VeilMethod::fft);
-        EXPECT_EQ(veil.last_method(), VeilMethod::fft);
-        EXPECT_EQ(veil.kernel_builds(), 1);  // both read the one kernel
-        float peak = 0;
-        for (float v : a.rgba) peak = std::max(peak, v);
+        glm::dvec3 out_direct, out_fft;
         // The FFT's rounding is ≈ 1e-16 of the brightest pixel's energy, spread
         // over every pixel; the veil's darkest pixels here are ≈ 1e-7 of the
         // peak, so 1e-6 relative (plus 1e-12 of the peak absolute) bounds it with
         // room, and a wrong shift, wrap or missing light is far beyond it.
-        double worst = 0;
-        for (std::size_t p = 0; p < a.rgba.size(); ++p) {
-            if (p % 4 == 3) continue;
-            const double d = std::abs(static_cast<double>(a.rgba[p]) - b.rgba[p]);
-            worst = std::max(worst, d / (std::abs(static_cast<double>(a.rgba[p])) + 1e-12 * peak));
-        }
-        EXPECT_LT(worst, 1e-6) << count << " lights";
+        EXPECT_LT(direct_vs_fft(lights_frame(count), &out_direct, &out_fft), 1e-6) << count << " lights";
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(out_direct[c], out_fft[c], 1e-9) << count << " lights, channel " << c;
     }
 }
