@@ -65,7 +65,8 @@ public:
         GlareModelKernel k;
         switch (gs.spectral_path) {
             case SpectralPath::anchored:  // docs/glare.md "The spectral path", on the GPU or the CPU as placed
-                if (resolve_placement(gs.placement) == ComputePlacement::gpu) {
+                // No generator (a caller without GL, e.g. the unit tests): the CPU.
+                if (r.gpu && resolve_placement(gs.placement) == ComputePlacement::gpu) {
                     GpuPsfGenerator& gen = r.gpu(gs.psf_size);
                     gen.generate_anchored(eye, r.samples, gs.spectral_anchors, r.time_s);
                     k.psf = gen.read_rgb();
