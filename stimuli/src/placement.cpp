@@ -32,6 +32,7 @@ bool software_renderer() {
 
 ComputePlacement resolve_placement(ComputePlacement p) {
     if (p != ComputePlacement::automatic) return p;
+    if (glGetString(GL_RENDERER) == nullptr) return ComputePlacement::cpu;  // no current context
     return software_renderer() ? ComputePlacement::cpu : ComputePlacement::gpu;
 }
 

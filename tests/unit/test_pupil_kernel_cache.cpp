@@ -9,6 +9,7 @@
 
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
+#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/pupil_kernel_cache.h"
 #include "atonlab/stimuli/scene.h"
 
@@ -40,6 +41,16 @@ struct KernelMaker {
 // 0.001 cd/m², the pupil follows K2012 eq 3.15 (3.76 → 6.89 mm).
 double dusk_pupil_mm(double t_s) {
     return pupil_diameter_mm_from_adaptation(std::pow(10.0, -3.0 * t_s / 10.0));
+}
+
+TEST(PupilKernelCache, WithoutAGlContextTheAutomaticPlacementIsTheCpu) {
+    // These tests build kernels with no GL context and no GPU generator: the
+    // default eye's PSF (anchored) must then be the CPU's, and say so.
+    EXPECT_EQ(resolve_placement(ComputePlacement::automatic), ComputePlacement::cpu);
+    EXPECT_EQ(resolve_placement(ComputePlacement::gpu), ComputePlacement::gpu);  // forced stays forced
+    GlareSettings g;
+    g.model = GlareModel::wave_optics;
+    EXPECT_EQ(glare_model_type(g.model).psf_fft_placement(g), ComputePlacement::cpu);
 }
 
 TEST(PupilKernelCache, InterpolatedKernelIsWithinATenthOfAPercentOfTheExactPupilsOverDuskToNight) {
