@@ -103,7 +103,8 @@ void GpuPsfGenerator::Impl::upload_field(const ComplexImage<double>& f, gl::Buff
     const auto texels = f.data.size();
     ComplexImage<float> packed(n);
     if (placement == PsfFftPlacement::cpu) {
-        // As generate(pupil): FFTW double, rounded once to float.
+        // FFTW double, rounded once to float for the upload: as fast as FFTW
+        // float on the machines measured (bench fft_nN) and exact.
         ComplexImage<double> spectrum = f;
         fftw_forward(spectrum);
         for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(spectrum.data[i]);
@@ -273,37 +274,19 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
     const bool cpu_fft = m.placement == PsfFftPlacement::cpu;
     double cpu_fft_ms = 0;
     m.timers[0].begin();
-    ComplexImage<float> packed(m.n);
-    if (cpu_fft) {
-        // FFTW double, rounded once to float for the upload: as fast as FFTW
-        // float on the machines measured (bench fft_nN) and exact.
-        const auto t0 = std::chrono::steady_clock::now();
-        ComplexImage<double> spectrum = pupil;
-        fftw_forward(spectrum);
-        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(spectrum.data[i]);
-        cpu_fft_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    } else {
-        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(pupil.data[i]);
-    }
-    // std::complex<float> is two floats (re, im): the std430 layout of vec2.
-    m.field.upload(0, texels * sizeof(std::complex<float>), packed.data.data());
+    const auto t0 = std::chrono::steady_clock::now();
+    m.upload_field(pupil, m.field);
+    if (cpu_fft) cpu_fft_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     m.timers[0].end();
 
     m.timers[1].begin();
-    if (!cpu_fft) m.fft->forward(m.field);
+    m.transform_on_gpu(m.field);
     m.timers[1].end();
 
     // |F|², shift, sum, unit sum, level 1.
     m.timers[2].begin();
+    m.power_and_sum(m.field, m.mono, m.sums);
     m.bind_all();
-    m.magnitude.set("n", n);
-    m.magnitude.use();
-    glDispatchCompute(groups_for(texels), 1, 1);
-    Impl::barrier();
-    m.reduce_mono.set("count", static_cast<unsigned>(texels));
-    m.reduce_mono.use();
-    glDispatchCompute(1, 1, 1);
-    Impl::barrier();
     m.scale_mono.set("n", n);
     m.scale_mono.use();
     glDispatchCompute(groups_for(texels), 1, 1);
