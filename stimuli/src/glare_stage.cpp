@@ -167,13 +167,21 @@ struct GlareStage::Impl {
         gs.model = g.model;
         const SpectralSamples samples = spectral_samples(spd_for(g.spd), gs.spectral_samples);
         const GlareModelType& type = glare_model_type(g.model);
-        auto build = [&](double grid_pupil_mm) {
-            GlareModelKernel k = type.billboard_kernel({gs, scene, samples, ppd, grid_pupil_mm, time_s,
-                                                        [this](int n) -> GpuPsfGenerator& { return generator_for(n); }});
+        auto gpu = [this](int n) -> GpuPsfGenerator& { return generator_for(n); };
+        auto build = [&](double grid_pupil_mm, const GlareKernelAhead* ahead) {
+            GlareKernelRequest r{gs, scene, samples, ppd, grid_pupil_mm, time_s, gpu};
+            r.ahead = ahead;
+            GlareModelKernel k = type.billboard_kernel(r);
             ++counts.kernels;
+            counts.kernels_ahead += ahead ? 1 : 0;
             return std::move(k.kernel);
         };
-        g.kernel = g.pupil_cache.kernel_at(pupil_mm, build);
+        // The next grid pupil's work without GL (the GPU build's pupil planes)
+        // on a worker thread, ready when the pupil gets there.
+        auto plan = [&](double grid_pupil_mm) {
+            return type.work_ahead({gs, scene, samples, ppd, grid_pupil_mm, time_s, gpu});
+        };
+        g.kernel = g.pupil_cache.kernel_at(pupil_mm, build, plan);
         g.psf.reset();  // no PSF at this pupil: the kernel is the grid kernels' cubic
         g.report = {};
         g.report.model = g.model;

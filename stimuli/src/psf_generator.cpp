@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <complex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "atonlab/display/colour.h"
@@ -338,8 +339,31 @@ void GpuPsfGenerator::generate(const EyeModel& eye, const SpectralSamples& sampl
     impl_->last.fft_ms = cpu_ms;  // the CPU's pupil planes, FFTs and binning
 }
 
+AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples,
+                                          int anchor_count, double time_s) {
+    eye.validate(n);
+    AnchoredPupilPlanes out;
+    out.n = n;
+    out.anchor_nm = spectral_anchor_wavelengths(samples, anchor_count);
+    out.two_scales = has_two_scales(eye);
+    const std::size_t parts = out.two_scales ? 2 : 1;
+    out.planes.resize(out.anchor_nm.size() * parts);
+    detail::parallel_items(static_cast<int>(out.anchor_nm.size()), [&](int i) {
+        const auto a = static_cast<std::size_t>(i);
+        const double w = eye.plane_width_mm * out.anchor_nm[a] / kReferenceWavelengthNm;
+        if (out.two_scales) {
+            PupilParts p = pupil_parts(eye, n, out.anchor_nm[a], w, time_s);
+            out.planes[a * parts] = std::move(p.scatter);
+            out.planes[a * parts + 1] = std::move(p.core);
+        } else {
+            out.planes[a] = pupil_plane(eye, n, out.anchor_nm[a], w, time_s);
+        }
+    });
+    return out;
+}
+
 void GpuPsfGenerator::generate_anchored(const EyeModel& eye, const SpectralSamples& samples, int anchor_count,
-                                        double time_s) {
+                                        double time_s, const AnchoredPupilPlanes* drawn) {
     Impl& m = *impl_;
     const int n = m.n;
     eye.validate(n);
@@ -349,22 +373,16 @@ void GpuPsfGenerator::generate_anchored(const EyeModel& eye, const SpectralSampl
     const std::size_t parts = two_scales ? 2 : 1;
     const auto texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
     m.degrees_per_texel = stimuli::psf_degrees_per_texel(eye);
+    if (drawn && (drawn->n != n || drawn->anchor_nm != anchor_nm || drawn->two_scales != two_scales ||
+                  drawn->planes.size() != k * parts))
+        throw std::invalid_argument("generate_anchored: the planes drawn ahead are for another size, anchors or eye");
 
     // The pupil planes on the CPU in double, as spectral_psf_anchored draws
-    // them (each anchor's plane over W·λk/λ0: its FFT lands on λ0's grid).
+    // them, unless a worker thread drew them ahead.
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<ComplexImage<double>> planes(k * parts);  // anchor i: [i·parts] scatter (or whole), [i·parts + 1] core
-    detail::parallel_items(static_cast<int>(k), [&](int i) {
-        const auto a = static_cast<std::size_t>(i);
-        const double w = eye.plane_width_mm * anchor_nm[a] / kReferenceWavelengthNm;
-        if (two_scales) {
-            PupilParts p = pupil_parts(eye, n, anchor_nm[a], w, time_s);
-            planes[a * parts] = std::move(p.scatter);
-            planes[a * parts + 1] = std::move(p.core);
-        } else {
-            planes[a] = pupil_plane(eye, n, anchor_nm[a], w, time_s);
-        }
-    });
+    AnchoredPupilPlanes here;
+    if (!drawn) here = anchored_pupil_planes(eye, n, samples, anchor_count, time_s);
+    const std::vector<ComplexImage<double>>& planes = drawn ? drawn->planes : here.planes;
     if (m.fields.size() != planes.size()) {
         m.fields.clear();
         for (std::size_t i = 0; i < planes.size(); ++i)

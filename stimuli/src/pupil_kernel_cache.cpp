@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <system_error>
 
 namespace atonlab::stimuli {
 
@@ -56,8 +57,10 @@ double kernel_relative_l2(const GlareKernel& a, const GlareKernel& reference) {
 }
 
 void PupilKernelCache::clear() {
+    ahead_.clear();  // a std::async future waits for its job here
     grid_.clear();
-    builds_ = 0;
+    builds_ = builds_ahead_ = 0;
+    has_last_ = false;
 }
 
 const GlareKernel& PupilKernelCache::grid_kernel(long k, const Builder& build) {
@@ -71,32 +74,76 @@ const GlareKernel& PupilKernelCache::grid_kernel(long k, const Builder& build) {
         });
         grid_.erase(far);
     }
-    GlareKernel kernel = build(static_cast<double>(k) * step_mm_);
+    Ahead ahead;
+    if (auto a = ahead_.find(k); a != ahead_.end()) {
+        try {
+            ahead = a->second.get();
+        } catch (...) {
+            // The work failed on the worker: the build below does it here and
+            // reports its error on this thread, as it would have without it.
+        }
+        ahead_.erase(a);
+    }
+    GlareKernel kernel = build(static_cast<double>(k) * step_mm_, ahead.get());
     ++builds_;
+    if (ahead) ++builds_ahead_;
     return grid_.emplace(k, std::move(kernel)).first->second;
 }
 
-GlareKernel PupilKernelCache::kernel_at(double pupil_mm, const Builder& build) {
+void PupilKernelCache::start_ahead(double x, long k0, double previous_pupil_mm, const Planner& plan) {
+    const double moved = x - previous_pupil_mm / step_mm_;  // in grid steps since the last call
+    if (moved == 0) return;
+    // Work that way for as many nodes beyond the stencil as the pupil moved
+    // steps (at least one, at most kMaxAhead): k0 + 3, k0 + 4, … opening,
+    // k0 − 2, k0 − 3, … closing. Work for nodes it has turned away from
+    // (behind the stencil) is dropped; a job still running is waited for.
+    const int dir = moved > 0 ? 1 : -1;
+    const long first = moved > 0 ? k0 + 3 : k0 - 2;
+    std::erase_if(ahead_, [&](const auto& a) { return (a.first - k0) * dir < (dir > 0 ? -1 : -2); });
+    const auto reach = static_cast<long>(std::clamp(std::ceil(std::abs(moved)), 1.0, static_cast<double>(kMaxAhead)));
+    for (long j = 0; j < reach; ++j) {
+        const long next = first + dir * j;
+        if (grid_.count(next) || ahead_.count(next)) continue;
+        GlareKernelAheadJob job = plan(static_cast<double>(next) * step_mm_);
+        if (!job) return;  // the model has nothing to do ahead
+        try {
+            ahead_.emplace(next, std::async(std::launch::async, std::move(job)));
+        } catch (const std::system_error&) {
+            return;  // no thread to be had: those builds do all their work in their frames
+        }
+    }
+}
+
+GlareKernel PupilKernelCache::kernel_at(double pupil_mm, const Builder& build, const Planner& plan) {
+    const double previous = last_pupil_mm_;
+    const bool had_last = has_last_;
     last_pupil_mm_ = pupil_mm;
+    has_last_ = true;
     const double x = pupil_mm / step_mm_;
     const double fl = std::floor(x);
     const auto k0 = static_cast<long>(fl);
-    if (x == fl) return grid_kernel(k0, build);  // on the grid: that kernel exactly
-    // Lagrange cubic in p through k0 − 1 … k0 + 2 (x lies between the middle two).
-    std::vector<long> nodes;
-    std::vector<double> weights;
-    for (long k = k0 - 1; k <= k0 + 2; ++k) {
-        double w = 1;
-        for (long j = k0 - 1; j <= k0 + 2; ++j)
-            if (j != k) w *= (x - static_cast<double>(j)) / static_cast<double>(k - j);
-        nodes.push_back(k);
-        weights.push_back(w);
+    GlareKernel out;
+    if (x == fl) {
+        out = grid_kernel(k0, build);  // on the grid: that kernel exactly
+    } else {
+        // Lagrange cubic in p through k0 − 1 … k0 + 2 (x lies between the middle two).
+        std::vector<long> nodes;
+        std::vector<double> weights;
+        for (long k = k0 - 1; k <= k0 + 2; ++k) {
+            double w = 1;
+            for (long j = k0 - 1; j <= k0 + 2; ++j)
+                if (j != k) w *= (x - static_cast<double>(j)) / static_cast<double>(k - j);
+            nodes.push_back(k);
+            weights.push_back(w);
+        }
+        // Build first (building may evict), then take the pointers.
+        for (long k : nodes) grid_kernel(k, build);
+        std::vector<const GlareKernel*> kernels;
+        for (long k : nodes) kernels.push_back(&grid_.at(k));
+        out = combine_kernels(kernels, weights);
     }
-    // Build first (building may evict), then take the pointers.
-    for (long k : nodes) grid_kernel(k, build);
-    std::vector<const GlareKernel*> kernels;
-    for (long k : nodes) kernels.push_back(&grid_.at(k));
-    return combine_kernels(kernels, weights);
+    if (plan && had_last) start_ahead(x, k0, previous, plan);
+    return out;
 }
 
 }  // namespace atonlab::stimuli

@@ -6,9 +6,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <future>
+#include <stdexcept>
 
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/spectral_path.h"
@@ -124,6 +127,43 @@ TEST_F(PsfAnchoredGpu, AFrameRendererPlacedOnTheGpuBuildsTheCpusKernelAndSaysSo)
         den += glm::dot(glm::dvec4(kernel[0].rgba[i]), glm::dvec4(kernel[0].rgba[i]));
     }
     EXPECT_LT(std::sqrt(num / den), kBound);
+}
+
+TEST_F(PsfAnchoredGpu, PupilPlanesDrawnAheadOnAWorkerGiveTheSameKernelBitForBit) {
+    // A moving pupil's next grid pupil (pupil_kernel_cache.h): the model's
+    // work without GL (work_ahead: the pupil planes) runs on another thread,
+    // and the build handed its result must be the build without it.
+    Scene s;
+    s.glare.model = GlareModel::wave_optics;
+    s.glare.psf_size = 64;
+    s.glare.placement = ComputePlacement::gpu;
+    const SpectralSamples samples = spectral_samples(display::d65_spectrum(), s.glare.spectral_samples);
+    GpuPsfGenerator gen(64, TwiddleSource::table_from_double, PsfFftPlacement::gpu);
+    auto gpu = [&](int) -> GpuPsfGenerator& { return gen; };
+    const GlareModelType& type = glare_model_type(GlareModel::wave_optics);
+    const GlareKernelRequest request{s.glare, s, samples, 20.0, 5.35, 1.5, gpu};
+    GlareKernelAheadJob job = type.work_ahead(request);
+    ASSERT_TRUE(job) << "the GPU placement's pupil planes are work a worker can do";
+    std::future<std::shared_ptr<const GlareKernelAhead>> drawn = std::async(std::launch::async, job);
+    const GlareModelKernel without = type.billboard_kernel(request);
+    GlareKernelRequest with_request = request;
+    const std::shared_ptr<const GlareKernelAhead> ahead = drawn.get();
+    ASSERT_NE(ahead, nullptr);
+    with_request.ahead = ahead.get();
+    const GlareModelKernel with = type.billboard_kernel(with_request);
+    ASSERT_EQ(with.kernel.size, without.kernel.size);
+    EXPECT_EQ(with.kernel.rgba, without.kernel.rgba);
+    ASSERT_TRUE(with.psf && without.psf);
+    EXPECT_EQ(stimuli::relative_l2(*with.psf, *without.psf), 0.0);
+
+    // Planes drawn for another size are refused, not transformed.
+    EyeModel eye = s.glare.eye;
+    eye.pupil_diameter_mm = 5.35;
+    const AnchoredPupilPlanes small = anchored_pupil_planes(eye, 32, samples, s.glare.spectral_anchors);
+    EXPECT_THROW(gen.generate_anchored(eye, samples, s.glare.spectral_anchors, 0.0, &small), std::invalid_argument);
+    // On the CPU placement there is nothing to do ahead: its build keeps the cores busy in the frame.
+    s.glare.placement = ComputePlacement::cpu;
+    EXPECT_FALSE(type.work_ahead({s.glare, s, samples, 20.0, 5.35, 1.5, gpu}));
 }
 
 }  // namespace

@@ -39,6 +39,7 @@ struct SimulatorFrame {
     double adaptation_cd_m2 = 0;
     double pupil_mm = 0;              ///< the wave-optics glare's pupil this frame (0 for other models)
     int psf_builds = 0;               ///< PSFs built (GlareBuildCounts::kernels)
+    int psf_builds_ahead = 0;         ///< of them, those whose pupil planes a worker drew ahead (kernels_ahead)
     int interpolations = 0;           ///< kernels interpolated between cached pupils
     int layer_builds = 0;             ///< area-layer sets built
     std::uint64_t cpu_ffts = 0;       ///< whole-image CPU transforms (stimuli::cpu_fft_count())

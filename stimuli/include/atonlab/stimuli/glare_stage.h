@@ -41,6 +41,9 @@ struct GlareGroupReport {
 /// pupil/eye state) and the area layers.
 struct GlareBuildCounts {
     int kernels = 0;         ///< PSFs built (exact pupils and the moving pupil's grid pupils)
+    /// Of `kernels`, grid pupils whose work without GL (the GPU placement's
+    /// pupil planes) a worker thread did before the frame needed it.
+    int kernels_ahead = 0;
     int layers = 0;
     int interpolations = 0;  ///< kernels interpolated between grid pupils (a moving pupil; no PSF built)
 };

@@ -5,6 +5,7 @@
 // GPU buffers; read_mono()/read_rgb() download for tests, files and the
 // billboard kernel. Needs a current GL 4.5 context for its whole life.
 #include <memory>
+#include <vector>
 
 #include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/gl/objects.h"
@@ -16,7 +17,7 @@ namespace atonlab::stimuli {
 /// GPU time of the last generate() per stage (ms), from timer queries (fft_ms:
 /// the CPU's steady clock when the FFT ran on the CPU; for a two-scale eye, the
 /// CPU's whole mono PSF: pupil planes, FFTs and binning). generate_anchored():
-/// upload_ms the CPU's pupil planes and their upload (steady clock), fft_ms
+/// upload_ms the CPU's pupil planes (unless drawn ahead) and their upload (steady clock), fft_ms
 /// every anchor's transforms, mono_ms their |F|², binning and unit sums,
 /// spectral_ms the samples from the anchors and the unit luminance.
 struct PsfGpuTimings {
@@ -30,6 +31,24 @@ struct PsfGpuTimings {
 /// fft_n512 on llvmpipe: 18 ms against 190 ms, and exact), far dearer than a
 /// real GPU's. automatic: the CPU on a software rasteriser, else the GPU.
 using PsfFftPlacement = ComputePlacement;
+
+/// The CPU's share of GpuPsfGenerator::generate_anchored(): each anchor's
+/// pupil plane in double (a two-scale eye: its scatter and core fields,
+/// pupil_parts), over W·λk/λ0 so that its FFT lands on λ0's grid. It needs no
+/// GL context: the glare stage has a worker thread draw a moving pupil's next
+/// grid pupil ahead of the frame that needs it (pupil_kernel_cache.h).
+struct AnchoredPupilPlanes {
+    int n = 0;
+    std::vector<double> anchor_nm;  ///< spectral_anchor_wavelengths()
+    bool two_scales = false;
+    /// Anchor i: [i·parts] the scatter (a one-scale eye: the whole plane), [i·parts + 1] the core (parts = 2).
+    std::vector<ComplexImage<double>> planes;
+};
+
+/// The planes generate_anchored(eye, samples, anchors, time_s) draws, all
+/// anchors at once on the cores. Throws as pupil_plane() does.
+AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples, int anchors,
+                                          double time_s = 0.0);
 
 class GpuPsfGenerator {
 public:
@@ -61,7 +80,11 @@ public:
     /// core binned by area onto the scatter's grid, unit sum; then every sample
     /// from its anchors by Lanczos-3 and XYZ → RGB (psf_anchored.comp). One
     /// GPU wait: none until read_rgb(). `anchors` as spectral_anchor_wavelengths().
-    void generate_anchored(const EyeModel& eye, const SpectralSamples& samples, int anchors, double time_s = 0.0);
+    /// `drawn`: the planes anchored_pupil_planes() drew ahead for the same
+    /// arguments (the same bits as drawing them here); std::invalid_argument
+    /// where its size, anchors or parts differ from these.
+    void generate_anchored(const EyeModel& eye, const SpectralSamples& samples, int anchors, double time_s = 0.0,
+                           const AnchoredPupilPlanes* drawn = nullptr);
     MonoPsf read_mono() const;
     RgbPsf read_rgb() const;
     PsfGpuTimings timings() const;

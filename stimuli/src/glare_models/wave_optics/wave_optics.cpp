@@ -13,6 +13,27 @@
 namespace atonlab::stimuli {
 namespace {
 
+/// The eye a billboard kernel is built for: the settings' at the kernel's
+/// pupil, which already holds the hippus of its time (kernel_pupil_mm), so
+/// hippus is applied once and the kernel does not depend on the time.
+EyeModel billboard_eye(const GlareSettings& gs, double pupil_mm) {
+    EyeModel eye = gs.eye;
+    eye.pupil_diameter_mm = pupil_mm;
+    eye.hippus.enabled = false;
+    return eye;
+}
+
+/// A GPU build's pupil planes, drawn ahead on a worker thread.
+struct PlanesDrawnAhead final : GlareKernelAhead {
+    AnchoredPupilPlanes planes;
+};
+
+bool anchored_on_the_gpu(const GlareKernelRequest& r) {
+    // No generator (a caller without GL, e.g. the unit tests): the CPU.
+    return r.glare.spectral_path == SpectralPath::anchored && r.gpu &&
+           resolve_placement(r.glare.placement) == ComputePlacement::gpu;
+}
+
 class WaveOptics final : public GlareModelType {
 public:
     WaveOptics() : GlareModelType(GlareModel::wave_optics) {}
@@ -57,18 +78,16 @@ public:
 
     GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const override {
         const GlareSettings& gs = r.glare;
-        EyeModel eye = gs.eye;
-        eye.pupil_diameter_mm = r.pupil_mm;
-        // r.pupil_mm already holds the hippus of time_s (kernel_pupil_mm); applied once.
-        eye.hippus.enabled = false;
+        const EyeModel eye = billboard_eye(gs, r.pupil_mm);
         eye.validate(gs.psf_size);
         GlareModelKernel k;
         switch (gs.spectral_path) {
             case SpectralPath::anchored:  // docs/glare.md "The spectral path", on the GPU or the CPU as placed
-                // No generator (a caller without GL, e.g. the unit tests): the CPU.
-                if (r.gpu && resolve_placement(gs.placement) == ComputePlacement::gpu) {
+                if (anchored_on_the_gpu(r)) {
+                    const auto* ahead = dynamic_cast<const PlanesDrawnAhead*>(r.ahead);
                     GpuPsfGenerator& gen = r.gpu(gs.psf_size);
-                    gen.generate_anchored(eye, r.samples, gs.spectral_anchors, r.time_s);
+                    gen.generate_anchored(eye, r.samples, gs.spectral_anchors, r.time_s,
+                                          ahead ? &ahead->planes : nullptr);
                     k.psf = gen.read_rgb();
                 } else {
                     k.psf = spectral_psf_anchored(eye, gs.psf_size, r.samples, gs.spectral_anchors, r.time_s);
@@ -87,6 +106,21 @@ public:
         k.radius_deg = default_glare_radius_deg(gs, k.psf->degrees_per_texel);
         k.kernel = glare_kernel_from_psf(*k.psf, r.pixels_per_degree, k.radius_deg, gs.window);
         return k;
+    }
+
+    /// On the GPU placement, the anchored path's pupil planes: the CPU's share
+    /// of the build (68 ms at N = 512 on the 2-core VM), which a frame would
+    /// otherwise wait for. On the CPU placement nothing: its build already
+    /// keeps every core busy inside the frame, so a worker would only move the
+    /// time, and the frames' CPU transforms would no longer be their own.
+    GlareKernelAheadJob work_ahead(const GlareKernelRequest& r) const override {
+        if (!anchored_on_the_gpu(r)) return {};
+        return [eye = billboard_eye(r.glare, r.pupil_mm), n = r.glare.psf_size, samples = r.samples,
+                anchors = r.glare.spectral_anchors, time_s = r.time_s] {
+            auto out = std::make_shared<PlanesDrawnAhead>();
+            out->planes = anchored_pupil_planes(eye, n, samples, anchors, time_s);
+            return std::shared_ptr<const GlareKernelAhead>(std::move(out));
+        };
     }
 
     /// On the CPU: `exact`, else `anchored` (`rescaled` runs on the GPU and is taken as `anchored`).

@@ -11,6 +11,7 @@
 // uses: the scene file's keys and `--set` checks, the glare stage, image_glare,
 // `atonlab glare` and `atonlab view`.
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -39,6 +40,14 @@ class GpuPsfGenerator;
 /// light_eval.comp's (the frame renderer uploads them per light).
 enum class GlarePath : std::uint8_t { direct = 0, billboard = 1, veil = 2 };
 
+/// What a model did on a worker thread ahead of the frame that needs its
+/// kernel (GlareModelType::work_ahead); each model derives its own.
+struct GlareKernelAhead {
+    virtual ~GlareKernelAhead() = default;
+};
+/// That work as a job: it owns copies of all it reads and touches no GL.
+using GlareKernelAheadJob = std::function<std::shared_ptr<const GlareKernelAhead>()>;
+
 /// What a model's kernel is built for.
 struct GlareKernelRequest {
     const GlareSettings& glare;      ///< the shared settings, with glare.model = this model
@@ -49,6 +58,8 @@ struct GlareKernelRequest {
     double time_s = 0;               ///< the frame's time (the eye's time-varying parts)
     /// The glare stage's GPU PSF generator of size n; empty on the CPU (`atonlab glare`).
     std::function<GpuPsfGenerator&(int n)> gpu;
+    /// work_ahead()'s result for this kernel when a worker ran it; null: none.
+    const GlareKernelAhead* ahead = nullptr;
 };
 
 /// A model's kernel, with the PSF it came from (the FFT models) and its radius.
@@ -111,6 +122,12 @@ public:
 
     /// The glare stage's kernel for a billboard (path() == billboard only).
     virtual GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const;
+    /// The part of billboard_kernel(r) that needs no GL context, as a job a
+    /// worker thread runs before a frame needs the kernel (a moving pupil's
+    /// next grid pupil, pupil_kernel_cache.h); billboard_kernel() then gets
+    /// its result as r.ahead and must build the same kernel, bit for bit, as
+    /// without it. Empty (the default): nothing worth doing ahead.
+    virtual GlareKernelAheadJob work_ahead(const GlareKernelRequest&) const { return {}; }
     /// `atonlab glare`'s kernel, on the CPU (on_images() only).
     virtual GlareKernel image_kernel(const GlareKernelRequest& r) const;
 
