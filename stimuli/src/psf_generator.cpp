@@ -26,6 +26,17 @@ constexpr int kMaxSpectralSamples = 128;  // psf_spectral.comp MAX_SAMPLES
 unsigned groups_for(std::size_t count) {
     return static_cast<unsigned>((count + 255) / 256);
 }
+
+/// A pupil-plane field as the generator uploads it for its FFT placement: the
+/// field itself rounded to float (the GPU transforms it), or its spectrum by
+/// FFTW in double rounded once to float (as fast as FFTW float on the machines
+/// measured, bench fft_nN, and exact).
+ComplexImage<float> field_as_uploaded(ComplexImage<double> f, PsfFftPlacement fft) {
+    if (fft == PsfFftPlacement::cpu) fftw_forward(f);
+    ComplexImage<float> packed(f.n);
+    for (std::size_t i = 0; i < f.data.size(); ++i) packed.data[i] = std::complex<float>(f.data[i]);
+    return packed;
+}
 }  // namespace
 
 struct GpuPsfGenerator::Impl {
@@ -101,19 +112,9 @@ struct GpuPsfGenerator::Impl {
 };
 
 void GpuPsfGenerator::Impl::upload_field(const ComplexImage<double>& f, gl::Buffer& out) const {
-    const auto texels = f.data.size();
-    ComplexImage<float> packed(n);
-    if (placement == PsfFftPlacement::cpu) {
-        // FFTW double, rounded once to float for the upload: as fast as FFTW
-        // float on the machines measured (bench fft_nN) and exact.
-        ComplexImage<double> spectrum = f;
-        fftw_forward(spectrum);
-        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(spectrum.data[i]);
-    } else {
-        for (std::size_t i = 0; i < texels; ++i) packed.data[i] = std::complex<float>(f.data[i]);
-    }
+    const ComplexImage<float> packed = field_as_uploaded(f, placement);
     // std::complex<float> is two floats (re, im): the std430 layout of vec2.
-    out.upload(0, texels * sizeof(std::complex<float>), packed.data.data());
+    out.upload(0, packed.data.size() * sizeof(std::complex<float>), packed.data.data());
 }
 
 void GpuPsfGenerator::Impl::power_and_sum(const gl::Buffer& spectrum, const gl::Buffer& power, const gl::Buffer& sum) {
@@ -340,23 +341,26 @@ void GpuPsfGenerator::generate(const EyeModel& eye, const SpectralSamples& sampl
 }
 
 AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples,
-                                          int anchor_count, double time_s) {
+                                          int anchor_count, double time_s, PsfFftPlacement fft) {
+    if (fft == PsfFftPlacement::automatic)
+        throw std::invalid_argument("anchored_pupil_planes: the FFT placement must be resolved (gpu or cpu)");
     eye.validate(n);
     AnchoredPupilPlanes out;
     out.n = n;
     out.anchor_nm = spectral_anchor_wavelengths(samples, anchor_count);
     out.two_scales = has_two_scales(eye);
+    out.fft = fft;
     const std::size_t parts = out.two_scales ? 2 : 1;
-    out.planes.resize(out.anchor_nm.size() * parts);
+    out.fields.resize(out.anchor_nm.size() * parts);
     detail::parallel_items(static_cast<int>(out.anchor_nm.size()), [&](int i) {
         const auto a = static_cast<std::size_t>(i);
         const double w = eye.plane_width_mm * out.anchor_nm[a] / kReferenceWavelengthNm;
         if (out.two_scales) {
             PupilParts p = pupil_parts(eye, n, out.anchor_nm[a], w, time_s);
-            out.planes[a * parts] = std::move(p.scatter);
-            out.planes[a * parts + 1] = std::move(p.core);
+            out.fields[a * parts] = field_as_uploaded(std::move(p.scatter), fft);
+            out.fields[a * parts + 1] = field_as_uploaded(std::move(p.core), fft);
         } else {
-            out.planes[a] = pupil_plane(eye, n, out.anchor_nm[a], w, time_s);
+            out.fields[a] = field_as_uploaded(pupil_plane(eye, n, out.anchor_nm[a], w, time_s), fft);
         }
     });
     return out;
@@ -374,21 +378,24 @@ void GpuPsfGenerator::generate_anchored(const EyeModel& eye, const SpectralSampl
     const auto texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
     m.degrees_per_texel = stimuli::psf_degrees_per_texel(eye);
     if (drawn && (drawn->n != n || drawn->anchor_nm != anchor_nm || drawn->two_scales != two_scales ||
-                  drawn->planes.size() != k * parts))
-        throw std::invalid_argument("generate_anchored: the planes drawn ahead are for another size, anchors or eye");
+                  drawn->fft != m.placement || drawn->fields.size() != k * parts))
+        throw std::invalid_argument(
+            "generate_anchored: the planes drawn ahead are for another size, anchors, eye or FFT placement");
 
     // The pupil planes on the CPU in double, as spectral_psf_anchored draws
     // them, unless a worker thread drew them ahead.
     const auto t0 = std::chrono::steady_clock::now();
     AnchoredPupilPlanes here;
-    if (!drawn) here = anchored_pupil_planes(eye, n, samples, anchor_count, time_s);
-    const std::vector<ComplexImage<double>>& planes = drawn ? drawn->planes : here.planes;
+    if (!drawn) here = anchored_pupil_planes(eye, n, samples, anchor_count, time_s, m.placement);
+    const std::vector<ComplexImage<float>>& planes = drawn ? drawn->fields : here.fields;
     if (m.fields.size() != planes.size()) {
         m.fields.clear();
         for (std::size_t i = 0; i < planes.size(); ++i)
             m.fields.emplace_back(texels * 2 * sizeof(float), nullptr, gl::BufferUsage::dynamic_draw);
     }
-    for (std::size_t i = 0; i < planes.size(); ++i) m.upload_field(planes[i], m.fields[i]);
+    // std::complex<float> is two floats (re, im): the std430 layout of vec2.
+    for (std::size_t i = 0; i < planes.size(); ++i)
+        m.fields[i].upload(0, texels * sizeof(std::complex<float>), planes[i].data.data());
     if (m.anchors.size() != k * texels * sizeof(float))
         m.anchors = gl::Buffer(k * texels * sizeof(float), nullptr, gl::BufferUsage::dynamic_draw);
     if (m.core_power.size() == 0) {  // bound for the one-scale eye too (its shader skips them)

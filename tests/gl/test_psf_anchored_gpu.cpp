@@ -161,6 +161,13 @@ TEST_F(PsfAnchoredGpu, PupilPlanesDrawnAheadOnAWorkerGiveTheSameKernelBitForBit)
     eye.pupil_diameter_mm = 5.35;
     const AnchoredPupilPlanes small = anchored_pupil_planes(eye, 32, samples, s.glare.spectral_anchors);
     EXPECT_THROW(gen.generate_anchored(eye, samples, s.glare.spectral_anchors, 0.0, &small), std::invalid_argument);
+    // Spectra made for a generator whose FFT runs on the CPU are not this generator's fields.
+    const AnchoredPupilPlanes spectra =
+        anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, PsfFftPlacement::cpu);
+    EXPECT_THROW(gen.generate_anchored(eye, samples, s.glare.spectral_anchors, 0.0, &spectra), std::invalid_argument);
+    // A worker has no GL context to resolve automatic by.
+    EXPECT_THROW(anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, PsfFftPlacement::automatic),
+                 std::invalid_argument);
     // On the CPU placement there is nothing to do ahead: its build keeps the cores busy in the frame.
     s.glare.placement = ComputePlacement::cpu;
     EXPECT_FALSE(type.work_ahead({s.glare, s, samples, 20.0, 5.35, 1.5, gpu}));

@@ -33,22 +33,29 @@ struct PsfGpuTimings {
 using PsfFftPlacement = ComputePlacement;
 
 /// The CPU's share of GpuPsfGenerator::generate_anchored(): each anchor's
-/// pupil plane in double (a two-scale eye: its scatter and core fields,
-/// pupil_parts), over W·λk/λ0 so that its FFT lands on λ0's grid. It needs no
-/// GL context: the glare stage has a worker thread draw a moving pupil's next
-/// grid pupil ahead of the frame that needs it (pupil_kernel_cache.h).
+/// pupil plane drawn in double (a two-scale eye: its scatter and core fields,
+/// pupil_parts) over W·λk/λ0, so that its FFT lands on λ0's grid, and rounded
+/// once to float as the generator uploads it. It needs no GL context: the
+/// glare stage has a worker thread make a moving pupil's next grid pupils ahead
+/// of the frame that needs them (pupil_kernel_cache.h), and that frame then
+/// only uploads them.
 struct AnchoredPupilPlanes {
     int n = 0;
     std::vector<double> anchor_nm;  ///< spectral_anchor_wavelengths()
     bool two_scales = false;
+    /// The generator's FFT placement they are for: gpu, the planes
+    /// themselves; cpu, their spectra by FFTW in double.
+    PsfFftPlacement fft = PsfFftPlacement::gpu;
     /// Anchor i: [i·parts] the scatter (a one-scale eye: the whole plane), [i·parts + 1] the core (parts = 2).
-    std::vector<ComplexImage<double>> planes;
+    std::vector<ComplexImage<float>> fields;
 };
 
-/// The planes generate_anchored(eye, samples, anchors, time_s) draws, all
-/// anchors at once on the cores. Throws as pupil_plane() does.
+/// The fields generate_anchored(eye, samples, anchors, time_s) uploads, all
+/// anchors at once on the cores, for a generator whose FFT runs at `fft`
+/// (gpu or cpu; std::invalid_argument for automatic, which only a GL
+/// context can resolve). Throws as pupil_plane() does.
 AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples, int anchors,
-                                          double time_s = 0.0);
+                                          double time_s = 0.0, PsfFftPlacement fft = PsfFftPlacement::gpu);
 
 class GpuPsfGenerator {
 public:
@@ -80,9 +87,10 @@ public:
     /// core binned by area onto the scatter's grid, unit sum; then every sample
     /// from its anchors by Lanczos-3 and XYZ → RGB (psf_anchored.comp). One
     /// GPU wait: none until read_rgb(). `anchors` as spectral_anchor_wavelengths().
-    /// `drawn`: the planes anchored_pupil_planes() drew ahead for the same
-    /// arguments (the same bits as drawing them here); std::invalid_argument
-    /// where its size, anchors or parts differ from these.
+    /// `drawn`: the fields anchored_pupil_planes() made ahead for the same
+    /// arguments and this generator's fft_placement() (the same bits as making
+    /// them here); std::invalid_argument where its size, anchors, parts or FFT
+    /// placement differ from these.
     void generate_anchored(const EyeModel& eye, const SpectralSamples& samples, int anchors, double time_s = 0.0,
                            const AnchoredPupilPlanes* drawn = nullptr);
     MonoPsf read_mono() const;

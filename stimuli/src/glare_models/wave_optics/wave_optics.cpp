@@ -118,7 +118,7 @@ public:
         return [eye = billboard_eye(r.glare, r.pupil_mm), n = r.glare.psf_size, samples = r.samples,
                 anchors = r.glare.spectral_anchors, time_s = r.time_s] {
             auto out = std::make_shared<PlanesDrawnAhead>();
-            out->planes = anchored_pupil_planes(eye, n, samples, anchors, time_s);
+            out->planes = anchored_pupil_planes(eye, n, samples, anchors, time_s, ComputePlacement::gpu);
             return std::shared_ptr<const GlareKernelAhead>(std::move(out));
         };
     }
