@@ -103,6 +103,7 @@ struct FrameRenderer::Impl {
     int light_count = 0;
     GlareStage glare;
     VeilingGlare veil;
+    std::vector<float> veil_light, veil_frame;  // the CPU veil's read-backs, kept between frames
     GpuVeilingGlare gpu_veil;
     VeilReport veil_report;
     FrameOptions options;
@@ -323,12 +324,15 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
         depth.bind(0);
         return;
     }
-    std::vector<float> light = glare_only.download_floats();
+    // Into buffers kept from frame to frame (Texture2D::download_floats).
+    std::vector<float>& light = veil_light;
+    glare_only.download_floats(light);
     veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
     if (ldr) {
         glare_only.upload(light.data());
     } else {
-        std::vector<float> frame = hdr.download_floats();
+        std::vector<float>& frame = veil_frame;
+        hdr.download_floats(frame);
         for (std::size_t i = 0; i < frame.size(); ++i)
             if (i % 4 != 3) frame[i] += light[i] * pre;
         hdr.upload(frame.data());

@@ -87,12 +87,17 @@ void Texture2D::upload(const float* data) {
 }
 
 std::vector<float> Texture2D::download_floats() const {
+    std::vector<float> out;
+    download_floats(out);
+    return out;
+}
+
+void Texture2D::download_floats(std::vector<float>& out) const {
     const auto fi = detail::format_info(format_);
-    std::vector<float> out(static_cast<std::size_t>(width_) * height_ * fi.channels);
+    out.resize(static_cast<std::size_t>(width_) * height_ * fi.channels);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     ATONLAB_GL_CHECK(glGetTextureImage(id(), 0, fi.format, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)),
                                        out.data()));
-    return out;
 }
 
 void Texture2D::bind(std::uint32_t unit) const { ATONLAB_GL_CHECK(glBindTextureUnit(unit, id())); }
