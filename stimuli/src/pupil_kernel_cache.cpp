@@ -3,6 +3,7 @@
 #include "atonlab/stimuli/pupil_kernel_cache.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <system_error>
@@ -96,10 +97,14 @@ void PupilKernelCache::start_ahead(double x, long k0, double previous_pupil_mm, 
     // Work that way for as many nodes beyond the stencil as the pupil moved
     // steps (at least one, at most kMaxAhead): k0 + 3, k0 + 4, … opening,
     // k0 − 2, k0 − 3, … closing. Work for nodes it has turned away from
-    // (behind the stencil) is dropped; a job still running is waited for.
+    // (behind the stencil) is dropped once done: dropping a job still running
+    // would wait for it here.
     const int dir = moved > 0 ? 1 : -1;
     const long first = moved > 0 ? k0 + 3 : k0 - 2;
-    std::erase_if(ahead_, [&](const auto& a) { return (a.first - k0) * dir < (dir > 0 ? -1 : -2); });
+    std::erase_if(ahead_, [&](const auto& a) {
+        return (a.first - k0) * dir < (dir > 0 ? -1 : -2) &&
+               a.second.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    });
     const auto reach = static_cast<long>(std::clamp(std::ceil(std::abs(moved)), 1.0, static_cast<double>(kMaxAhead)));
     for (long j = 0; j < reach; ++j) {
         const long next = first + dir * j;

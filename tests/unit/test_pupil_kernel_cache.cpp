@@ -213,6 +213,29 @@ TEST(PupilKernelCache, APupilMovingSeveralGridStepsAFrameHasWorkStartedForEachNo
     sweep_with_and_without_work_ahead(25, [](int i) { return 3.503 + 0.12 * i; });
 }
 
+TEST(PupilKernelCache, APupilThatTurnsBackAndForthGetsTheSameKernelsAsWithoutWorkAhead) {
+    // Hippus-like swings of ±0.2 mm (4 grid steps) with a period of about 31
+    // frames: the direction flips every 16 frames, work started for nodes
+    // the pupil turns away from is dropped or handed over later, and every
+    // kernel stays the one a cache without work ahead gives.
+    Recorder with, without;
+    PupilKernelCache ahead(kPupilGridStepMm), plain(kPupilGridStepMm);
+    for (int i = 0; i < 200; ++i) {
+        const double p = 5.013 + 0.2 * std::sin(i / 5.0);
+        with.call = without.call = i;
+        EXPECT_EQ(ahead.kernel_at(p, with.builder(), with.planner()).rgba[0],
+                  plain.kernel_at(p, without.builder()).rgba[0])
+            << "frame " << i;
+    }
+    EXPECT_EQ(with.asked, without.asked);
+    for (std::size_t b = 0; b < with.asked.size(); ++b) {
+        if (!std::isnan(with.handed[b])) {
+            EXPECT_EQ(with.handed[b], with.asked[b]) << "build " << b;
+        }
+    }
+    EXPECT_GT(ahead.builds_ahead(), 0);
+}
+
 TEST(PupilKernelCache, WorkThatFailsAheadIsDoneAgainByTheBuildOnTheCallingThread) {
     Recorder r;
     int failed = 0;
