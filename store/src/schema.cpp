@@ -170,13 +170,25 @@ CREATE TABLE scenes (
 ALTER TABLE sessions ADD COLUMN scene_id INTEGER REFERENCES scenes(id);
 )sql";
 
-constexpr std::array<Migration, 6> migrations = {
+// Version 7: what the session was besides its trials. simulation_json: a
+// simulated session's observer, its true values per condition and its design
+// (`atonlab simulate`, docs/simulate.md); stop_json: why a session stopped
+// before its end when the runner stopped it (docs/running.md). NULL otherwise.
+constexpr std::string_view schema_v7 = R"sql(
+ALTER TABLE sessions ADD COLUMN simulation_json TEXT
+    CHECK (simulation_json IS NULL OR json_valid(simulation_json));
+ALTER TABLE sessions ADD COLUMN stop_json TEXT
+    CHECK (stop_json IS NULL OR json_valid(stop_json));
+)sql";
+
+constexpr std::array<Migration, 7> migrations = {
     Migration{1, "protocols, displays, calibrations, observers, sessions, trials, snapshots", sql::text(schema_v1)},
     Migration{2, "calibration readings and checks; calibrations append-only", sql::text(schema_v2)},
     Migration{3, "instrument transcripts of calibration readings", schema_v3},
     Migration{4, "sessions.displayability_json", schema_v4},
     Migration{5, "view trial_settings: each trial's overrides, typed and unquoted", schema_v5},
     Migration{6, "scenes; sessions.scene_id", schema_v6},
+    Migration{7, "sessions.simulation_json, sessions.stop_json", schema_v7},
 };
 
 }  // namespace

@@ -13,7 +13,8 @@ namespace {
 constexpr const char* select_sessions =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name, "
+    "s.simulation_json, s.stop_json "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
     "LEFT JOIN scenes sc ON sc.id = s.scene_id "
     "ORDER BY s.id";
@@ -21,7 +22,8 @@ constexpr const char* select_sessions =
 constexpr const char* select_one_session =
     "SELECT s.id, o.code, s.protocol_id, p.name, p.sha256, s.software_version, s.seed, s.calibration_id, "
     "s.started_at, s.ended_at, s.status, s.resume_count, "
-    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name "
+    "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), s.displayability_json, sc.sha256, sc.name, "
+    "s.simulation_json, s.stop_json "
     "FROM sessions s JOIN observers o ON o.id = s.observer_id JOIN protocols p ON p.id = s.protocol_id "
     "LEFT JOIN scenes sc ON sc.id = s.scene_id "
     "WHERE s.id = ?1";
@@ -59,6 +61,8 @@ SessionRecord session_from_row(const sql::Statement& s, const std::filesystem::p
     r.displayability_json = s.optional_text(13);
     r.scene_sha256 = s.optional_text(14);
     r.scene_name = s.optional_text(15).value_or("");
+    r.simulation_json = s.optional_text(16);
+    r.stop_json = s.optional_text(17);
     return r;
 }
 
@@ -167,7 +171,8 @@ SessionId Store::begin_session(const SessionStart& start) {
 
     sql::Use ins(db.cached(
         "INSERT INTO sessions (observer_id, protocol_id, calibration_id, software_version, seed, "
-        "started_at, displayability_json, scene_id) VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ", ?6, ?7)"));
+        "started_at, displayability_json, scene_id, simulation_json) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, " ATONLAB_STORE_NOW ", ?6, ?7, ?8)"));
     ins->bind(1, observer_id);
     ins->bind(2, protocol_id);
     if (start.calibration) {
@@ -186,6 +191,11 @@ SessionId Store::begin_session(const SessionStart& start) {
         ins->bind(7, *scene_id);
     } else {
         ins->bind_null(7);
+    }
+    if (start.simulation_json.empty()) {
+        ins->bind_null(8);
+    } else {
+        ins->bind(8, start.simulation_json);
     }
     ins->run(doing);
     const SessionId id{sqlite3_last_insert_rowid(db.get())};

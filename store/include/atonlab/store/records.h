@@ -109,6 +109,10 @@ struct SessionStart {
     /// The software that ran the session; empty means this library's own version
     /// (software_version()).
     std::string software_version;
+    /// A simulated session (`atonlab simulate`, docs/simulate.md): its
+    /// observer, true values and design, JSON; empty for any other session
+    /// (stored NULL). Schema version 7.
+    std::string simulation_json;
 };
 
 /// A session as stored.
@@ -131,6 +135,10 @@ struct SessionRecord {
     /// stored no scene (a session from before schema v6).
     std::optional<std::string> scene_sha256;
     std::string scene_name;  ///< SessionStart's; empty with no scene stored
+    std::optional<std::string> simulation_json;  ///< SessionStart's; none for any other session (schema v7)
+    /// Why the runner stopped the session before its end, JSON (docs/running.md);
+    /// none when it did not (schema v7).
+    std::optional<std::string> stop_json;
 };
 
 /// One trial: what was shown, what the observer answered, how well the frames
