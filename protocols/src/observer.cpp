@@ -204,8 +204,21 @@ Answer ModelObserver::answer(const Shown& shown) {
     throw std::invalid_argument("unknown task");
 }
 
+double ModelObserver::decision_2afc(const Shown& shown) const {
+    return log_difference(log10_brightness(view_at(shown, 0)), log10_brightness(view_at(shown, 1)));
+}
+
+double ModelObserver::decision_yes_no(const Shown& shown) const {
+    const View& v = view_at(shown, 0);
+    const double e = increment_illuminance_lux(*v.image, v.light_px, params_.window_radius_deg);
+    return e > 0 ? params_.exponent * std::log10(e / params_.detection_threshold_lux) : -kInf;  // log10 B − log10 B_θ
+}
+
 Answer ModelObserver::answer_2afc(const Shown& shown) {
-    const double delta = log_difference(log10_brightness(view_at(shown, 0)), log10_brightness(view_at(shown, 1)));
+    return answer_2afc_delta(decision_2afc(shown));
+}
+
+Answer ModelObserver::answer_2afc_delta(double delta) {
     const double sigma = params_.noise_sd_log10;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
     const Answer easy{Response::Left, response_time(z)};
@@ -218,10 +231,10 @@ Answer ModelObserver::answer_2afc(const Shown& shown) {
 }
 
 Answer ModelObserver::answer_yes_no(const Shown& shown) {
-    const View& v = view_at(shown, 0);
-    const double e = increment_illuminance_lux(*v.image, v.light_px, params_.window_radius_deg);
-    const double delta =
-        e > 0 ? params_.exponent * std::log10(e / params_.detection_threshold_lux) : -kInf;  // log10 B − log10 B_θ
+    return answer_yes_no_delta(decision_yes_no(shown));
+}
+
+Answer ModelObserver::answer_yes_no_delta(double delta) {
     const double sigma = params_.noise_sd_log10;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
     const double rt = response_time(z);

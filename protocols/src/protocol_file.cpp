@@ -67,6 +67,7 @@ public:
         step([&] { read_screens(doc_, root, p); });
         step([&] { read_blocks(root, p); });
         step([&] { read_responses(doc_, root, p); });
+        step([&] { read_observer(doc_, root, p); });
         doc_.collect_into(nullptr);
         errors_.throw_if_any();
         return p;

@@ -21,7 +21,8 @@
 
 namespace atonlab::protocols::detail {
 
-inline constexpr std::string_view kRootKeys[] = {"protocol", "display", "timing", "responses", "screens", "defaults", "block"};
+inline constexpr std::string_view kRootKeys[] = {"protocol", "display",  "timing", "responses",
+                                                 "screens",  "defaults", "block",  "observer"};
 inline constexpr std::string_view kProtocolKeys[] = {"name", "description", "scene", "seed", "adaptation_s"};
 inline constexpr std::string_view kDisplayKeys[] = {"width_px",           "height_px", "width_m",
                                              "viewing_distance_m", "name",      "max_calibration_age_days"};
@@ -289,6 +290,9 @@ void read_display(const Document& doc, const Section& root, Protocol& p);
 void read_timing(const Document& doc, const Section& root, Protocol& p);
 void read_screens(const Document& doc, const Section& root, Protocol& p);
 void read_responses(const Document& doc, const Section& root, Protocol& p);
+/// [observer]: the model observer's keys and a simulated observer's departures
+/// (simulated_observer.h), each checked against its range.
+void read_observer(const Document& doc, const Section& root, Protocol& p);
 
 /// Expands the conditions file `f` of block `bi` into [[block.condition]]
 /// tables (conditions_file.cpp); `protocol_text` may carry the file.

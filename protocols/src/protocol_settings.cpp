@@ -7,6 +7,7 @@
 
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/toml_text.h"
+#include "atonlab/protocols/simulated_observer.h"
 #include "protocol_schema.h"
 
 namespace atonlab::protocols::detail {
@@ -124,6 +125,27 @@ void read_timing(const Document& doc, const Section& root, Protocol& p) {
     }
     if (const toml::node* n = s.get("adaptation_skippable"))
         p.timing.adaptation_skippable = doc.boolean(n, s.key_path("adaptation_skippable"));
+}
+
+void read_observer(const Document& doc, const Section& root, Protocol& p) {
+    const toml::table* t = root.table("observer");
+    if (t == nullptr) return;
+    Section s(doc, *t, "observer", "the [observer] table");
+    std::vector<std::string_view> names;
+    for (const ObserverKey& k : observer_keys()) names.push_back(k.name);
+    s.allow(names);
+    SimulatedObserverParams checked;  // each value checked against its key's range as it is read
+    for (auto&& [k, v] : *t) {
+        const std::string key(k.str());
+        const double value = *s.number(key);
+        const SourceLocation where{doc.file(), Document::line_of(&v), 0, s.key_path(key)};
+        try {
+            set_observer_key(checked, key, value, where);
+        } catch (const InputError& e) {
+            s.fail(key, e.message());
+        }
+        p.observer.push_back(ObserverSetting{key, value, where});
+    }
 }
 
 void read_screens(const Document& doc, const Section& root, Protocol& p) {

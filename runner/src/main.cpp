@@ -18,6 +18,7 @@
 #include "psf_command.h"
 #include "render_command.h"
 #include "run_command.h"
+#include "simulate_command.h"
 #include "image_commands.h"
 #include "light_command.h"
 #include "view_command.h"
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
     atonlab::runner::add_psf_command(app, psf);
     atonlab::runner::RunOptions run;
     atonlab::runner::add_run_command(app, run);
+    atonlab::runner::SimulateOptions simulate;
+    atonlab::runner::add_simulate_command(app, simulate);
     atonlab::runner::CheckOptions check;
     atonlab::runner::add_check_command(app, check);
     atonlab::runner::AnalyzeOptions analyze;
@@ -59,6 +62,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("render")) return atonlab::runner::run_render(render);
         if (app.got_subcommand("psf")) return atonlab::runner::run_psf(psf);
         if (app.got_subcommand("run")) return atonlab::runner::run_run(run);
+        if (app.got_subcommand("simulate")) return atonlab::runner::run_simulate(simulate);
         if (app.got_subcommand("check")) return atonlab::runner::run_check(check);
         if (app.got_subcommand("analyze")) return atonlab::runner::run_analyze(analyze);
         if (app.got_subcommand("calibrate")) return atonlab::runner::run_calibrate(calibrate);

@@ -15,6 +15,7 @@
 #include "atonlab/present/screen_presenter.h"
 #include "atonlab/present/text.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/protocols/simulated_observer.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/store.h"
@@ -57,6 +58,22 @@ bool displayability_allows(const Displayability& displayability, const RunOption
     }
     std::fprintf(stderr, "atonlab: warning: running anyway (--allow-undisplayable; recorded with the session)\n");
     return true;
+}
+
+/// The model observer's parameters: the protocol's [observer] table. Its
+/// departures from the stationary model (bias, overdispersion, learning,
+/// fluctuation) are `atonlab simulate`'s; a run with the model observer
+/// refuses them rather than answering as another observer.
+p::ModelObserverParams model_observer_params(const RunOptions& o, const p::Protocol& protocol) {
+    const p::SimulatedObserverParams params = p::observer_params(protocol);
+    if (o.model_observer)
+        for (const p::ObserverSetting& s : protocol.observer)
+            if (p::find_observer_key(s.key)->departure)
+                throw InputError(s.where, fmt::format("the observer's {} is a simulated observer's (atonlab "
+                                                      "simulate); atonlab run's model observer is the stationary "
+                                                      "model: leave it out to run this protocol.",
+                                                      s.key));
+    return o.model_params.value_or(params.model);
 }
 
 /// A model observer inside an adjustment match when the log stopped: show it
@@ -140,6 +157,7 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
     start.scene_name = in.protocol.scene.filename().string();
     start.seed = run.seed;
     start.displayability_json = displayability_json(displayability, o.allow_undisplayable);
+    start.simulation_json = o.simulation_json;
     start.calibration = calibration.calibration     ? *calibration.calibration
                         : calibration.from_profiles ? copy_into_study(store, *calibration.from_profiles)
                                                     : record_display(store, in.display_scene, in.protocol.scene);
@@ -165,7 +183,7 @@ int run_session(const RunOptions& o) {
     store_options.max_size_bytes = o.db_max_bytes;
     std::optional<st::Store> existing = read_existing_study(o.db, store_options);
     const SessionToRun run = session_to_run(o, existing, protocol, in.protocol_sha, in.scene_sha, code);
-    SessionObserver observer(o, observer_seed_to_run(o, run), std::move(in.script));
+    SessionObserver observer(o, observer_seed_to_run(o, run), std::move(in.script), model_observer_params(o, protocol));
     Replayed replayed = replay_logged(protocol, run, o.db, observer);
 
     // --- The display's calibration (calibration_policy.h): warnings before the

@@ -363,7 +363,11 @@ std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, 
                          "system that supports shared memory)",
                          str(path), mode));
     }
-    db->exec("PRAGMA synchronous = FULL", "set synchronous = FULL");
+    if (options.durable) {
+        db->exec("PRAGMA synchronous = FULL", "set synchronous = FULL");
+    } else {
+        db->exec("PRAGMA synchronous = OFF", "set synchronous = OFF");
+    }
     if (options.max_size_bytes > 0) {
         const std::int64_t page = db->query_int("PRAGMA page_size", "read the page size");
         db->exec(pragma("max_page_count", std::max<std::int64_t>(1, options.max_size_bytes / page)).c_str(),

@@ -37,6 +37,9 @@ struct Store::Impl {
     SessionStatus status_of(SessionId session, std::string_view doing);
     SessionRecord read_session(SessionId session, std::string_view doing);
     std::vector<TrialRecord> read_trials(SessionId session, std::string_view doing);
+    /// Checks trial t against the session under the write lock (running, the
+    /// next index, JSON that parses) and inserts it. Call inside a write transaction.
+    void insert_trial(SessionId session, const TrialRecord& t, const std::string& doing);
     std::string read_protocol_text(SessionId session, std::string_view doing);
     std::optional<std::string> read_scene_text(SessionId session, std::string_view doing);
     /// Stores `text` in the protocols or scenes table once per SHA-256 and

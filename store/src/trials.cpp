@@ -28,70 +28,99 @@ std::string why_invalid(const TrialRecord& t) {
 
 }  // namespace
 
+// The body of record_trial's and record_trials' transactions.
+void Store::Impl::insert_trial(SessionId session, const TrialRecord& t, const std::string& doing) {
+    Impl& impl = *this;
+    {
+        // The session must be running, the index must be the next one (no gap,
+        // no overwrite), and the JSON must parse: all checked under the write
+        // lock, so two writers cannot both take the same index.
+        sql::Use s(db->cached("SELECT s.status, "
+                             "coalesce((SELECT max(trial_index) FROM trials WHERE session_id = s.id), -1) + 1, "
+                             "json_valid(?2), json_valid(?3) FROM sessions s WHERE s.id = ?1"));
+        s->bind(1, session.value);
+        s->bind(2, t.stimulus_json);
+        s->bind(3, t.procedure_state_json);
+        if (!s->step(doing)) impl.not_found(doing, fmt::format("session {}", session.value));
+        const std::string status = s->text(0);
+        if (status != "running") {
+            impl.invalid(doing, fmt::format("session {} is {}, not running", session.value, status));
+        }
+        if (const std::int64_t next = s->int64(1); next != t.trial_index) {
+            impl.invalid(doing, fmt::format("the session's next trial index is {}", next));
+        }
+        if (s->int64(2) != 1) impl.invalid(doing, "stimulus_json is not valid JSON");
+        if (s->int64(3) != 1) impl.invalid(doing, "procedure_state_json is not valid JSON");
+    }
+    sql::Use s(db->cached(
+        "INSERT INTO trials (session_id, trial_index, block, condition_id, procedure_id, level, test_on_left, "
+        "stimulus_json, response, response_value, response_time_s, onset_time_s, dropped_frames, "
+        "missed_deadline, procedure_state_json, recorded_at) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, " ATONLAB_STORE_NOW ")"));
+    s->bind(1, session.value);
+    s->bind(2, t.trial_index);
+    s->bind(3, t.block);
+    s->bind(4, t.condition_id);
+    s->bind(5, t.procedure_id);
+    s->bind(6, t.level);
+    if (t.test_on_left) {
+        s->bind(7, *t.test_on_left ? 1 : 0);
+    } else {
+        s->bind_null(7);
+    }
+    s->bind(8, t.stimulus_json);
+    s->bind(9, t.response);
+    s->bind(10, t.response_value);
+    s->bind(11, t.response_time_s);
+    s->bind(12, t.onset_time_s);
+    s->bind(13, t.dropped_frames);
+    s->bind(14, t.missed_deadline ? 1 : 0);
+    s->bind(15, t.procedure_state_json);
+    s->run(doing);
+}
+
+namespace {
+
+/// A disk-full error says what was kept.
+[[noreturn]] void rethrow_disk_full(const StoreError& e, std::string_view what_was_not_stored) {
+    // The transaction was rolled back before any commit record reached the WAL.
+    throw StoreError(e.kind(), e.file(),
+                     fmt::format("{}; {} not stored, and the trials stored before {} intact", e.what(),
+                                 what_was_not_stored, what_was_not_stored == "this trial was" ? "it are" : "them are"),
+                     e.sqlite_code());
+}
+
+}  // namespace
+
 void Store::record_trial(SessionId session, const TrialRecord& t) {
     const std::string doing = fmt::format("record trial {} of session {}", t.trial_index, session.value);
     impl_->require_writable(doing);
     if (const std::string why = why_invalid(t); !why.empty()) impl_->invalid(doing, why);
-    sql::Connection& db = *impl_->db;
     try {
-        sql::Transaction tx(db, sql::Transaction::Kind::write, doing);
-        {
-            // The session must be running, the index must be the next one (no gap,
-            // no overwrite), and the JSON must parse: all checked under the write
-            // lock, so two writers cannot both take the same index.
-            sql::Use s(
-                db.cached("SELECT s.status, "
-                          "coalesce((SELECT max(trial_index) FROM trials WHERE session_id = s.id), -1) + 1, "
-                          "json_valid(?2), json_valid(?3) FROM sessions s WHERE s.id = ?1"));
-            s->bind(1, session.value);
-            s->bind(2, t.stimulus_json);
-            s->bind(3, t.procedure_state_json);
-            if (!s->step(doing)) impl_->not_found(doing, fmt::format("session {}", session.value));
-            const std::string status = s->text(0);
-            if (status != "running") {
-                impl_->invalid(doing, fmt::format("session {} is {}, not running", session.value, status));
-            }
-            if (const std::int64_t next = s->int64(1); next != t.trial_index) {
-                impl_->invalid(doing, fmt::format("the session's next trial index is {}", next));
-            }
-            if (s->int64(2) != 1) impl_->invalid(doing, "stimulus_json is not valid JSON");
-            if (s->int64(3) != 1) impl_->invalid(doing, "procedure_state_json is not valid JSON");
-        }
-        {
-            sql::Use s(db.cached(
-                "INSERT INTO trials (session_id, trial_index, block, condition_id, procedure_id, level, test_on_left, "
-                "stimulus_json, response, response_value, response_time_s, onset_time_s, dropped_frames, "
-                "missed_deadline, procedure_state_json, recorded_at) "
-                "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, " ATONLAB_STORE_NOW ")"));
-            s->bind(1, session.value);
-            s->bind(2, t.trial_index);
-            s->bind(3, t.block);
-            s->bind(4, t.condition_id);
-            s->bind(5, t.procedure_id);
-            s->bind(6, t.level);
-            if (t.test_on_left) {
-                s->bind(7, *t.test_on_left ? 1 : 0);
-            } else {
-                s->bind_null(7);
-            }
-            s->bind(8, t.stimulus_json);
-            s->bind(9, t.response);
-            s->bind(10, t.response_value);
-            s->bind(11, t.response_time_s);
-            s->bind(12, t.onset_time_s);
-            s->bind(13, t.dropped_frames);
-            s->bind(14, t.missed_deadline ? 1 : 0);
-            s->bind(15, t.procedure_state_json);
-            s->run(doing);
-        }
+        sql::Transaction tx(*impl_->db, sql::Transaction::Kind::write, doing);
+        impl_->insert_trial(session, t, doing);
         tx.commit();  // synchronous=FULL: the WAL is on disk when this returns
     } catch (const StoreError& e) {
         if (e.kind() != StoreErrc::disk_full) throw;
-        // The transaction was rolled back before any commit record reached the WAL.
-        throw StoreError(
-            e.kind(), e.file(),
-            std::string(e.what()) + "; this trial was not stored, and the trials stored before it are intact",
-            e.sqlite_code());
+        rethrow_disk_full(e, "this trial was");
+    }
+}
+
+void Store::record_trials(SessionId session, std::span<const TrialRecord> trials) {
+    if (trials.empty()) return;
+    const std::string doing = fmt::format("record trials {} to {} of session {}", trials.front().trial_index,
+                                          trials.back().trial_index, session.value);
+    impl_->require_writable(doing);
+    for (const TrialRecord& t : trials)
+        if (const std::string why = why_invalid(t); !why.empty())
+            impl_->invalid(doing, fmt::format("trial {}: {}", t.trial_index, why));
+    try {
+        sql::Transaction tx(*impl_->db, sql::Transaction::Kind::write, doing);
+        for (const TrialRecord& t : trials) impl_->insert_trial(session, t, doing);
+        tx.commit();
+    } catch (const StoreError& e) {
+        if (e.kind() != StoreErrc::disk_full) throw;
+        rethrow_disk_full(e, "these trials were");
     }
 }
 

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "atonlab/protocols/observer.h"
+
 namespace atonlab::runner {
 
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
@@ -14,11 +16,21 @@ namespace atonlab::runner {
 /// 6 the observer ended the session (quit key, confirmed), 128 + N stopped by signal N.
 struct RunOptions {
     std::string protocol;
+    /// Non-empty: the protocol's text, read instead of the file's (`atonlab
+    /// simulate`'s designs, protocol_variant.h); `protocol` still names the
+    /// file, for messages and the folder its scene and conditions files are in.
+    std::string protocol_text;
+    /// Non-empty: the session is a simulated one; stored as its
+    /// sessions.simulation_json (docs/simulate.md).
+    std::string simulation_json;
+    /// The model observer's parameters instead of the protocol's [observer]
+    /// table's (`atonlab simulate --observer` with --render-every-trial).
+    std::optional<protocols::ModelObserverParams> model_params;
     std::string db;
     std::string profiles;      ///< --profiles: the display-profile file (default: profile_location.h)
     bool no_profiles = false;  ///< --no-profiles: the study file's calibrations only
     bool model_observer = false;
-    std::string observer;  ///< the observer code (--observer)
+    std::string observer;  ///< the observer code (--observer); with model_observer, "model" when empty
     std::string script;    ///< scripted answers (--script)
     bool headless = false;
     std::optional<std::int64_t> resume;

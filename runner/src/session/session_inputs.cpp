@@ -44,7 +44,7 @@ std::string checked_observer_code(const RunOptions& o) {
                          "name the trial to stall with --inject-stall-at-trial N.");
     if (o.capture_trial && o.capture_dir.empty())
         throw InputError(SourceLocation::command_line("--capture-trial"), "give the folder with --capture-dir DIR.");
-    const std::string code = o.model_observer ? std::string("model") : (o.observer.empty() ? "script" : o.observer);
+    const std::string code = !o.observer.empty() ? o.observer : o.model_observer ? std::string("model") : "script";
     if (!valid_observer_code(code))
         throw InputError(SourceLocation::command_line("--observer"),
                          fmt::format("the observer code \"{}\" must be 1 to 32 letters, digits, '_' or '-' (a code, "
@@ -55,9 +55,17 @@ std::string checked_observer_code(const RunOptions& o) {
 
 SessionInputs load_session_inputs(const RunOptions& o) {
     SessionInputs in;
-    in.protocol = p::load_protocol(o.protocol);
+    if (o.protocol_text.empty()) {
+        in.protocol = p::load_protocol(o.protocol);
+        in.protocol_text = p::with_conditions_files(files::read_text(o.protocol, "protocol file"), o.protocol);
+    } else {
+        in.protocol_text = p::with_conditions_files(o.protocol_text, o.protocol);
+        in.protocol = p::parse_protocol(in.protocol_text, o.protocol);
+        if (!std::filesystem::is_regular_file(in.protocol.scene))
+            throw InputError(SourceLocation{o.protocol, 0, 0, "protocol.scene"},
+                             fmt::format("the scene file {} does not exist.", in.protocol.scene.string()));
+    }
     if (!o.script.empty()) in.script = p::ScriptedObserver::load(o.script);
-    in.protocol_text = p::with_conditions_files(files::read_text(o.protocol, "protocol file"), o.protocol);
     in.protocol_sha = store::sha256_hex(in.protocol_text);
     in.scene_text = files::read_text(in.protocol.scene, "scene template");
     in.scene_sha = store::sha256_hex(in.scene_text);

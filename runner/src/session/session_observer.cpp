@@ -27,8 +27,8 @@ p::Shown shown_for(const p::ScheduledTrial& t, StimulusRenderer& renderer,
 }
 
 SessionObserver::SessionObserver(const RunOptions& o, std::uint64_t observer_seed,
-                                 std::optional<p::ScriptedObserver> script)
-    : model_(o.model_observer), seed_(observer_seed), script_(std::move(script)) {}
+                                 std::optional<p::ScriptedObserver> script, p::ModelObserverParams params)
+    : model_(o.model_observer), seed_(observer_seed), params_(params), script_(std::move(script)) {}
 
 p::Answer SessionObserver::answer(const p::ScheduledTrial& t, StimulusRenderer* renderer) {
     if (!model_) return script_->answer(p::Shown{t.task, {}, t.stimulus.adjusted_view});

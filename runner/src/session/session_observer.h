@@ -26,7 +26,10 @@ protocols::Shown shown_for(const protocols::ScheduledTrial& t, StimulusRenderer&
 /// resumed session answers exactly as an uninterrupted one would have.
 class SessionObserver {
 public:
-    SessionObserver(const RunOptions& o, std::uint64_t observer_seed, std::optional<protocols::ScriptedObserver> script);
+    /// params: the model observer's (the protocol's [observer] table; ignored
+    /// unless o.model_observer).
+    SessionObserver(const RunOptions& o, std::uint64_t observer_seed, std::optional<protocols::ScriptedObserver> script,
+                    protocols::ModelObserverParams params = {});
 
     bool model() const noexcept { return model_; }
     bool person() const noexcept { return !model_ && !script_; }  ///< a person answers at the screen

@@ -116,10 +116,17 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
 
 std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s,
                        const std::optional<p::Response>& answer, const std::string& input, std::size_t step) {
+    return state_json(schedule, observer.person() ? "person" : observer.model() ? "model" : "script", observer.seed(),
+                      answer_rt_s, answer, input, step);
+}
+
+std::string state_json(const p::Schedule& schedule, std::string_view observer_kind, std::uint64_t observer_seed,
+                       double answer_rt_s, const std::optional<p::Response>& answer, const std::string& input,
+                       std::size_t step) {
     Json j;
     j["schedule"] = schedule.state();
-    j["observer"] = observer.person() ? "person" : observer.model() ? "model" : "script";
-    j["observer_seed"] = observer.seed();
+    j["observer"] = std::string(observer_kind);
+    j["observer_seed"] = observer_seed;
     j["answer_after_offset_s"] = answer_rt_s;
     j["step"] = step;
     if (answer) j["answer"] = std::string(p::response_word(*answer));

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "atonlab/protocols/protocol.h"
@@ -37,6 +38,11 @@ std::string stimulus_json(const protocols::Protocol& protocol, const protocols::
 /// was repeated), `input` the key or button, `step` the schedule's step.
 std::string state_json(const protocols::Schedule& schedule, const SessionObserver& observer, double answer_rt_s,
                        const std::optional<protocols::Response>& answer, const std::string& input, std::size_t step);
+/// The same for an observer named by its kind ("person", "model", "script",
+/// "simulated") and seed.
+std::string state_json(const protocols::Schedule& schedule, std::string_view observer_kind,
+                       std::uint64_t observer_seed, double answer_rt_s, const std::optional<protocols::Response>& answer,
+                       const std::string& input, std::size_t step);
 
 /// The observer seed a session's first trial recorded, if any.
 std::optional<std::uint64_t> logged_observer_seed(const std::vector<store::TrialRecord>& trials);

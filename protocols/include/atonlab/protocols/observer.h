@@ -151,6 +151,17 @@ public:
     /// Noiseless log10 brightness of a view.
     double log10_brightness(const View& v) const;
 
+    /// The noiseless decision variable of a 2AFC trial: log10 B(view 0) − log10 B(view 1).
+    double decision_2afc(const Shown& shown) const;
+    /// The noiseless decision variable of a yes-no trial: p·log10(E_inc / E_θ),
+    /// −∞ when the light adds no increment.
+    double decision_yes_no(const Shown& shown) const;
+    /// The answer to a 2AFC (or yes-no) trial whose decision variable is
+    /// `delta`: what answer() gives for a Shown with that decision variable,
+    /// draw for draw (simulated_observer.h answers tabulated trials with it).
+    Answer answer_2afc_delta(double delta);
+    Answer answer_yes_no_delta(double delta);
+
 private:
     double gaussian();
     Answer answer_2afc(const Shown& shown);

@@ -249,6 +249,14 @@ struct ResponseMap {
     std::optional<Action> screen_key_action(std::string_view key) const;
 };
 
+/// One key of the protocol's [observer] table (simulated_observer.h
+/// observer_keys()), checked against its range when the file was read.
+struct ObserverSetting {
+    std::string key;
+    double value = 0.0;
+    SourceLocation where;  ///< the file, line and key it was written at
+};
+
 struct Protocol {
     std::string file;  ///< as given to the parser (messages)
     std::string name;
@@ -260,6 +268,9 @@ struct Protocol {
     ResponseMap responses;
     Screens screens;
     std::vector<Block> blocks;
+    /// [observer]: the model observer's parameters and a simulated observer's
+    /// departures, in file order (simulated_observer.h observer_params()).
+    std::vector<ObserverSetting> observer;
 
     /// The condition called `name`, or nullptr.
     const Condition* find_condition(std::string_view name) const;

@@ -34,6 +34,12 @@ struct StoreOptions {
     /// StoreErrc::corrupt and left unchanged. false only for salvage: reading
     /// what is left of a file known to be damaged (read-only opens).
     bool verify = true;
+    /// true: every commit is on disk when it returns (synchronous = FULL).
+    /// false: commits are not synced (synchronous = OFF) and the caller makes
+    /// the file durable itself once it is written (syncfs before renaming it
+    /// into place): only for a file that can be written again from scratch,
+    /// such as a simulated session (docs/simulate.md). Never for a person's session.
+    bool durable = true;
 };
 
 class Store {
@@ -118,6 +124,11 @@ public:
     /// written. On any failure (disk full, I/O error) the trial is not stored and
     /// every earlier trial is intact.
     void record_trial(SessionId session, const TrialRecord& trial);
+    /// Records consecutive trials in ONE transaction, each checked as
+    /// record_trial checks it; all are stored or none. For a simulated session,
+    /// which can be recomputed from its seed (docs/simulate.md): a person's
+    /// session keeps record_trial's one commit per answer.
+    void record_trials(SessionId session, std::span<const TrialRecord> trials);
     /// The session's trials in trial_index order.
     std::vector<TrialRecord> trials(SessionId session) const;
     std::int64_t trial_count(SessionId session) const;
