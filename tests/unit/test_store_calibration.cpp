@@ -128,7 +128,7 @@ TEST(StoreSchemaV2, VersionOneFileMigratesKeepingEveryRow) {
     }
     RawDb raw(path);
     EXPECT_EQ(raw.integer("PRAGMA user_version"), schema_version());
-    EXPECT_EQ(raw.text("SELECT group_concat(version, ',') FROM schema_history"), "1,2,3,4,5,6");
+    EXPECT_EQ(raw.text("SELECT group_concat(version, ',') FROM schema_history"), "1,2,3,4,5,6,7");
     EXPECT_EQ(raw.text("SELECT ifnull(displayability_json, 'null') FROM sessions WHERE id = 1"), "null");
     EXPECT_EQ(raw.integer("SELECT count(*) FROM snapshots WHERE data = x'0102'"), 1);
     EXPECT_EQ(raw.text("SELECT source FROM calibrations WHERE id = 1"),

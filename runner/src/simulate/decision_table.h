@@ -40,7 +40,7 @@ struct DecisionTable {
     double bound = 0.0;          ///< the error bound asked for, decision units (log10 brightness)
     double largest_check = 0.0;  ///< the largest midpoint deviation of the last halving of any curve
     /// What the table holds the decision variable to: the larger of `bound`
-    /// and 1.5 × largest_check (the rendered decision variable is a step
+    /// and 5 × largest_check (the rendered decision variable is a step
     /// function of the level, one pixel's code at a time, which linear
     /// interpolation cannot follow closer than its steps).
     double stated_bound = 0.0;
