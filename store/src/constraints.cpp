@@ -23,38 +23,6 @@ bool iequals(std::string_view a, std::string_view b) {
     return true;
 }
 
-// Where the string literal, quoted identifier or comment starting at `i` ends
-// (one past it), or `i` when none starts there. SQLite's lexical rules
-// (sqlite.org/lang_keywords.html, lang_comment.html): '…' and "…" and `…`
-// with the quote doubled inside, […], -- to the end of the line, /* … */.
-std::size_t skip_quoted(std::string_view s, std::size_t i) {
-    const char c = s[i];
-    if (c == '\'' || c == '"' || c == '`') {
-        for (std::size_t j = i + 1; j < s.size(); ++j) {
-            if (s[j] != c) continue;
-            if (j + 1 < s.size() && s[j + 1] == c) {
-                ++j;
-                continue;
-            }
-            return j + 1;
-        }
-        return s.size();
-    }
-    if (c == '[') {
-        const std::size_t end = s.find(']', i);
-        return end == std::string_view::npos ? s.size() : end + 1;
-    }
-    if (s.substr(i, 2) == "--") {
-        const std::size_t end = s.find('\n', i);
-        return end == std::string_view::npos ? s.size() : end + 1;
-    }
-    if (s.substr(i, 2) == "/*") {
-        const std::size_t end = s.find("*/", i + 2);
-        return end == std::string_view::npos ? s.size() : end + 2;
-    }
-    return i;
-}
-
 // The text inside the parentheses that open at `open`, or nullopt when they
 // never close (the file's schema text would then not have loaded at all).
 std::optional<std::string_view> balanced(std::string_view s, std::size_t open) {
@@ -91,6 +59,37 @@ std::string one_line(std::string_view text) {
 }
 
 }  // namespace
+
+// SQLite's lexical rules
+// (sqlite.org/lang_keywords.html, lang_comment.html): '…' and "…" and `…`
+// with the quote doubled inside, […], -- to the end of the line, /* … */.
+std::size_t skip_quoted(std::string_view s, std::size_t i) {
+    const char c = s[i];
+    if (c == '\'' || c == '"' || c == '`') {
+        for (std::size_t j = i + 1; j < s.size(); ++j) {
+            if (s[j] != c) continue;
+            if (j + 1 < s.size() && s[j + 1] == c) {
+                ++j;
+                continue;
+            }
+            return j + 1;
+        }
+        return s.size();
+    }
+    if (c == '[') {
+        const std::size_t end = s.find(']', i);
+        return end == std::string_view::npos ? s.size() : end + 1;
+    }
+    if (s.substr(i, 2) == "--") {
+        const std::size_t end = s.find('\n', i);
+        return end == std::string_view::npos ? s.size() : end + 1;
+    }
+    if (s.substr(i, 2) == "/*") {
+        const std::size_t end = s.find("*/", i + 2);
+        return end == std::string_view::npos ? s.size() : end + 2;
+    }
+    return i;
+}
 
 std::vector<std::string> check_clauses(std::string_view sql) {
     std::vector<std::string> out;
@@ -151,6 +150,20 @@ TableConstraints table_constraints(sql::Connection& db, const std::string& table
         breaks.push_back(fmt::format("{} IS NULL", sql_identifier(column)));
         out.names.push_back(fmt::format("NOT NULL ({})", column));
     }
+    // Every value within the connection's length limit (sqlite.h,
+    // limit_to_atonlab). A longer text fails to load (SQLITE_TOOBIG) where an
+    // expression reads it; a blob's length is read from its record header
+    // without loading it, so it is compared here, as is a text that no CHECK
+    // or NOT NULL reads. typeof() loads nothing.
+    const std::int64_t limit = db.max_value_bytes();
+    sql::Statement all(db, "SELECT name FROM pragma_table_info(?1)");
+    all.bind(1, std::string_view(table));
+    while (all.step("list the columns")) {
+        const std::string column = all.text(0);
+        breaks.push_back(fmt::format("(typeof({0}) IN ('text', 'blob') AND length({0}) > {1})",
+                                     sql_identifier(column), limit));
+        out.names.push_back(fmt::format("{} ({}: at most {} bytes)", kLengthLimit, column, limit));
+    }
     if (breaks.empty()) {
         out.which = "NULL";
         return out;
@@ -178,8 +191,17 @@ std::vector<ConstraintViolation> find_constraint_violations(sql::Connection& db,
                                          "ORDER BY r",
                                          c.which, sql_identifier(table)));
         const std::string doing = fmt::format("check the constraints of the {} table", table);
-        while (s.step(doing)) {
-            out.push_back({table, s.int64(0), c.names.at(static_cast<std::size_t>(s.int64(1)))});
+        try {
+            while (s.step(doing)) {
+                out.push_back({table, s.int64(0), c.names.at(static_cast<std::size_t>(s.int64(1)))});
+                if (limit != 0 && out.size() >= limit) return out;
+            }
+        } catch (const StoreError& e) {
+            // A text or blob longer than the connection's limit, loaded by a
+            // CHECK or NOT NULL: SQLite stops the scan at that row (row id 0:
+            // which one is not known).
+            if ((e.sqlite_code() & 0xff) != SQLITE_TOOBIG) throw;
+            out.push_back({table, 0, fmt::format("{} (at most {} bytes)", kLengthLimit, db.max_value_bytes())});
             if (limit != 0 && out.size() >= limit) return out;
         }
     }
@@ -191,7 +213,9 @@ std::string describe(const std::vector<ConstraintViolation>& found) {
     const std::size_t shown = std::min<std::size_t>(found.size(), 3);
     for (std::size_t i = 0; i < shown; ++i) {
         const ConstraintViolation& v = found[i];
-        out += fmt::format("{}row {} of {} breaks {}", i == 0 ? "" : "; ", v.row_id, v.table, v.constraint);
+        out += v.row_id != 0 ? fmt::format("{}row {} of {} breaks {}", i == 0 ? "" : "; ", v.row_id, v.table,
+                                           v.constraint)
+                             : fmt::format("{}a row of {} breaks {}", i == 0 ? "" : "; ", v.table, v.constraint);
     }
     if (found.size() > shown) out += "; and more";
     return out;
