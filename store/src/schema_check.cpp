@@ -29,8 +29,8 @@ std::string quoted(std::string_view text) {
 
 // The database the first `version` steps make, in memory.
 std::unique_ptr<sql::Connection> reference_db(std::span<const Migration> steps, int version) {
-    auto db = std::make_unique<sql::Connection>(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE |
-                                                                SQLITE_OPEN_MEMORY);
+    auto db =
+        std::make_unique<sql::Connection>(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_MEMORY);
     for (const Migration& step : steps) {
         if (step.to_version > version) break;
         const std::string text(step.sql);
@@ -71,7 +71,8 @@ const Column* find_column(const std::vector<Column>& columns, const std::string&
 std::string column_difference(const std::string& table, const std::vector<Column>& ref,
                               const std::vector<Column>& file) {
     for (const Column& f : file)
-        if (!find_column(ref, std::get<0>(f))) return fmt::format("column {} was added to table {}", std::get<0>(f), table);
+        if (!find_column(ref, std::get<0>(f)))
+            return fmt::format("column {} was added to table {}", std::get<0>(f), table);
     for (const Column& r : ref) {
         const Column* f = find_column(file, std::get<0>(r));
         if (!f) return fmt::format("column {} of table {} is missing", std::get<0>(r), table);
@@ -107,8 +108,8 @@ std::string check_difference(const std::string& table, const std::string& ref_sq
 
 // Where two normalised texts first differ, as a short quote of each.
 std::string text_difference(const std::string& ref, const std::string& file) {
-    std::size_t at = static_cast<std::size_t>(std::mismatch(ref.begin(), ref.end(), file.begin(), file.end()).first -
-                                              ref.begin());
+    std::size_t at =
+        static_cast<std::size_t>(std::mismatch(ref.begin(), ref.end(), file.begin(), file.end()).first - ref.begin());
     at = at > 20 ? at - 20 : 0;  // a little context before it
     return fmt::format("the file has {} where atonlab's has {}", quoted(std::string_view(file).substr(at)),
                        quoted(std::string_view(ref).substr(at)));

@@ -24,13 +24,13 @@ namespace atonlab::store {
 namespace {
 
 namespace fs = std::filesystem;
+using ::atonlab::test::contains;
 using test_support::expect_store_error;
 using test_support::file_bytes;
 using test_support::make_start;
 using test_support::make_trial;
 using test_support::RawDb;
 using test_support::TempDir;
-using ::atonlab::test::contains;
 
 const fs::path kFixtures = fs::path(ATONLAB_SOURCE_DIR) / "tests/data/store_schema";
 
