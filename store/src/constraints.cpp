@@ -127,20 +127,23 @@ std::vector<std::string> check_clauses(std::string_view sql) {
     return out;
 }
 
-TableConstraints table_constraints(sql::Connection& db, const std::string& table) {
+TableConstraints table_constraints(sql::Connection& db, const std::string& table,
+                                   std::optional<std::string_view> create_table_sql) {
     TableConstraints out;
     std::vector<std::string> breaks;  // for each constraint, an SQL condition true for a row that breaks it
-    {
-        sql::Statement create(db, "SELECT sql FROM sqlite_schema WHERE type = 'table' AND name = ?1");
-        create.bind(1, std::string_view(table));
-        // A CHECK fails when its value, cast to NUMERIC, is zero; NULL passes
-        // (sqlite.org/lang_createtable.html, "CHECK constraints"). The body
-        // keeps its own lines, so a -- comment inside it ends where it ended.
-        if (create.step("read the table's schema") && !create.is_null(0)) {
-            for (const std::string& body : check_clauses(create.text(0))) {
-                breaks.push_back(fmt::format("CAST((\n{}\n) AS NUMERIC) = 0", body));
-                out.names.push_back(fmt::format("CHECK ({})", one_line(body)));
-            }
+    std::optional<std::string> create(create_table_sql);
+    if (!create) {
+        sql::Statement s(db, "SELECT sql FROM sqlite_schema WHERE type = 'table' AND name = ?1");
+        s.bind(1, std::string_view(table));
+        if (s.step("read the table's schema") && !s.is_null(0)) create = s.text(0);
+    }
+    // A CHECK fails when its value, cast to NUMERIC, is zero; NULL passes
+    // (sqlite.org/lang_createtable.html, "CHECK constraints"). The body
+    // keeps its own lines, so a -- comment inside it ends where it ended.
+    if (create) {
+        for (const std::string& body : check_clauses(*create)) {
+            breaks.push_back(fmt::format("CAST((\n{}\n) AS NUMERIC) = 0", body));
+            out.names.push_back(fmt::format("CHECK ({})", one_line(body)));
         }
     }
     sql::Statement columns(db, "SELECT name FROM pragma_table_info(?1) WHERE \"notnull\"");

@@ -9,6 +9,7 @@
 // connection run, so `analyze` sees what `run` sees.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,7 +47,10 @@ struct TableConstraints {
     std::string which;
     std::vector<std::string> names;  ///< "CHECK (json_valid(stimulus_json))", "NOT NULL (level)"
 };
-TableConstraints table_constraints(sql::Connection& db, const std::string& table);
+/// `create_table_sql`: the CHECK clauses from this text instead of the
+/// file's own (salvage judges an altered file's rows by atonlab's).
+TableConstraints table_constraints(sql::Connection& db, const std::string& table,
+                                   std::optional<std::string_view> create_table_sql = std::nullopt);
 
 /// The rows of every table of the file (sqlite_schema, not sqlite_*) that
 /// break a CHECK or NOT NULL constraint of the schema the file itself holds,

@@ -178,6 +178,13 @@ const std::vector<SchemaObject>& reference_schema(std::span<const Migration> ste
     return it->second;
 }
 
+std::optional<std::string> reference_table_sql(std::span<const Migration> steps, int version,
+                                               std::string_view table) {
+    for (const SchemaObject& o : reference_schema(steps, version))
+        if (o.type == "table" && o.name == table) return o.sql;
+    return std::nullopt;
+}
+
 std::optional<std::string> first_schema_difference(sql::Connection& db, const std::vector<SchemaObject>& file_schema,
                                                    std::span<const Migration> steps, int version) {
     const std::vector<SchemaObject>& ref = reference_schema(steps, version);

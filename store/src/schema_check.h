@@ -41,6 +41,11 @@ std::vector<SchemaObject> read_schema(sql::Connection& db);
 /// database: made once per list and version in an in-memory database and kept.
 const std::vector<SchemaObject>& reference_schema(std::span<const Migration> steps, int version);
 
+/// The CREATE TABLE text (normalised) of `table` in reference_schema(steps,
+/// version), or nullopt when that schema has no such table.
+std::optional<std::string> reference_table_sql(std::span<const Migration> steps, int version,
+                                               std::string_view table);
+
 /// The first way `file_schema` (read_schema of `db`) differs from the
 /// reference for `version`, as a clause ("the CHECK (…) of table observers was
 /// removed", "column y was added to table trials", "an index sessions_by_observer

@@ -242,6 +242,38 @@ TEST(StoreSchemaCheck, EveryKindOfDifferenceIsNamed) {
     }
 }
 
+TEST(StoreSchemaCheck, SalvageJudgesTheRowsOfAnAlteredFileByAtonlabsConstraints) {
+    // A weakened CHECK let in a trial atonlab never writes (response_time_s < 0).
+    TempDir dir;
+    const fs::path p = dir.path() / "weakened.db";
+    write_study(p);
+    {
+        RawDb raw(p);
+        ASSERT_EQ(raw.exec("PRAGMA writable_schema = ON; UPDATE sqlite_schema SET sql = replace(sql, "
+                           "'CHECK (response_time_s >= 0)', 'CHECK (response_time_s >= -100)') WHERE name = 'trials';"),
+                  "");
+    }
+    {
+        RawDb raw(p);  // a fresh connection holds the weakened CHECK
+        ASSERT_EQ(raw.exec("INSERT INTO trials (session_id, trial_index, block, condition_id, procedure_id, level, "
+                           "stimulus_json, response, response_time_s, onset_time_s, dropped_frames, missed_deadline, "
+                           "procedure_state_json, recorded_at) SELECT session_id, 5, block, condition_id, procedure_id, "
+                           "level, stimulus_json, response, -1, onset_time_s, dropped_frames, missed_deadline, "
+                           "procedure_state_json, recorded_at FROM trials WHERE trial_index = 0"),
+                  "");
+        ASSERT_EQ(raw.integer("SELECT count(*) FROM trials"), 6);
+    }
+    expect_altered(p, "the CHECK (response_time_s >= 0) of table trials differs");
+    StoreOptions salvage;
+    salvage.verify = false;
+    const Salvage got = Store::open_read_only(p, salvage).salvage();
+    EXPECT_EQ(got.trials.size(), 5u);
+    ASSERT_EQ(got.skipped.size(), 1u);
+    EXPECT_EQ(got.skipped[0].table, "trials");
+    EXPECT_EQ(got.skipped[0].row_id, 6);
+    EXPECT_EQ(got.skipped[0].why, "breaks CHECK (response_time_s >= 0)");
+}
+
 TEST(StoreSchemaCheck, ALayoutOnlyChangeIsNotAnAlteration) {
     // White space and comments: the same statement, as SQLite reads it.
     TempDir dir;
