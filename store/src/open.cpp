@@ -156,6 +156,13 @@ std::string one_line(const std::string& text) {
 // connection skips it anyway, and the one pass after it names the rows, so a
 // reader and a writer refuse the same file with the same sentence. Measured
 // at about 1 s for a 100 MB study (docs/store.md, "Opening").
+[[noreturn]] void fail_too_long(sql::Connection& db, FileKind kind, const std::string& where) {
+    fail(StoreErrc::corrupt, db.path(),
+         fmt::format("{} holds a text or blob longer than {} bytes, atonlab's limit for one value, which no study "
+                     "atonlab writes needs ({}); it was not changed ({})",
+                     str(db.path()), db.max_value_bytes(), where, damaged_hint(kind)));
+}
+
 void verify(sql::Connection& db, FileKind kind) {
     std::string report;
     try {
@@ -168,6 +175,8 @@ void verify(sql::Connection& db, FileKind kind) {
         // image is malformed", "unsupported file format", ...).
         if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other && e.kind() != StoreErrc::not_a_database)
             throw;
+        // A value over the connection's length limit stops SQLite's walk.
+        if ((e.sqlite_code() & 0xff) == SQLITE_TOOBIG) fail_too_long(db, kind, "found by SQLite's integrity check");
         report = sqlite3_errmsg(db.get());
     }
     if (report != "ok") {
@@ -178,12 +187,8 @@ void verify(sql::Connection& db, FileKind kind) {
     const std::vector<ConstraintViolation> broken = find_constraint_violations(db, 4);
     for (const ConstraintViolation& v : broken) {
         if (v.constraint.rfind(kLengthLimit, 0) != 0) continue;
-        fail(StoreErrc::corrupt, db.path(),
-             fmt::format("{} holds a text or blob longer than {} bytes, atonlab's limit for one value, which no "
-                         "study atonlab writes needs ({} of {}); it was not changed ({})",
-                         str(db.path()), db.max_value_bytes(),
-                         v.row_id != 0 ? fmt::format("row {}", v.row_id) : std::string("a row"), v.table,
-                         damaged_hint(kind)));
+        fail_too_long(db, kind,
+                      fmt::format("{} of {}", v.row_id != 0 ? fmt::format("row {}", v.row_id) : "a row", v.table));
     }
     if (!broken.empty()) {
         fail(StoreErrc::corrupt, db.path(),

@@ -346,6 +346,15 @@ TEST(StoreLimits, AValueLongerThanTheLimitIsRefusedAtTheOpenWithASentence) {
         {"text", "UPDATE protocols SET text = printf('%.*c', 5000, 'x')", "(a row of protocols)"},
         // A blob in a column nothing else reads: its length, from the record header.
         {"blob", "UPDATE sessions SET calibration_id = zeroblob(5000)", "(row 1 of sessions)"},
+        // A text in a nullable column no CHECK reads (trials are append-only: a
+        // new row); SQLite's integrity check, which reads it, stops at it.
+        {"nullable text",
+         "INSERT INTO trials (session_id, trial_index, block, condition_id, procedure_id, level, stimulus_json, "
+         "response, response_value, response_time_s, onset_time_s, dropped_frames, missed_deadline, "
+         "procedure_state_json, recorded_at) SELECT session_id, 5, block, condition_id, procedure_id, level, "
+         "stimulus_json, response, printf('%.*c', 5000, 'x'), response_time_s, onset_time_s, dropped_frames, "
+         "missed_deadline, procedure_state_json, recorded_at FROM trials WHERE trial_index = 0",
+         "(found by SQLite's integrity check)"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.name);
