@@ -148,6 +148,15 @@ std::string one_line(const std::string& text) {
     return out;
 }
 
+// A value longer than the connection's limit on one text or blob
+// (sqlite.h, limit_to_atonlab; docs/store.md, "Limits"), `where` in the file.
+[[noreturn]] void fail_too_long(sql::Connection& db, FileKind kind, const std::string& where) {
+    fail(StoreErrc::corrupt, db.path(),
+         fmt::format("{} holds a text or blob longer than {} bytes, atonlab's limit for one value, which no study "
+                     "atonlab writes needs ({}); it was not changed ({})",
+                     str(db.path()), db.max_value_bytes(), where, damaged_hint(kind)));
+}
+
 // PRAGMA integrity_check, stopped at its first problem: b-tree structure,
 // free list, every record's format, NOT NULL constraints, and that every
 // index matches its table (quick_check skips that last part); then the
@@ -156,13 +165,6 @@ std::string one_line(const std::string& text) {
 // connection skips it anyway, and the one pass after it names the rows, so a
 // reader and a writer refuse the same file with the same sentence. Measured
 // at about 1 s for a 100 MB study (docs/store.md, "Opening").
-[[noreturn]] void fail_too_long(sql::Connection& db, FileKind kind, const std::string& where) {
-    fail(StoreErrc::corrupt, db.path(),
-         fmt::format("{} holds a text or blob longer than {} bytes, atonlab's limit for one value, which no study "
-                     "atonlab writes needs ({}); it was not changed ({})",
-                     str(db.path()), db.max_value_bytes(), where, damaged_hint(kind)));
-}
-
 void verify(sql::Connection& db, FileKind kind) {
     std::string report;
     try {

@@ -37,8 +37,8 @@ struct StoreOptions {
     /// known to be damaged or altered (read-only opens).
     bool verify = true;
     /// The longest text or blob the connection reads or writes
-    /// (SQLITE_LIMIT_LENGTH; docs/store.md, "Limits"): 256 MiB, over ten times
-    /// the largest snapshot measured. A file holding a longer value is refused
+    /// (SQLITE_LIMIT_LENGTH; docs/store.md, "Limits"): 256 MiB, over a thousand
+    /// times the largest snapshot measured (182 KB). A file holding a longer value is refused
     /// at open (with verify) or where the value is read. Lower it only to test
     /// that refusal; SQLite itself allows at most 1,000,000,000 bytes.
     std::int64_t max_value_bytes = std::int64_t{256} << 20;
