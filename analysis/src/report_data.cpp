@@ -280,6 +280,7 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
     for (const DamagedInput& x : d.damaged)
         j["damaged_inputs"].push_back(Json{{"file", x.file},
                                            {"problem", x.problem},
+                                           {"schema_altered", x.schema_altered},
                                            {"sessions_read", static_cast<std::int64_t>(x.sessions_read)},
                                            {"trials_read", static_cast<std::int64_t>(x.trials_read)},
                                            {"sessions_unreadable", x.sessions_unreadable},

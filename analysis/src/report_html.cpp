@@ -509,8 +509,12 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
         h += fmt::format(
             "<div class=\"warn\"><p><b>Damaged input: <code>{}</code></b> was read with <code>--salvage</code>: "
             "{} session(s) and {} trial(s) were read; {} trial row(s) and {} session row(s) could not be read. "
-            "What is wrong: {}</p>\n",
-            esc(x.file), x.sessions_read, x.trials_read, x.trials_unreadable, x.sessions_unreadable, esc(x.problem));
+            "{}What is wrong: {}</p>\n",
+            esc(x.file), x.sessions_read, x.trials_read, x.trials_unreadable, x.sessions_unreadable,
+            x.schema_altered ? "<b>Its schema was altered</b>: its tables are not the ones atonlab made, so its rows "
+                               "were held to constraints atonlab did not write. "
+                             : "",
+            esc(x.problem));
         if (!x.skipped_rows.empty()) {
             h += "<p>Rows left out:</p>\n<ul>\n";
             for (const std::string& row : x.skipped_rows) h += "<li>" + esc(row) + "</li>\n";

@@ -202,7 +202,8 @@ Dataset read_study(const std::filesystem::path& study_file, bool salvage) {
     try {
         return read_store(store::Store::open_read_only(study_file), file);
     } catch (const store::StoreError& e) {
-        if (salvage && e.kind() == store::StoreErrc::corrupt) return salvage_store(study_file, e);
+        if (salvage && (e.kind() == store::StoreErrc::corrupt || e.kind() == store::StoreErrc::schema_altered))
+            return salvage_store(study_file, e);
         if (e.kind() != store::StoreErrc::older_schema) throw;
     }
     // A file of an older schema can only be migrated by a writer, and the input
@@ -423,9 +424,9 @@ Dataset read_store(const store::Store& db, const std::string& file) {
     return d;
 }
 
-// A damaged file, read row by row: every session and trial SQLite can still
-// read. The file is opened read-only without the integrity check (it has just
-// failed it); nothing in it is changed.
+// A damaged file, or one whose schema was altered, read row by row: every
+// session and trial SQLite can still read. The file is opened read-only
+// without the checks (it has just failed one); nothing in it is changed.
 Dataset salvage_store(const std::filesystem::path& study_file, const store::StoreError& damage) {
     const std::string file = study_file.string();
     store::StoreOptions options;
@@ -451,6 +452,7 @@ Dataset salvage_store(const std::filesystem::path& study_file, const store::Stor
     DamagedInput damaged;
     damaged.file = file;
     damaged.problem = damage.what();
+    damaged.schema_altered = damage.kind() == store::StoreErrc::schema_altered;
     damaged.sessions_read = got.sessions.size();
     for (const store::SessionRecord& s : got.sessions) damaged.trials_read += static_cast<std::size_t>(s.trial_count);
     damaged.sessions_unreadable = got.unreadable_sessions;

@@ -23,38 +23,6 @@ bool iequals(std::string_view a, std::string_view b) {
     return true;
 }
 
-// Where the string literal, quoted identifier or comment starting at `i` ends
-// (one past it), or `i` when none starts there. SQLite's lexical rules
-// (sqlite.org/lang_keywords.html, lang_comment.html): '…' and "…" and `…`
-// with the quote doubled inside, […], -- to the end of the line, /* … */.
-std::size_t skip_quoted(std::string_view s, std::size_t i) {
-    const char c = s[i];
-    if (c == '\'' || c == '"' || c == '`') {
-        for (std::size_t j = i + 1; j < s.size(); ++j) {
-            if (s[j] != c) continue;
-            if (j + 1 < s.size() && s[j + 1] == c) {
-                ++j;
-                continue;
-            }
-            return j + 1;
-        }
-        return s.size();
-    }
-    if (c == '[') {
-        const std::size_t end = s.find(']', i);
-        return end == std::string_view::npos ? s.size() : end + 1;
-    }
-    if (s.substr(i, 2) == "--") {
-        const std::size_t end = s.find('\n', i);
-        return end == std::string_view::npos ? s.size() : end + 1;
-    }
-    if (s.substr(i, 2) == "/*") {
-        const std::size_t end = s.find("*/", i + 2);
-        return end == std::string_view::npos ? s.size() : end + 2;
-    }
-    return i;
-}
-
 // The text inside the parentheses that open at `open`, or nullopt when they
 // never close (the file's schema text would then not have loaded at all).
 std::optional<std::string_view> balanced(std::string_view s, std::size_t open) {
@@ -92,6 +60,37 @@ std::string one_line(std::string_view text) {
 
 }  // namespace
 
+// SQLite's lexical rules
+// (sqlite.org/lang_keywords.html, lang_comment.html): '…' and "…" and `…`
+// with the quote doubled inside, […], -- to the end of the line, /* … */.
+std::size_t skip_quoted(std::string_view s, std::size_t i) {
+    const char c = s[i];
+    if (c == '\'' || c == '"' || c == '`') {
+        for (std::size_t j = i + 1; j < s.size(); ++j) {
+            if (s[j] != c) continue;
+            if (j + 1 < s.size() && s[j + 1] == c) {
+                ++j;
+                continue;
+            }
+            return j + 1;
+        }
+        return s.size();
+    }
+    if (c == '[') {
+        const std::size_t end = s.find(']', i);
+        return end == std::string_view::npos ? s.size() : end + 1;
+    }
+    if (s.substr(i, 2) == "--") {
+        const std::size_t end = s.find('\n', i);
+        return end == std::string_view::npos ? s.size() : end + 1;
+    }
+    if (s.substr(i, 2) == "/*") {
+        const std::size_t end = s.find("*/", i + 2);
+        return end == std::string_view::npos ? s.size() : end + 2;
+    }
+    return i;
+}
+
 std::vector<std::string> check_clauses(std::string_view sql) {
     std::vector<std::string> out;
     for (std::size_t i = 0; i < sql.size();) {
@@ -128,20 +127,23 @@ std::vector<std::string> check_clauses(std::string_view sql) {
     return out;
 }
 
-TableConstraints table_constraints(sql::Connection& db, const std::string& table) {
+TableConstraints table_constraints(sql::Connection& db, const std::string& table,
+                                   std::optional<std::string_view> create_table_sql) {
     TableConstraints out;
     std::vector<std::string> breaks;  // for each constraint, an SQL condition true for a row that breaks it
-    {
-        sql::Statement create(db, "SELECT sql FROM sqlite_schema WHERE type = 'table' AND name = ?1");
-        create.bind(1, std::string_view(table));
-        // A CHECK fails when its value, cast to NUMERIC, is zero; NULL passes
-        // (sqlite.org/lang_createtable.html, "CHECK constraints"). The body
-        // keeps its own lines, so a -- comment inside it ends where it ended.
-        if (create.step("read the table's schema") && !create.is_null(0)) {
-            for (const std::string& body : check_clauses(create.text(0))) {
-                breaks.push_back(fmt::format("CAST((\n{}\n) AS NUMERIC) = 0", body));
-                out.names.push_back(fmt::format("CHECK ({})", one_line(body)));
-            }
+    std::optional<std::string> create(create_table_sql);
+    if (!create) {
+        sql::Statement s(db, "SELECT sql FROM sqlite_schema WHERE type = 'table' AND name = ?1");
+        s.bind(1, std::string_view(table));
+        if (s.step("read the table's schema") && !s.is_null(0)) create = s.text(0);
+    }
+    // A CHECK fails when its value, cast to NUMERIC, is zero; NULL passes
+    // (sqlite.org/lang_createtable.html, "CHECK constraints"). The body
+    // keeps its own lines, so a -- comment inside it ends where it ended.
+    if (create) {
+        for (const std::string& body : check_clauses(*create)) {
+            breaks.push_back(fmt::format("CAST((\n{}\n) AS NUMERIC) = 0", body));
+            out.names.push_back(fmt::format("CHECK ({})", one_line(body)));
         }
     }
     sql::Statement columns(db, "SELECT name FROM pragma_table_info(?1) WHERE \"notnull\"");
@@ -150,6 +152,27 @@ TableConstraints table_constraints(sql::Connection& db, const std::string& table
         const std::string column = columns.text(0);
         breaks.push_back(fmt::format("{} IS NULL", sql_identifier(column)));
         out.names.push_back(fmt::format("NOT NULL ({})", column));
+    }
+    // Every value within the connection's length limit (sqlite.h,
+    // limit_to_atonlab). A text longer than it fails to load (SQLITE_TOOBIG):
+    // `c < ''` (never true) loads it without counting its characters, as
+    // length() would, and SQLite cannot fold it away as it folds `IS NULL` on
+    // a NOT NULL column. A blob's length is read from its record header
+    // without loading it, so it is compared. typeof() loads nothing. A file
+    // no longer than the limit cannot hold a longer value (its pages hold
+    // every byte of every value), so the checks are left out for it: most
+    // studies (docs/store.md, "Limits").
+    const std::int64_t limit = db.max_value_bytes();
+    const std::int64_t file_bytes = db.query_int("PRAGMA page_count", "read the file's size") *
+                                    db.query_int("PRAGMA page_size", "read the file's size");
+    sql::Statement all(db, "SELECT name FROM pragma_table_info(?1)");
+    all.bind(1, std::string_view(table));
+    while (file_bytes > limit && all.step("list the columns")) {
+        const std::string column = all.text(0);
+        breaks.push_back(fmt::format("CASE typeof({0}) WHEN 'blob' THEN length({0}) > {1} WHEN 'text' THEN {0} < '' "
+                                     "ELSE 0 END",
+                                     sql_identifier(column), limit));
+        out.names.push_back(fmt::format("{} ({}: at most {} bytes)", kLengthLimit, column, limit));
     }
     if (breaks.empty()) {
         out.which = "NULL";
@@ -178,8 +201,17 @@ std::vector<ConstraintViolation> find_constraint_violations(sql::Connection& db,
                                          "ORDER BY r",
                                          c.which, sql_identifier(table)));
         const std::string doing = fmt::format("check the constraints of the {} table", table);
-        while (s.step(doing)) {
-            out.push_back({table, s.int64(0), c.names.at(static_cast<std::size_t>(s.int64(1)))});
+        try {
+            while (s.step(doing)) {
+                out.push_back({table, s.int64(0), c.names.at(static_cast<std::size_t>(s.int64(1)))});
+                if (limit != 0 && out.size() >= limit) return out;
+            }
+        } catch (const StoreError& e) {
+            // A text or blob longer than the connection's limit, loaded by a
+            // CHECK or NOT NULL: SQLite stops the scan at that row (row id 0:
+            // which one is not known).
+            if ((e.sqlite_code() & 0xff) != SQLITE_TOOBIG) throw;
+            out.push_back({table, 0, fmt::format("{} (at most {} bytes)", kLengthLimit, db.max_value_bytes())});
             if (limit != 0 && out.size() >= limit) return out;
         }
     }
@@ -191,7 +223,9 @@ std::string describe(const std::vector<ConstraintViolation>& found) {
     const std::size_t shown = std::min<std::size_t>(found.size(), 3);
     for (std::size_t i = 0; i < shown; ++i) {
         const ConstraintViolation& v = found[i];
-        out += fmt::format("{}row {} of {} breaks {}", i == 0 ? "" : "; ", v.row_id, v.table, v.constraint);
+        out += v.row_id != 0 ? fmt::format("{}row {} of {} breaks {}", i == 0 ? "" : "; ", v.row_id, v.table,
+                                           v.constraint)
+                             : fmt::format("{}a row of {} breaks {}", i == 0 ? "" : "; ", v.table, v.constraint);
     }
     if (found.size() > shown) out += "; and more";
     return out;

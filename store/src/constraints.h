@@ -9,6 +9,7 @@
 // connection run, so `analyze` sees what `run` sees.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,14 +22,22 @@ namespace atonlab::store::detail {
 struct ConstraintViolation {
     std::string table;
     std::int64_t row_id = 0;
-    std::string constraint;  ///< "CHECK (json_valid(stimulus_json))" or "NOT NULL (level)"
+    std::string constraint;  ///< "CHECK (json_valid(stimulus_json))", "NOT NULL (level)", or kLengthLimit's
 };
+
+/// Where the string literal, quoted identifier or comment starting at `i` of
+/// `sql` ends (one past it), or `i` when none starts there.
+std::size_t skip_quoted(std::string_view sql, std::size_t i);
 
 /// The bodies of the CHECK clauses of one CREATE TABLE statement, in order,
 /// each without its outer parentheses ("json_valid(stimulus_json)"). String
 /// literals, quoted identifiers and comments are skipped, so a column named
 /// "checked" or a comment saying CHECK is not taken for one.
 std::vector<std::string> check_clauses(std::string_view create_table_sql);
+
+/// How TableConstraints::names starts for a value longer than the
+/// connection's limit on one text or blob (sqlite.h, limit_to_atonlab).
+inline constexpr std::string_view kLengthLimit = "the length limit on one value";
 
 /// One table's constraints as SQL over one of its rows: `which` is an
 /// expression whose value is the index in `names` of the first constraint
@@ -38,7 +47,10 @@ struct TableConstraints {
     std::string which;
     std::vector<std::string> names;  ///< "CHECK (json_valid(stimulus_json))", "NOT NULL (level)"
 };
-TableConstraints table_constraints(sql::Connection& db, const std::string& table);
+/// `create_table_sql`: the CHECK clauses from this text instead of the
+/// file's own (salvage judges an altered file's rows by atonlab's).
+TableConstraints table_constraints(sql::Connection& db, const std::string& table,
+                                   std::optional<std::string_view> create_table_sql = std::nullopt);
 
 /// The rows of every table of the file (sqlite_schema, not sqlite_*) that
 /// break a CHECK or NOT NULL constraint of the schema the file itself holds,

@@ -25,6 +25,8 @@ const char* to_string(StoreErrc kind) noexcept {
             return "newer_schema";
         case StoreErrc::older_schema:
             return "older_schema";
+        case StoreErrc::schema_altered:
+            return "schema_altered";
         case StoreErrc::read_only:
             return "read_only";
         case StoreErrc::disk_full:

@@ -15,6 +15,7 @@
 
 #include "atonlab/store/version.h"
 #include "constraints.h"
+#include "schema_check.h"
 
 namespace atonlab::store::detail {
 namespace {
@@ -121,7 +122,7 @@ void check_header(const fs::path& path, FileKind kind) {
 // json_valid(), which SQLite 3.40 (Debian 12) does not mark innocuous, so an
 // untrusted schema could not be written; with extensions off, no function a
 // file's schema can name has a side effect.
-void harden(sql::Connection& db) {
+void harden(sql::Connection& db, const StoreOptions& options) {
     for (const auto& [option, value] :
          {std::pair{SQLITE_DBCONFIG_DEFENSIVE, 1}, std::pair{SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0},
           std::pair{SQLITE_DBCONFIG_DQS_DDL, 0}, std::pair{SQLITE_DBCONFIG_DQS_DML, 0}}) {
@@ -129,6 +130,7 @@ void harden(sql::Connection& db) {
         if (rc != SQLITE_OK) db.fail(rc, fmt::format("set SQLite's defensive option {}", option));
     }
     db.exec("PRAGMA cell_size_check = ON", "turn on cell_size_check");
+    db.limit_to_atonlab(options.max_value_bytes);
 }
 
 // One line of at most 160 characters, for a sentence quoting SQLite's report
@@ -144,6 +146,15 @@ std::string one_line(const std::string& text) {
     }
     if (out.size() > 160) out = out.substr(0, 157) + "...";
     return out;
+}
+
+// A value longer than the connection's limit on one text or blob
+// (sqlite.h, limit_to_atonlab; docs/store.md, "Limits"), `where` in the file.
+[[noreturn]] void fail_too_long(sql::Connection& db, FileKind kind, const std::string& where) {
+    fail(StoreErrc::corrupt, db.path(),
+         fmt::format("{} holds a text or blob longer than {} bytes, atonlab's limit for one value, which no study "
+                     "atonlab writes needs ({}); it was not changed ({})",
+                     str(db.path()), db.max_value_bytes(), where, damaged_hint(kind)));
 }
 
 // PRAGMA integrity_check, stopped at its first problem: b-tree structure,
@@ -166,6 +177,8 @@ void verify(sql::Connection& db, FileKind kind) {
         // image is malformed", "unsupported file format", ...).
         if (e.kind() != StoreErrc::corrupt && e.kind() != StoreErrc::other && e.kind() != StoreErrc::not_a_database)
             throw;
+        // A value over the connection's length limit stops SQLite's walk.
+        if ((e.sqlite_code() & 0xff) == SQLITE_TOOBIG) fail_too_long(db, kind, "found by SQLite's integrity check");
         report = sqlite3_errmsg(db.get());
     }
     if (report != "ok") {
@@ -174,11 +187,33 @@ void verify(sql::Connection& db, FileKind kind) {
                          one_line(report), damaged_hint(kind)));
     }
     const std::vector<ConstraintViolation> broken = find_constraint_violations(db, 4);
+    for (const ConstraintViolation& v : broken) {
+        if (v.constraint.rfind(kLengthLimit, 0) != 0) continue;
+        fail_too_long(db, kind,
+                      fmt::format("{} of {}", v.row_id != 0 ? fmt::format("row {}", v.row_id) : "a row", v.table));
+    }
     if (!broken.empty()) {
         fail(StoreErrc::corrupt, db.path(),
              fmt::format("{} is damaged inside its records ({}); it was not changed ({})", str(db.path()),
                          describe(broken), damaged_hint(kind)));
     }
+}
+
+// The file's tables, columns, constraints, indexes, triggers and views
+// against those the first `version` steps make (schema_check.h). Cheap: the
+// reference is made once per version, and only sqlite_schema is read.
+void check_schema(sql::Connection& db, const std::vector<SchemaObject>& schema, std::span<const Migration> steps,
+                  int version, FileKind kind) {
+    const std::optional<std::string> difference = first_schema_difference(db, schema, steps, version);
+    if (!difference) return;
+    fail(StoreErrc::schema_altered, db.path(),
+         fmt::format("{}'s schema was altered ({}), so it is not the schema atonlab's migrations make for version "
+                     "{}; it was not changed ({})",
+                     str(db.path()), *difference, version,
+                     kind == FileKind::study
+                         ? "atonlab neither writes to nor analyses such a file: restore it from a backup, or read "
+                           "what it holds with atonlab analyze --salvage"
+                         : "restore it from a backup, or measure the displays again into a new profile file"));
 }
 
 // PRAGMA journal_mode = WAL needs an exclusive lock on a file not yet in WAL
@@ -262,7 +297,7 @@ std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, 
                       : access == Access::open_existing ? SQLITE_OPEN_READWRITE
                                                         : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
     auto db = std::make_unique<sql::Connection>(path, flags);
-    harden(*db);
+    harden(*db, options);
 
     // SQLITE_OPEN_READWRITE silently falls back to read-only on a write-protected file.
     if (access != Access::read_only && sqlite3_db_readonly(db->get(), "main") == 1) {
@@ -281,6 +316,7 @@ std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, 
     int version = 0;
     std::int64_t objects = 0;
     bool study_tables = false;
+    std::vector<SchemaObject> schema;
     try {
         sql::Transaction look(*db, sql::Transaction::Kind::read, "read the file header");
         app_id = db->query_int("PRAGMA application_id", "read the file header");
@@ -290,6 +326,7 @@ std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, 
                            "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN "
                            "('schema_history', 'sessions', 'trials')",
                            "look for the study's tables") == 3;
+        schema = read_schema(*db);  // with the version it belongs to
         look.commit();
     } catch (const StoreError& e) {
         if (e.kind() == StoreErrc::not_a_database) {
@@ -340,7 +377,11 @@ std::unique_ptr<sql::Connection> open_file(const fs::path& path, Access access, 
                          str(path), version, latest));
     }
 
-    if (!empty && options.verify) verify(*db, kind);
+    if (!empty && options.verify) {
+        // The schema first: the constraint scan evaluates the file's own CHECK texts.
+        check_schema(*db, schema, steps, version, kind);
+        verify(*db, kind);
+    }
 
     if (access == Access::read_only) {
         if (version < latest) {

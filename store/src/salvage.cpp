@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <map>
 
+#include "atonlab/store/schema.h"
 #include "constraints.h"
+#include "schema_check.h"
 #include "store_impl.h"
 
 namespace atonlab::store {
@@ -37,6 +39,26 @@ std::string broken_column(const detail::TableConstraints& c, const char* table, 
     return fmt::format("(SELECT {} FROM {} WHERE rowid = {})", c.which, table, id);
 }
 
+// The constraints a row of `table` is judged by: the CHECKs atonlab's own
+// migrations wrote for the file's version, so that a file whose schema was
+// altered (a CHECK weakened, removed) does not let through rows the analysis
+// assumes cannot exist; the file's own where atonlab's cannot be evaluated
+// on it (a column they name was removed).
+detail::TableConstraints constraints_for(sql::Connection& db, const char* table, int version) {
+    if (version >= 1 && version <= schema_version()) {
+        if (const auto own = detail::reference_table_sql(schema_migrations(), version, table)) {
+            try {
+                detail::TableConstraints c = detail::table_constraints(db, table, *own);
+                sql::Statement probe(db, fmt::format("SELECT {} FROM {} LIMIT 0", c.which, table));
+                return c;
+            } catch (const StoreError&) {
+                // fall back to the file's own constraints
+            }
+        }
+    }
+    return detail::table_constraints(db, table);
+}
+
 }  // namespace
 
 Salvage Store::salvage() const {
@@ -53,7 +75,7 @@ Salvage Store::salvage() const {
 
     // Sessions, one row id at a time; the trial count is of the trials read below.
     if (const auto last = largest_id(db, "SELECT max(id) FROM sessions", out.problems, "sessions")) {
-        const detail::TableConstraints c = detail::table_constraints(db, "sessions");
+        const detail::TableConstraints c = constraints_for(db, "sessions", file_schema_version());
         // displayability_json NULL: a damaged file may be of a schema before it (v4); the
         // scene's hash and name where the file has them (v6); last, the first constraint the
         // row breaks (NULL when none).
@@ -85,7 +107,7 @@ Salvage Store::salvage() const {
 
     // Trials, by row id: the table's b-tree only, not the (session, index) index.
     if (const auto last = largest_id(db, "SELECT max(id) FROM trials", out.problems, "trials")) {
-        const detail::TableConstraints c = detail::table_constraints(db, "trials");
+        const detail::TableConstraints c = constraints_for(db, "trials", file_schema_version());
         sql::Statement s(db, fmt::format("SELECT session_id, trial_index, block, condition_id, procedure_id, level, "
                                          "test_on_left, stimulus_json, response, response_value, response_time_s, "
                                          "onset_time_s, dropped_frames, missed_deadline, procedure_state_json, "

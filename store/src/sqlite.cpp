@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <limits>
 #include <utility>
 
@@ -197,8 +198,43 @@ void Connection::fail(int rc, std::string_view doing) const {
         code = sqlite3_extended_errcode(db_);
         message = sqlite3_errmsg(db_);
     }
+    // A value over limit_to_atonlab's length: say what the limit is.
+    if ((code & 0xff) == SQLITE_TOOBIG && db_ && message == "string or blob too big")
+        message += fmt::format(" (longer than {} bytes, atonlab's limit for one text or blob)", max_value_bytes());
     throw StoreError(kind_of(code), path_,
                      fmt::format("{}: could not {}: {} ({})", path_.string(), doing, message, code_name(code)), code);
+}
+
+void Connection::limit_to_atonlab(std::int64_t max_value_bytes) {
+    // What atonlab's own records need, with a wide margin (docs/store.md,
+    // "Limits", says how each was chosen); SQLite's defaults are far larger
+    // (sqlite.org/limits.html), sized for any application. A file from
+    // elsewhere then cannot make a statement allocate or recurse far beyond a
+    // real study's needs: a longer value, a deeper expression, more columns
+    // is an error (SQLITE_TOOBIG, SQLITE_ERROR) instead of memory and stack.
+    const int length = static_cast<int>(std::clamp<std::int64_t>(max_value_bytes, 1, std::numeric_limits<int>::max()));
+    constexpr int kSqlLengthBytes = 1 << 20;  // the longest statement atonlab prepares: a few kB
+    constexpr int kExprDepth = 100;           // atonlab's deepest expression: about 10
+    constexpr int kColumns = 100;             // the widest table or result: 19 (view trial_log)
+    constexpr int kVariables = 100;           // the highest parameter atonlab binds: ?15
+    constexpr int kTriggerDepth = 10;         // atonlab's triggers only RAISE: depth 1
+    constexpr int kLikePatternBytes = 1000;   // atonlab's LIKE and GLOB patterns: under 30 bytes
+    constexpr int kCompoundSelect = 10;       // atonlab writes no UNION
+    constexpr int kVdbeOps = 1'000'000;       // atonlab's longest statement: well under 10,000 operations
+    for (const auto& [id, value] : {std::pair{SQLITE_LIMIT_LENGTH, length}, std::pair{SQLITE_LIMIT_SQL_LENGTH, kSqlLengthBytes},
+                                    std::pair{SQLITE_LIMIT_EXPR_DEPTH, kExprDepth}, std::pair{SQLITE_LIMIT_COLUMN, kColumns},
+                                    std::pair{SQLITE_LIMIT_VARIABLE_NUMBER, kVariables},
+                                    std::pair{SQLITE_LIMIT_TRIGGER_DEPTH, kTriggerDepth},
+                                    std::pair{SQLITE_LIMIT_LIKE_PATTERN_LENGTH, kLikePatternBytes},
+                                    std::pair{SQLITE_LIMIT_COMPOUND_SELECT, kCompoundSelect},
+                                    std::pair{SQLITE_LIMIT_VDBE_OP, kVdbeOps},
+                                    std::pair{SQLITE_LIMIT_ATTACHED, 0}, std::pair{SQLITE_LIMIT_WORKER_THREADS, 0}}) {
+        sqlite3_limit(db_, id, value);  // returns the previous value; SQLite only ever lowers a limit here
+    }
+}
+
+std::int64_t Connection::max_value_bytes() const noexcept {
+    return sqlite3_limit(db_, SQLITE_LIMIT_LENGTH, -1);
 }
 
 void Connection::exec(const char* sql, std::string_view doing) {

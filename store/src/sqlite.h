@@ -51,6 +51,13 @@ public:
     /// Runs a statement returning one text value.
     std::string query_text(const char* sql, std::string_view doing);
 
+    /// Lowers SQLite's run-time limits (sqlite3_limit) to what atonlab's own
+    /// records need (docs/store.md, "Limits"); `max_value_bytes` is the
+    /// longest text or blob (SQLITE_LIMIT_LENGTH).
+    void limit_to_atonlab(std::int64_t max_value_bytes);
+    /// The longest text or blob this connection reads or writes (SQLITE_LIMIT_LENGTH).
+    std::int64_t max_value_bytes() const noexcept;
+
     /// A statement compiled once per connection and kept (SQLITE_PREPARE_PERSISTENT).
     /// Use it through a Use guard so it is always reset.
     Statement& cached(const char* sql);

@@ -8,6 +8,8 @@
 //    was; `analyze` refuses a damaged one (exit 4) and a foreign one (exit 2,
 //    docs/analysis.md), and with --salvage reads what is left and says so in
 //    the first lines of report.html and summary.json;
+//  - a schema altered by hand: refused by the same commands (exit 4) naming
+//    the difference, unchanged; --salvage says the schema was altered;
 //  - each headless refusal path of `run` (exit 2: a billboard too wide for the
 //    display, a session to resume in a file that does not exist or does not
 //    hold it; exit 3: no GL) leaves no study file behind and an existing one
@@ -338,6 +340,71 @@ TEST_F(StudyRefusals, ATrialOverwrittenInsideItsRecordIsRefusedByEveryCommandAnd
     EXPECT_EQ(store::number_at(summary, "/damaged_inputs/0/trials_read").value_or(-1), trials - 1);
     EXPECT_TRUE(contains(file_bytes(out / "report.html"), "trials row 2: breaks CHECK (json_valid(stimulus_json))"));
     EXPECT_EQ(file_bytes(p), before) << "salvage changed the file";
+}
+
+// A schema altered by hand (tests/data/store_schema/alterations.txt: a CHECK
+// replaced, a CHECK removed, a column added, an index dropped, a trigger
+// added, a view replaced; docs/store.md "Opening"): run, calibrate and analyze
+// exit 4 with one sentence naming the difference, and the file's bytes are
+// unchanged; analyze --salvage reads every trial and the first lines of
+// report.html and summary.json say that the schema was altered.
+TEST_F(StudyRefusals, ASchemaAlteredByHandIsRefusedByEveryCommandAndSalvageSaysSo) {
+    std::ifstream in(kData / "store_schema/alterations.txt");
+    int alterations = 0;
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        const auto a = line.find('|');
+        const auto b = line.find('|', a + 1);
+        const std::string name = line.substr(0, a);
+        SCOPED_TRACE(name);
+        ++alterations;
+        const fs::path p = copy_of_good((name + ".db").c_str());
+        {
+            RawDb raw(p);
+            ASSERT_EQ(raw.exec(line.substr(b + 1)), "");
+        }
+        const std::string before = file_bytes(p);
+        const std::string sentence = p.string() + "'s schema was altered (" + line.substr(a + 1, b - a - 1);
+
+        const Result run = run_tiny(p, tmp_.path(), "run");
+        EXPECT_EQ(run.code, 4) << run.err;
+        expect_one_sentence_naming(run, p);
+        EXPECT_TRUE(contains(run.err, sentence)) << run.err;
+        const Result cal = atonlab({"calibrate", "import", (kData / "calibration/display.ti3").string(), "--display",
+                                    "lcd", "--db", p.string(), "--width-px", "320", "--height-px", "180", "--width-m",
+                                    "0.1", "--viewing-distance-m", "0.9", "--date", "2024-03-12"},
+                                   tmp_.path(), "cal");
+        EXPECT_EQ(cal.code, 4) << cal.err;
+        EXPECT_TRUE(contains(cal.err, sentence)) << cal.err;
+        const fs::path out = tmp_.path() / (name + "-report");
+        const Result an = atonlab({"analyze", p.string(), "--out", out.string(), "--quiet"}, tmp_.path(), "an");
+        EXPECT_EQ(an.code, 4) << an.err;
+        expect_one_sentence_naming(an, p);
+        EXPECT_TRUE(contains(an.err, sentence)) << an.err;
+        EXPECT_FALSE(fs::exists(out / "report.html"));
+        EXPECT_EQ(file_bytes(p), before) << "a command changed the refused file";
+        if (name != "check_replaced") continue;
+
+        std::int64_t trials = 0;
+        {
+            RawDb raw(p, SQLITE_OPEN_READONLY);
+            trials = raw.integer("SELECT count(*) FROM trials");
+        }
+        const Result salvaged = atonlab(
+            {"analyze", p.string(), "--out", out.string(), "--quiet", "--salvage", "--bootstrap", "0"}, tmp_.path(),
+            "sv");
+        ASSERT_TRUE(salvaged.code == 0 || salvaged.code == 5) << salvaged.err;  // 5: figures missing without gnuplot
+        const nlohmann::json summary = store::parse_json(file_bytes(out / "summary.json"), "summary.json");
+        EXPECT_TRUE(store::boolean_at(summary, "/damaged_inputs/0/schema_altered").value_or(false));
+        EXPECT_TRUE(contains(store::string_at(summary, "/damaged_inputs/0/problem").value_or(""), sentence));
+        EXPECT_EQ(store::number_at(summary, "/damaged_inputs/0/trials_read").value_or(-1),
+                  static_cast<double>(trials));
+        const std::string html = file_bytes(out / "report.html");
+        EXPECT_TRUE(contains(html, "Its schema was altered")) << "report.html does not say so";
+        EXPECT_LT(html.find("Its schema was altered"), html.find("<h2")) << "not in the first lines";
+        EXPECT_EQ(file_bytes(p), before) << "salvage changed the file";
+    }
+    EXPECT_EQ(alterations, 6);
 }
 
 // A session's displayability_json overwritten inside its record: analyze

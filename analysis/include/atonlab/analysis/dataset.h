@@ -182,6 +182,9 @@ struct SnapshotRef {
 struct DamagedInput {
     std::string file;
     std::string problem;  ///< the store's sentence saying what is wrong
+    /// Its schema is not the one atonlab's migrations make (StoreErrc::schema_altered):
+    /// its rows were held to constraints atonlab did not write.
+    bool schema_altered = false;
     std::size_t sessions_read = 0;
     std::size_t trials_read = 0;
     std::int64_t sessions_unreadable = 0;  ///< session rows that could not be read

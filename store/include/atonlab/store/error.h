@@ -15,6 +15,7 @@ enum class StoreErrc {
     not_a_study,       ///< an SQLite database, but not one written by atonlab
     newer_schema,      ///< written by a newer atonlab (user_version above schema_version()); left untouched
     older_schema,      ///< needs a migration, but was opened read-only
+    schema_altered,    ///< its tables, indexes, triggers or views are not the ones atonlab's migrations make; left untouched
     read_only,         ///< opened for writing, but the file (or its directory) is write-protected
     disk_full,         ///< SQLITE_FULL: the disk, or the configured size limit, is full
     io_error,          ///< SQLITE_IOERR: the operating system refused a read or write

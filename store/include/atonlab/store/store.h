@@ -29,10 +29,12 @@ struct StoreOptions {
     /// StoreErrc::disk_full exactly as a full disk would. Lets a lab cap a study's
     /// size, and lets tests exercise the disk-full path.
     std::int64_t max_size_bytes = 0;
-    /// Check an existing file with SQLite's PRAGMA integrity_check before it is
-    /// used (docs/store.md, "Opening"): a damaged file is refused with
-    /// StoreErrc::corrupt and left unchanged. false only for salvage: reading
-    /// what is left of a file known to be damaged (read-only opens).
+    /// Check an existing file before it is used (docs/store.md, "Opening"):
+    /// its schema against the one atonlab's migrations make for its version
+    /// (StoreErrc::schema_altered), then SQLite's PRAGMA integrity_check and
+    /// the constraints over every row (StoreErrc::corrupt); a refused file is
+    /// left unchanged. false only for salvage: reading what is left of a file
+    /// known to be damaged or altered (read-only opens).
     bool verify = true;
     /// true: every commit is on disk when it returns (synchronous = FULL).
     /// false: commits are not synced (synchronous = OFF) and the caller makes
@@ -40,6 +42,12 @@ struct StoreOptions {
     /// into place): only for a file that can be written again from scratch,
     /// such as a simulated session (docs/simulate.md). Never for a person's session.
     bool durable = true;
+    /// The longest text or blob the connection reads or writes
+    /// (SQLITE_LIMIT_LENGTH; docs/store.md, "Limits"): 256 MiB, over a thousand
+    /// times the largest snapshot measured (182 KB). A file holding a longer value is refused
+    /// at open (with verify) or where the value is read. Lower it only to test
+    /// that refusal; SQLite itself allows at most 1,000,000,000 bytes.
+    std::int64_t max_value_bytes = std::int64_t{256} << 20;
 };
 
 class Store {
