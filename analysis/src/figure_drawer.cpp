@@ -43,13 +43,12 @@ bool FigureDrawer::draw(Figure f, const std::string& body) {
         return false;
     }
     std::error_code ec;
-    const bool written =
-        fs::file_size(out_dir_ / png, ec) > 0 && !ec && fs::file_size(out_dir_ / svg, ec) > 0 && !ec;
+    const bool written = fs::file_size(out_dir_ / png, ec) > 0 && !ec && fs::file_size(out_dir_ / svg, ec) > 0 && !ec;
     if (run.exit_status != 0 || !written) {
         std::string first = run.errors;
         if (const auto nl = first.find_last_not_of("\n "); nl != std::string::npos) first.erase(nl + 1);
-        result_.problems.push_back(fmt::format("figure {}: gnuplot failed (exit status {}): {}", f.id,
-                                               run.exit_status, first.empty() ? "no output file" : first));
+        result_.problems.push_back(fmt::format("figure {}: gnuplot failed (exit status {}): {}", f.id, run.exit_status,
+                                               first.empty() ? "no output file" : first));
         fs::remove(out_dir_ / png, ec);
         fs::remove(out_dir_ / svg, ec);
         return false;

@@ -52,31 +52,32 @@ std::string conditions_html(const SimulationResults& r) {
     const bool several = r.manifest.designs.size() > 1;
     std::string h = "<h2>Per design and condition</h2>\n<div class=\"table-wrap\"><table>\n<tr>";
     if (several) h += "<th>design</th>";
-    h += "<th>condition</th><th>true value</th><th>sessions</th><th>mean</th><th>median</th><th>bias</th>"
-         "<th>SD</th><th>RMSE</th><th>coverage</th><th>its 95% interval</th><th>median width</th>"
-         "<th>trials per session: median, P90</th><th>unreliable fits</th></tr>\n";
+    h += "<th>condition</th><th>true value</th><th>unit</th><th>sessions</th><th>mean</th><th>median</th>"
+         "<th>bias</th><th>SD</th><th>RMSE</th><th>coverage [95% interval]</th><th>median width</th>"
+         "<th>trials: median, P90</th><th>unreliable</th></tr>\n";
     for (const ConditionSummary& c : r.conditions) {
         h += "<tr>";
-        if (several) h += fmt::format("<td>{}</td>", esc(c.design.empty() ? fmt::format("{}", c.design_index) : c.design));
+        if (several)
+            h += fmt::format("<td>{}</td>", esc(c.design.empty() ? fmt::format("{}", c.design_index) : c.design));
         const bool low = c.coverage_ci && c.coverage_ci->upper < r.options.ci_level;
+        const std::string coverage = percent(c.coverage) + " " + ci_percent(c.coverage_ci);
         h += fmt::format(
-            "<td>{}</td><td class=\"num\">{}{} ({} at P = {:.3g}){}</td><td class=\"num\">{}</td><td "
-            "class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
-            "class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
-            "class=\"num\">{} {}</td><td class=\"num\">{} / {}</td></tr>\n",
-            esc(c.condition), f4(c.truth), c.truth_differs ? "*" : "", esc(c.truth_what), c.truth_p,
-            c.unit.empty() ? "" : " " + esc(c.unit), c.n_sessions, f4(c.mean), f4(c.median), f4(c.bias), f4(c.sd),
-            f4(c.rmse),
-            low ? "<span class=\"bad\">" + percent(c.coverage) + "</span>" : percent(c.coverage),
-            ci_percent(c.coverage_ci), f3(c.width_median),
-            c.trials_median ? fmt::format("{:g},", *c.trials_median) : "&ndash;",
-            c.trials_p90 ? fmt::format("{:g}", *c.trials_p90) : "", c.n_unreliable, c.n_estimates);
+            "<td>{}</td><td class=\"num\">{}{}<br><small>{} at P = {:.3g}</small></td><td>{}</td>"
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+            "<td class=\"num\">{}, {}</td><td class=\"num\">{} of {}</td></tr>\n",
+            esc(c.condition), f4(c.truth), c.truth_differs ? "*" : "", esc(c.truth_what), c.truth_p, esc(c.unit),
+            c.n_sessions, f4(c.mean), f4(c.median), f4(c.bias), f4(c.sd), f4(c.rmse),
+            low ? "<span class=\"bad\">" + coverage + "</span>" : coverage, f3(c.width_median),
+            c.trials_median ? fmt::format("{:g}", *c.trials_median) : "&ndash;",
+            c.trials_p90 ? fmt::format("{:g}", *c.trials_p90) : "&ndash;", c.n_unreliable, c.n_estimates);
     }
     h += "</table></div>\n";
     h += fmt::format(
-        "<p>Bias, SD and RMSE in the condition's level units. Coverage: of the {} sessions' intervals, the share "
-        "that holds the session's true value; in red where its Clopper-Pearson interval lies wholly below the "
-        "nominal {:.0f}%. * the sessions' true values differ (each estimate is compared with its own).</p>\n",
+        "<p>Bias, SD and RMSE in the condition's level units. Coverage: of the sessions' {} intervals, the share "
+        "that holds the session's true value, with its Clopper-Pearson 95% interval; in red where that interval "
+        "lies wholly below the nominal {:.0f}%. Unreliable: estimates the analysis flagged (kept in every number). "
+        "* the sessions' true values differ (each estimate is compared with its own).</p>\n",
         to_string(r.options.intervals), 100.0 * r.options.ci_level);
     return h;
 }
@@ -84,8 +85,9 @@ std::string conditions_html(const SimulationResults& r) {
 std::string power_html(const SimulationResults& r) {
     std::string h = "<h2>Power</h2>\n";
     if (!r.options.effect_log10)
-        return h + "<p>No effect was stated: give <code>--effect D</code> (log10 units) to see the power to detect "
-                   "it.</p>\n";
+        return h +
+               "<p>No effect was stated: give <code>--effect D</code> (log10 units) to see the power to detect "
+               "it.</p>\n";
     if (r.power.empty()) return h + "<p>No power could be computed (see the notes above).</p>\n";
     h += fmt::format(
         "<p>The share of sessions that would detect an effect of {} log10 units at &alpha; = {:.2g} (two-sided), "
@@ -98,8 +100,8 @@ std::string power_html(const SimulationResults& r) {
             "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
             esc(p.design.empty() ? fmt::format("{}", p.design_index) : p.design),
-            esc(p.condition_b.empty() ? fmt::format("{}: {}", p.condition_a, p.what) : p.what),
-            f4(p.true_difference), f4(p.sd_difference), p.n_sessions, percent(p.power), ci_percent(p.power_ci));
+            esc(p.condition_b.empty() ? fmt::format("{}: {}", p.condition_a, p.what) : p.what), f4(p.true_difference),
+            f4(p.sd_difference), p.n_sessions, percent(p.power), ci_percent(p.power_ci));
     return h + "</table></div>\n";
 }
 
@@ -111,9 +113,10 @@ std::string methods_html(const SimulationResults& r) {
               "of the maximum (Wilks 1938; Venzon &amp; Moolgavkar 1988); no resampling. An end the profile does not "
               "reach within the fit's search range is that range's limit (counted as <em>open</em> in "
               "summary.json)"
-            : fmt::format("the percentile interval of {} parametric bootstrap resamples per fit (Wichmann &amp; Hill "
-                          "2001b), exactly as the study report's",
-                          r.options.bootstrap);
+            : fmt::format(
+                  "the percentile interval of {} parametric bootstrap resamples per fit (Wichmann &amp; Hill "
+                  "2001b), exactly as the study report's",
+                  r.options.bootstrap);
     return "<h2>Methods</h2>\n<ul>\n"
            "<li>Each study file holds one simulated session and its observer's true values. Its conditions are "
            "estimated as the study report estimates one observer's (psychometric fit by binomial maximum "
@@ -145,10 +148,11 @@ void write_simulation_report_html(const std::filesystem::path& file, const Simul
     h += skipped_html(r);
     h += fmt::format("<p>Made by atonlab {} with <code>{}</code>.</p>\n", esc(ctx.software_version),
                      esc(ctx.command_line));
-    h += fmt::format("<p>Simulation folder <code>{}</code>: protocol <code>{}</code> (SHA-256 <code>{}</code>), {} "
-                     "design(s):</p>\n<ul>\n",
-                     esc(r.folder.string()), esc(r.manifest.protocol), esc(r.manifest.protocol_sha256.substr(0, 16)),
-                     r.manifest.designs.size());
+    h += fmt::format(
+        "<p>Simulation folder <code>{}</code>: protocol <code>{}</code> (SHA-256 <code>{}</code>), {} "
+        "design(s):</p>\n<ul>\n",
+        esc(r.folder.string()), esc(r.manifest.protocol), esc(r.manifest.protocol_sha256.substr(0, 16)),
+        r.manifest.designs.size());
     for (std::size_t i = 0; i < r.manifest.designs.size(); ++i) {
         const SimulationDesign& d = r.manifest.designs[i];
         h += fmt::format("<li>{}: <b>{}</b>{}</li>\n", i, esc(d.label.empty() ? "(the protocol as it is)" : d.label),

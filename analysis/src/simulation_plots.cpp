@@ -68,7 +68,8 @@ void strip_figure(detail::FigureDrawer& d, const SimulationResults& r, bool widt
         column[{c.design_index, c.condition}] = column.size() + 1;
         const double x = static_cast<double>(column.size());
         tics.push_back({num(x), column_label(r, c)});
-        if (!widths && c.bias && c.sd) summary.push_back({num(x), num(*c.bias), num(*c.bias - *c.sd), num(*c.bias + *c.sd)});
+        if (!widths && c.bias && c.sd)
+            summary.push_back({num(x), num(*c.bias), num(*c.bias - *c.sd), num(*c.bias + *c.sd)});
         if (widths && c.width_median) summary.push_back({num(x), num(*c.width_median)});
     }
     std::size_t i = 0;
@@ -87,10 +88,11 @@ void strip_figure(detail::FigureDrawer& d, const SimulationResults& r, bool widt
     xtics += ")\n";
     const double level = 100.0 * r.options.ci_level;
     std::string body =
-        widths ? axes(tics.size(), fmt::format("Width of each session's {:.0f}% interval ({})", level,
-                                                to_string(r.options.intervals)),
-                      unit_label(r, "interval width"))
-               : axes(tics.size(), "Each session's estimate minus its true value", unit_label(r, "estimate − truth"));
+        widths
+            ? axes(tics.size(),
+                   fmt::format("Width of each session's {:.0f}% interval ({})", level, to_string(r.options.intervals)),
+                   unit_label(r, "interval width"))
+            : axes(tics.size(), "Each session's estimate minus its true value", unit_label(r, "estimate − truth"));
     body += xtics;
     if (!widths) body += "set arrow from graph 0, first 0 to graph 1, first 0 nohead lc rgb '#444444' dt 2\n";
     body += fmt::format("plot {} using 1:2 with points pt 7 ps 0.35 lc rgb '#801f77b4' title 'one session'",
@@ -98,17 +100,19 @@ void strip_figure(detail::FigureDrawer& d, const SimulationResults& r, bool widt
     if (!summary.empty())
         body += widths ? fmt::format(", \\\n     {} using 1:2 with points pt 5 ps 1.6 lc rgb '#d62728' title 'median'",
                                      d.data("widths-median.tsv", summary))
-                       : fmt::format(", \\\n     {} using 1:2:3:4 with yerrorbars pt 5 ps 1.4 lw 2 lc rgb '#d62728' "
-                                     "title 'bias ± 1 SD'",
-                                     d.data("errors-summary.tsv", summary));
+                       : fmt::format(
+                             ", \\\n     {} using 1:2:3:4 with yerrorbars pt 5 ps 1.4 lw 2 lc rgb '#d62728' "
+                             "title 'bias ± 1 SD'",
+                             d.data("errors-summary.tsv", summary));
     body += "\n";
     Figure f;
     f.id = widths ? "simulation-widths" : "simulation-estimates";
     f.kind = f.id;
     f.title = widths ? "Interval widths" : "Estimates around the truth";
-    f.caption = widths ? fmt::format("Each dot is one session's {:.0f}% interval width (spread sideways to be seen); "
-                                     "the red square is the median.",
-                                     level)
+    f.caption = widths ? fmt::format(
+                             "Each dot is one session's {:.0f}% interval width (spread sideways to be seen); "
+                             "the red square is the median.",
+                             level)
                        : "Each dot is one session's estimate minus its own true value (spread sideways to be seen); "
                          "red: the mean error (the bias) ± 1 SD of the estimates. The dashed line is no error.";
     d.draw(std::move(f), body);
@@ -118,13 +122,15 @@ void coverage_figure(detail::FigureDrawer& d, const SimulationResults& r) {
     Rows rows, band;
     const double level = r.options.ci_level;
     double x_min = 1e300, x_max = 0.0;
+    // Conditions at the same trials side by side: each a little to the right of the last.
+    std::map<double, int> at_x;
     for (const ConditionSummary& c : r.conditions) {
         if (!c.coverage || !c.coverage_ci || !c.trials_median) continue;
-        const double x = *c.trials_median;
+        const double x = *c.trials_median * (1.0 + 0.004 * at_x[*c.trials_median]++);
         x_min = std::min(x_min, x);
         x_max = std::max(x_max, x);
-        rows.push_back({num(x), num(*c.coverage), num(c.coverage_ci->lower), num(c.coverage_ci->upper),
-                        column_label(r, c)});
+        rows.push_back(
+            {num(x), num(*c.coverage), num(c.coverage_ci->lower), num(c.coverage_ci->upper), column_label(r, c)});
         // Where an exact interval's coverage falls 95 % of the time with n sessions.
         const boost::math::binomial_distribution<> b(c.n_intervals, level);
         const double lo = boost::math::quantile(b, 0.025) / c.n_intervals;
@@ -133,18 +139,18 @@ void coverage_figure(detail::FigureDrawer& d, const SimulationResults& r) {
     }
     if (rows.empty()) return;
     const double pad = std::max(1.0, 0.1 * (x_max - x_min));
-    std::string body = "reset\nset datafile separator '\\t'\nset key bottom right box opaque\nset grid\n";
+    std::string body = "reset\nset datafile separator '\\t'\nset key above box\nset grid\n";
     body += fmt::format("set xrange [{}:{}]\nset yrange [*:1.02]\n", num(std::max(0.0, x_min - pad)), num(x_max + pad));
-    body += fmt::format("set title {}\nset xlabel 'trials per session (median of the condition)'\nset ylabel "
-                        "'coverage'\n",
-                        gp_quote(fmt::format("Coverage of the {:.0f}% intervals ({})", 100.0 * level,
-                                             to_string(r.options.intervals))));
+    body += fmt::format(
+        "set title {}\nset xlabel 'trials per session (median of the condition)'\nset ylabel "
+        "'coverage'\n",
+        gp_quote(fmt::format("Coverage of the {:.0f}% intervals ({})", 100.0 * level, to_string(r.options.intervals))));
     body += fmt::format("set arrow from graph 0, first {0} to graph 1, first {0} nohead lc rgb '#444444' dt 2\n",
                         num(level));
     body += fmt::format(
         "plot {} using 1:2:({}):3 with boxxyerror fs solid 0.25 noborder lc rgb '#888888' title 'a correct "
         "interval, 95% of the time', \\\n     {} using 1:2:3:4 with yerrorbars pt 7 ps 1.2 lc rgb '#1f77b4' title "
-        "'coverage (Clopper-Pearson 95%)', \\\n     '' using 1:2:5 with labels offset 1,0.8 left font ',8' notitle\n",
+        "'coverage (Clopper-Pearson 95%)', \\\n     '' using 1:2:5 with labels offset 0.8,0 left font ',8' notitle\n",
         d.data("coverage-band.tsv", band), num(0.25 * pad), d.data("coverage.tsv", rows));
     Figure f;
     f.id = "simulation-coverage";

@@ -22,7 +22,6 @@
 #include "atonlab/common/read_file.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/json.h"
-#include "atonlab/store/store.h"
 
 namespace atonlab::analysis {
 
@@ -161,9 +160,9 @@ SimulationManifest read_simulation_manifest(const fs::path& dir) {
         throw InputError(at("format"), "this is not an atonlab simulation manifest (format \"atonlab-simulation\")");
     const auto version = store::number_at(j, "/version");
     if (!version || *version < 1 || *version > kManifestVersion)
-        throw InputError(at("version"), fmt::format("version {} is not one this atonlab reads (1 to {})",
-                                                    version ? fmt::format("{}", *version) : "(none)",
-                                                    kManifestVersion));
+        throw InputError(at("version"),
+                         fmt::format("version {} is not one this atonlab reads (1 to {})",
+                                     version ? fmt::format("{}", *version) : "(none)", kManifestVersion));
     SimulationManifest m;
     m.protocol = store::string_at(j, "/protocol").value_or("");
     m.protocol_sha256 = store::string_at(j, "/protocol_sha256").value_or("");
@@ -196,17 +195,7 @@ SessionRead read_simulated_session(const fs::path& file, int design_index, const
         out.reason = fmt::format("its session is {}, not completed", info.status);
         return out;
     }
-    // SessionInfo does not carry simulation_json: read it from the store's record.
-    std::optional<std::string> simulation_json;
-    try {
-        store::StoreOptions so;
-        so.verify = false;  // read_study has just checked the file
-        const store::Store db = store::Store::open_read_only(file, so);
-        simulation_json = db.sessions().front().simulation_json;
-    } catch (const std::exception& e) {
-        out.reason = fmt::format("refused: {}", e.what());
-        return out;
-    }
+    const std::optional<std::string>& simulation_json = info.simulation_json;
     if (!simulation_json) {
         out.reason = "its session is not a simulated one (no simulation_json): an ordinary study file";
         return out;
@@ -262,8 +251,7 @@ SimulationResults analyze_simulation(const fs::path& dir, const SimulationOption
     std::atomic<std::size_t> next{0}, done{0};
     const auto work = [&] {
         for (std::size_t i = next++; i < found.size(); i = next++) {
-            if (found[i].skip.empty())
-                reads[i] = read_simulated_session(found[i].path, found[i].design_index, options);
+            if (found[i].skip.empty()) reads[i] = read_simulated_session(found[i].path, found[i].design_index, options);
             ++done;
         }
     };

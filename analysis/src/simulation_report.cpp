@@ -1,9 +1,10 @@
 // The simulation report's data files (simulation_report.h): summary.json,
 // simulation.csv and sessions.csv; the page is simulation_html.cpp, the
 // figures simulation_plots.cpp.
+#include "atonlab/analysis/simulation_report.h"
+
 #include <fmt/format.h>
 
-#include "atonlab/analysis/simulation_report.h"
 #include "atonlab/common/atomic_file.h"
 #include "atonlab/store/json.h"
 #include "csv.h"
@@ -82,20 +83,20 @@ Json power_json(const PowerSummary& p) {
 }  // namespace
 
 const std::vector<std::string>& simulation_csv_columns() {
-    static const std::vector<std::string> c{
-        "design_index", "design",         "condition",     "unit",        "true_what",     "true_p",
-        "true_value",   "true_min",       "true_max",      "sessions",    "estimates",     "unreliable",
-        "mean",         "median",         "bias",          "sd",          "rmse",          "intervals",
-        "covered",      "coverage",       "coverage_lower", "coverage_upper", "open_intervals", "width_median",
-        "trials_median", "trials_p90"};
+    static const std::vector<std::string> c{"design_index",   "design",         "condition",      "unit",
+                                            "true_what",      "true_p",         "true_value",     "true_min",
+                                            "true_max",       "sessions",       "estimates",      "unreliable",
+                                            "mean",           "median",         "bias",           "sd",
+                                            "rmse",           "intervals",      "covered",        "coverage",
+                                            "coverage_lower", "coverage_upper", "open_intervals", "width_median",
+                                            "trials_median",  "trials_p90"};
     return c;
 }
 
 const std::vector<std::string>& sessions_csv_columns() {
-    static const std::vector<std::string> c{"design_index", "design",  "index",   "seed",     "file",
-                                            "observer",     "condition", "true_value", "estimate", "lower",
-                                            "upper",        "open",    "covered", "trials",   "reliable",
-                                            "method"};
+    static const std::vector<std::string> c{"design_index", "design",     "index",    "seed",  "file",  "observer",
+                                            "condition",    "true_value", "estimate", "lower", "upper", "open",
+                                            "covered",      "trials",     "reliable", "method"};
     return c;
 }
 
@@ -108,23 +109,22 @@ void write_simulation_summary_json(const std::filesystem::path& file, const Simu
     j["command_line"] = ctx.command_line;
     j["folder"] = r.folder.string();
     Json designs = Json::array();
-    for (const SimulationDesign& d : r.manifest.designs) designs.push_back(Json{{"label", d.label}, {"overrides", d.overrides}});
+    for (const SimulationDesign& d : r.manifest.designs)
+        designs.push_back(Json{{"label", d.label}, {"overrides", d.overrides}});
     j["simulation"] = Json{{"protocol", r.manifest.protocol},
                            {"protocol_sha256", r.manifest.protocol_sha256},
                            {"designs", std::move(designs)}};
-    j["options"] = Json{{"intervals", to_string(r.options.intervals)},
-                        {"bootstrap", r.options.intervals == IntervalMethod::Bootstrap ? Json(r.options.bootstrap)
-                                                                                       : Json(nullptr)},
-                        {"bootstrap_interval", r.options.intervals == IntervalMethod::Bootstrap ? Json("percentile")
-                                                                                                : Json(nullptr)},
-                        {"seed", r.options.seed},
-                        {"family", to_string(r.options.family)},
-                        {"level", r.options.ci_level},
-                        {"effect_log10", or_null(r.options.effect_log10)},
-                        {"effect_between", r.options.effect_between
-                                               ? Json::array({r.options.effect_between->first,
-                                                              r.options.effect_between->second})
-                                               : Json(nullptr)}};
+    j["options"] = Json{
+        {"intervals", to_string(r.options.intervals)},
+        {"bootstrap", r.options.intervals == IntervalMethod::Bootstrap ? Json(r.options.bootstrap) : Json(nullptr)},
+        {"bootstrap_interval", r.options.intervals == IntervalMethod::Bootstrap ? Json("percentile") : Json(nullptr)},
+        {"seed", r.options.seed},
+        {"family", to_string(r.options.family)},
+        {"level", r.options.ci_level},
+        {"effect_log10", or_null(r.options.effect_log10)},
+        {"effect_between", r.options.effect_between
+                               ? Json::array({r.options.effect_between->first, r.options.effect_between->second})
+                               : Json(nullptr)}};
     Json skipped = Json::array();
     for (const SkippedFile& s : r.skipped) skipped.push_back(Json{{"file", s.file}, {"reason", s.reason}});
     j["files"] = Json{{"found", r.files_found}, {"read", r.sessions.size()}, {"skipped", r.skipped.size()}};
@@ -137,30 +137,47 @@ void write_simulation_summary_json(const std::filesystem::path& file, const Simu
     j["power"] = std::move(power);
     j["warnings"] = r.warnings;
     if (ctx.plots) j["figure_problems"] = ctx.plots->problems;
-    j["timing"] = Json{{"read_s", r.read_s},
-                       {"files_per_s", r.read_s > 0.0 ? Json(static_cast<double>(r.files_found) / r.read_s)
-                                                      : Json(nullptr)},
-                       {"threads", r.options.n_threads},
-                       {"bootstrap_fits", r.bootstrap_fits},
-                       {"bootstrap_fits_per_s", r.bootstrap_fits > 0 && r.read_s > 0.0
-                                                    ? Json(static_cast<double>(r.bootstrap_fits) / r.read_s)
-                                                    : Json(nullptr)},
-                       {"total_s", ctx.total_s}};
+    j["timing"] =
+        Json{{"read_s", r.read_s},
+             {"files_per_s", r.read_s > 0.0 ? Json(static_cast<double>(r.files_found) / r.read_s) : Json(nullptr)},
+             {"threads", r.options.n_threads},
+             {"bootstrap_fits", r.bootstrap_fits},
+             {"bootstrap_fits_per_s", r.bootstrap_fits > 0 && r.read_s > 0.0
+                                          ? Json(static_cast<double>(r.bootstrap_fits) / r.read_s)
+                                          : Json(nullptr)},
+             {"total_s", ctx.total_s}};
     files::write_file_atomically(file, store::dump_json(j, 2) + "\n");
 }
 
 void write_simulation_csv(const std::filesystem::path& file, const SimulationResults& r) {
     std::string out = row_of(simulation_csv_columns());
     for (const ConditionSummary& c : r.conditions) {
-        out += row_of({std::to_string(c.design_index), c.design, c.condition, c.unit, c.truth_what,
-                       detail::number_text(c.truth_p), cell(c.truth), c.truth ? detail::number_text(c.truth_min) : "",
-                       c.truth ? detail::number_text(c.truth_max) : "", std::to_string(c.n_sessions),
-                       std::to_string(c.n_estimates), std::to_string(c.n_unreliable), cell(c.mean), cell(c.median),
-                       cell(c.bias), cell(c.sd), cell(c.rmse), std::to_string(c.n_intervals),
-                       std::to_string(c.n_covered), cell(c.coverage),
+        out += row_of({std::to_string(c.design_index),
+                       c.design,
+                       c.condition,
+                       c.unit,
+                       c.truth_what,
+                       detail::number_text(c.truth_p),
+                       cell(c.truth),
+                       c.truth ? detail::number_text(c.truth_min) : "",
+                       c.truth ? detail::number_text(c.truth_max) : "",
+                       std::to_string(c.n_sessions),
+                       std::to_string(c.n_estimates),
+                       std::to_string(c.n_unreliable),
+                       cell(c.mean),
+                       cell(c.median),
+                       cell(c.bias),
+                       cell(c.sd),
+                       cell(c.rmse),
+                       std::to_string(c.n_intervals),
+                       std::to_string(c.n_covered),
+                       cell(c.coverage),
                        c.coverage_ci ? detail::number_text(c.coverage_ci->lower) : "",
-                       c.coverage_ci ? detail::number_text(c.coverage_ci->upper) : "", std::to_string(c.n_open),
-                       cell(c.width_median), cell(c.trials_median), cell(c.trials_p90)});
+                       c.coverage_ci ? detail::number_text(c.coverage_ci->upper) : "",
+                       std::to_string(c.n_open),
+                       cell(c.width_median),
+                       cell(c.trials_median),
+                       cell(c.trials_p90)});
     }
     files::write_file_atomically(file, out);
 }
@@ -168,10 +185,9 @@ void write_simulation_csv(const std::filesystem::path& file, const SimulationRes
 void write_sessions_csv(const std::filesystem::path& file, const SimulationResults& r) {
     std::string out = row_of(sessions_csv_columns());
     for (const SessionSummary& s : r.sessions) {
-        const std::string design =
-            static_cast<std::size_t>(s.design_index) < r.manifest.designs.size()
-                ? r.manifest.designs[static_cast<std::size_t>(s.design_index)].label
-                : std::string();
+        const std::string design = static_cast<std::size_t>(s.design_index) < r.manifest.designs.size()
+                                       ? r.manifest.designs[static_cast<std::size_t>(s.design_index)].label
+                                       : std::string();
         for (const SessionEstimate& e : s.conditions) {
             const bool covered = e.ci && e.truth && e.ci->contains(*e.truth);
             out += row_of({std::to_string(s.design_index), design, std::to_string(s.index), std::to_string(s.seed),

@@ -193,8 +193,7 @@ std::vector<PowerSummary> power_analyses(const std::vector<SessionSummary>& sess
                 if (!ea || !eb || !ea->estimate || !eb->estimate || !ea->truth || !eb->truth) continue;
                 const auto sa = se_of(*ea, level), sb = se_of(*eb, level);
                 if (!sa || !sb) continue;
-                samples.push_back(
-                    {*ea->estimate - *eb->estimate, *ea->truth - *eb->truth, std::hypot(*sa, *sb)});
+                samples.push_back({*ea->estimate - *eb->estimate, *ea->truth - *eb->truth, std::hypot(*sa, *sb)});
             }
             PowerSummary p = power_of(samples, *options.effect_log10, level);
             p.design_index = design;

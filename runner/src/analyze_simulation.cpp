@@ -80,7 +80,8 @@ int run_analyze_simulation(const AnalyzeOptions& o) {
         if (!tty || (done != total && now - last < std::chrono::milliseconds(200))) return;
         last = now;
         const double s = std::chrono::duration<double>(now - started).count();
-        std::fprintf(stderr, "\r\033[Kread %zu/%zu files (%.0f/s)", done, total, s > 0.0 ? static_cast<double>(done) / s : 0.0);
+        std::fprintf(stderr, "\r\033[Kread %zu/%zu files (%.0f/s)", done, total,
+                     s > 0.0 ? static_cast<double>(done) / s : 0.0);
         std::fflush(stderr);
     };
     const an::SimulationResults results = an::analyze_simulation(dir, so);

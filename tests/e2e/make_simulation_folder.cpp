@@ -31,13 +31,13 @@ int main(int argc, char** argv) {
     const int distinct = argc > 4 ? std::min(n, std::stoi(argv[4])) : n;
     fs::create_directories(dir / "sessions" / "00");
     using Json = nlohmann::ordered_json;
-    std::ofstream(dir / "simulation.json")
-        << atonlab::store::dump_json(Json{{"format", "atonlab-simulation"},
-                                          {"version", 1},
-                                          {"protocol", "sim.toml"},
-                                          {"protocol_sha256", "0"},
-                                          {"designs", Json::array({Json{{"label", ""}, {"overrides", Json::array()}}})}},
-                                     2);
+    std::ofstream(dir / "simulation.json") << atonlab::store::dump_json(
+        Json{{"format", "atonlab-simulation"},
+             {"version", 1},
+             {"protocol", "sim.toml"},
+             {"protocol_sha256", "0"},
+             {"designs", Json::array({Json{{"label", ""}, {"overrides", Json::array()}}})}},
+        2);
     const std::string protocol = td::constant_stimuli_protocol(reps);
     for (int i = 0; i < n; ++i) {
         const fs::path file = dir / "sessions" / "00" / fmt::format("session-{:06}.db", i);
@@ -50,8 +50,12 @@ int main(int argc, char** argv) {
         Json truth;
         for (const char* c : {"night-empirical", "night-perceptual"})
             truth[c] = {{"value", 2.0}, {"what", "pse"}, {"p", 0.5}};
-        obs.simulation_json = atonlab::store::dump_json(Json{
-            {"design", ""}, {"design_index", 0}, {"index", i}, {"seed", i + 1}, {"true", truth}, {"decisions", "table"}});
+        obs.simulation_json = atonlab::store::dump_json(Json{{"design", ""},
+                                                             {"design_index", 0},
+                                                             {"index", i},
+                                                             {"seed", i + 1},
+                                                             {"true", truth},
+                                                             {"decisions", "table"}});
         td::run_simulated(file, protocol, obs, static_cast<std::uint64_t>(i + 1));
     }
     return 0;

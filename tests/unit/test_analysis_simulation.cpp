@@ -52,12 +52,11 @@ void write_manifest(const fs::path& dir, int n_designs) {
     for (int d = 0; d < n_designs; ++d)
         designs.push_back({{"label", fmt::format("repetitions={}", 10 * (d + 1))},
                            {"overrides", {fmt::format("repetitions={}", 10 * (d + 1))}}});
-    std::ofstream(dir / "simulation.json") << store::dump_json(
-        nlohmann::ordered_json{{"format", "atonlab-simulation"},
-                               {"version", 1},
-                               {"protocol", "sim.toml"},
-                               {"protocol_sha256", "00"},
-                               {"designs", designs}});
+    std::ofstream(dir / "simulation.json") << store::dump_json(nlohmann::ordered_json{{"format", "atonlab-simulation"},
+                                                                                      {"version", 1},
+                                                                                      {"protocol", "sim.toml"},
+                                                                                      {"protocol_sha256", "00"},
+                                                                                      {"designs", designs}});
 }
 
 /// simulation_json of a session whose conditions' true PSE is `truth`.

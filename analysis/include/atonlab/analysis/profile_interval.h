@@ -6,7 +6,7 @@
 //   LL_p(t) = max over beta (and a free lambda) of LL(alpha(t, beta), beta, gamma, lambda)
 //
 // lies within chi2_1(level) / 2 of the maximum (Wilks 1938). It needs no
-// resampling (a few thousand likelihood evaluations), which is what the
+// resampling (one small optimisation per threshold tried), which is what the
 // simulation report (simulation.h) uses per session by default. It assumes the
 // likelihood's asymptotic chi-squared shape, so with few trials its coverage is
 // measured, not promised: that is what the simulation report is for.
@@ -24,7 +24,7 @@ struct ProfileInterval {
     /// search range of alpha (FitOptions' default: the tested range extended
     /// by its own length on each side): that end is the range's limit.
     bool lower_open = false, upper_open = false;
-    std::string reason;  ///< why there is no interval
+    std::string reason;     ///< why there is no interval
     int n_evaluations = 0;  ///< likelihood evaluations
 };
 

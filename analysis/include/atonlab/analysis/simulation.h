@@ -75,10 +75,10 @@ struct SimulationOptions {
 /// One condition of one session.
 struct SessionEstimate {
     std::string condition;
-    std::optional<double> truth;  ///< simulation_json's true value, level units
-    std::string truth_what;       ///< "pse", "matching level", "threshold"
-    double truth_p = 0.5;         ///< the probability the truth is defined at
-    double estimate_p = 0.5;      ///< the probability the estimate is defined at (ConditionInfo::target_p)
+    std::optional<double> truth;     ///< simulation_json's true value, level units
+    std::string truth_what;          ///< "pse", "matching level", "threshold"
+    double truth_p = 0.5;            ///< the probability the truth is defined at
+    double estimate_p = 0.5;         ///< the probability the estimate is defined at (ConditionInfo::target_p)
     std::optional<double> estimate;  ///< the analysis's headline (study_analysis.h HeadlineEstimate)
     std::optional<Interval> ci;
     bool ci_open = false;  ///< a profile interval that reached the search range: not closed there
@@ -116,22 +116,22 @@ struct ConditionSummary {
     int design_index = 0;
     std::string design, condition, unit, truth_what;
     double truth_p = 0.5;
-    std::optional<double> truth;      ///< the mean of the sessions' true values
+    std::optional<double> truth;  ///< the mean of the sessions' true values
     double truth_min = 0.0, truth_max = 0.0;
-    bool truth_differs = false;       ///< the sessions' true values are not all the same (beyond 1e-9)
-    int n_sessions = 0;               ///< sessions holding the condition
-    int n_estimates = 0;              ///< of those, with an estimate and a truth
-    int n_unreliable = 0;             ///< estimates the analysis flagged unreliable (kept)
+    bool truth_differs = false;          ///< the sessions' true values are not all the same (beyond 1e-9)
+    int n_sessions = 0;                  ///< sessions holding the condition
+    int n_estimates = 0;                 ///< of those, with an estimate and a truth
+    int n_unreliable = 0;                ///< estimates the analysis flagged unreliable (kept)
     std::optional<double> mean, median;  ///< of the estimates
     /// Of the errors estimate − truth, each against its own session's truth:
     /// bias their mean, sd the estimates' SD (n − 1), rmse sqrt(mean error²).
     std::optional<double> bias, sd, rmse;
-    int n_intervals = 0;              ///< estimates with an interval
-    int n_covered = 0;                ///< intervals holding their session's truth
-    int n_open = 0;                   ///< profile intervals not closed within the search range
-    std::optional<double> coverage;   ///< n_covered / n_intervals
-    std::optional<Interval> coverage_ci;  ///< Clopper-Pearson, at the report's level
-    std::optional<double> width_median;   ///< of the intervals, level units
+    int n_intervals = 0;                              ///< estimates with an interval
+    int n_covered = 0;                                ///< intervals holding their session's truth
+    int n_open = 0;                                   ///< profile intervals not closed within the search range
+    std::optional<double> coverage;                   ///< n_covered / n_intervals
+    std::optional<Interval> coverage_ci;              ///< Clopper-Pearson, at the report's level
+    std::optional<double> width_median;               ///< of the intervals, level units
     std::optional<double> trials_median, trials_p90;  ///< the condition's trials per session
 };
 
@@ -146,7 +146,7 @@ struct PowerSummary {
     int n_sessions = 0;                     ///< sessions with both estimates and intervals
     int n_detected = 0;
     std::optional<double> power;
-    std::optional<Interval> power_ci;  ///< Clopper-Pearson
+    std::optional<Interval> power_ci;     ///< Clopper-Pearson
     std::optional<double> sd_difference;  ///< SD of the estimated differences over sessions
 };
 
@@ -161,13 +161,13 @@ struct SimulationResults {
     SimulationOptions options;  ///< as given (progress cleared)
     SimulationManifest manifest;
     std::filesystem::path folder;
-    std::size_t files_found = 0;          ///< every file under sessions/ (a -wal or -shm counted with its file)
-    std::vector<SessionSummary> sessions;  ///< read and summarised, in file order
-    std::vector<SkippedFile> skipped;      ///< left out, each with its reason
+    std::size_t files_found = 0;               ///< every file under sessions/ (a -wal or -shm counted with its file)
+    std::vector<SessionSummary> sessions;      ///< read and summarised, in file order
+    std::vector<SkippedFile> skipped;          ///< left out, each with its reason
     std::vector<ConditionSummary> conditions;  ///< per design, in the conditions' order
     std::vector<PowerSummary> power;
     std::vector<std::string> warnings;
-    double read_s = 0.0;             ///< wall time of reading and estimating every file
+    double read_s = 0.0;              ///< wall time of reading and estimating every file
     std::int64_t bootstrap_fits = 0;  ///< refits done (IntervalMethod::Bootstrap)
 };
 
