@@ -52,21 +52,21 @@ std::string conditions_html(const SimulationResults& r) {
     const bool several = r.manifest.designs.size() > 1;
     std::string h = "<h2>Per design and condition</h2>\n<div class=\"table-wrap\"><table>\n<tr>";
     if (several) h += "<th>design</th>";
-    h += "<th>condition</th><th>true value</th><th>unit</th><th>sessions</th><th>mean</th><th>median</th>"
+    h += "<th>condition</th><th>true value</th><th>sessions</th><th>mean</th><th>median</th>"
          "<th>bias</th><th>SD</th><th>RMSE</th><th>coverage [95% interval]</th><th>median width</th>"
-         "<th>trials: median, P90</th><th>unreliable</th></tr>\n";
+         "<th>trials (median, P90)</th><th>unreliable</th></tr>\n";
     for (const ConditionSummary& c : r.conditions) {
         h += "<tr>";
         if (several)
             h += fmt::format("<td>{}</td>", esc(c.design.empty() ? fmt::format("{}", c.design_index) : c.design));
         const bool low = c.coverage_ci && c.coverage_ci->upper < r.options.ci_level;
-        const std::string coverage = percent(c.coverage) + " " + ci_percent(c.coverage_ci);
+        const std::string coverage = percent(c.coverage) + "<br><small>" + ci_percent(c.coverage_ci) + "</small>";
         h += fmt::format(
-            "<td>{}</td><td class=\"num\">{}{}<br><small>{} at P = {:.3g}</small></td><td>{}</td>"
+            "<td>{}</td><td class=\"num\">{}{}<br><small>{}<br>{}, P = {:.3g}</small></td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
             "<td class=\"num\">{}, {}</td><td class=\"num\">{} of {}</td></tr>\n",
-            esc(c.condition), f4(c.truth), c.truth_differs ? "*" : "", esc(c.truth_what), c.truth_p, esc(c.unit),
+            esc(c.condition), f4(c.truth), c.truth_differs ? "*" : "", esc(c.unit), esc(c.truth_what), c.truth_p,
             c.n_sessions, f4(c.mean), f4(c.median), f4(c.bias), f4(c.sd), f4(c.rmse),
             low ? "<span class=\"bad\">" + coverage + "</span>" : coverage, f3(c.width_median),
             c.trials_median ? fmt::format("{:g}", *c.trials_median) : "&ndash;",
@@ -156,7 +156,9 @@ void write_simulation_report_html(const std::filesystem::path& file, const Simul
     for (std::size_t i = 0; i < r.manifest.designs.size(); ++i) {
         const SimulationDesign& d = r.manifest.designs[i];
         h += fmt::format("<li>{}: <b>{}</b>{}</li>\n", i, esc(d.label.empty() ? "(the protocol as it is)" : d.label),
-                         d.overrides.empty() ? std::string() : esc(fmt::format(" ({})", fmt::join(d.overrides, ", "))));
+                         d.overrides.empty() || (d.overrides.size() == 1 && d.overrides[0] == d.label)
+                             ? std::string()
+                             : esc(fmt::format(" ({})", fmt::join(d.overrides, ", "))));
     }
     h += "</ul>\n";
     h += fmt::format(

@@ -140,7 +140,9 @@ void coverage_figure(detail::FigureDrawer& d, const SimulationResults& r) {
     if (rows.empty()) return;
     const double pad = std::max(1.0, 0.1 * (x_max - x_min));
     std::string body = "reset\nset datafile separator '\\t'\nset key above box\nset grid\n";
-    body += fmt::format("set xrange [{}:{}]\nset yrange [*:1.02]\n", num(std::max(0.0, x_min - pad)), num(x_max + pad));
+    // Room on the right for the last points' labels.
+    body += fmt::format("set xrange [{}:{}]\nset yrange [*:1.02]\n", num(std::max(0.0, x_min - pad)),
+                        num(x_max + 4.0 * pad));
     body += fmt::format(
         "set title {}\nset xlabel 'trials per session (median of the condition)'\nset ylabel "
         "'coverage'\n",
