@@ -13,6 +13,7 @@
 #include <map>
 
 #include "analysis_test_data.h"
+#include "atonlab/analysis/profile_interval.h"
 #include "atonlab/analysis/simulation.h"
 #include "atonlab/analysis/simulation_report.h"
 #include "atonlab/common/input_error.h"
@@ -184,6 +185,41 @@ TEST(AnalysisSimulation, PowerIsTheNormalTheoryPowerForKnownErrors) {
         EXPECT_LE(p.power_ci->lower, *p.power);
         EXPECT_GE(p.power_ci->upper, *p.power);
     }
+}
+
+// With many trials the profile-likelihood interval is the Wald interval of
+// the Fisher information (both are first-order the same; Pawitan 2001, sec.
+// 9.5). A probit with lambda fixed at 0, alpha = 2, beta = 10, 5 levels of
+// 4,000 trials with the expected counts: Var(alpha) = (I^-1)_00 with
+// I_jk = sum n dPsi/dtheta_j dPsi/dtheta_k / (Psi (1 - Psi)),
+// dPsi/dalpha = -beta phi(z), dPsi/dbeta = (x - alpha) phi(z). Tolerance 3 %
+// of the half-width: the likelihood's small asymmetry at this n.
+TEST(AnalysisSimulation, ProfileIntervalIsTheFisherIntervalWithManyTrials) {
+    const double alpha = 2.0, beta = 10.0, n = 4000.0;
+    std::vector<LevelCounts> data;
+    double i00 = 0.0, i01 = 0.0, i11 = 0.0;
+    for (const double x : {1.8, 1.9, 2.0, 2.1, 2.2}) {
+        const double z = beta * (x - alpha);
+        const double p = td::phi(z);
+        data.push_back({x, static_cast<int>(n), static_cast<int>(std::lround(n * p))});
+        const double density = std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI);
+        const double da = -beta * density, db = (x - alpha) * density;
+        const double w = n / (p * (1.0 - p));
+        i00 += w * da * da;
+        i01 += w * da * db;
+        i11 += w * db * db;
+    }
+    const double var_alpha = i11 / (i00 * i11 - i01 * i01);
+    const double half = 1.959963984540054 * std::sqrt(var_alpha);
+    FitOptions fo;
+    fo.lapse = RateConstraint::fixed_at(0.0);
+    const PsychometricFit fit = fit_psychometric(data, fo);
+    ASSERT_TRUE(fit.estimate);
+    const ProfileInterval p = profile_threshold_interval(data, fit, 0.95);
+    ASSERT_TRUE(p.ci) << p.reason;
+    EXPECT_FALSE(p.lower_open || p.upper_open);
+    EXPECT_NEAR(fit.estimate->threshold - p.ci->lower, half, 0.03 * half);
+    EXPECT_NEAR(p.ci->upper - fit.estimate->threshold, half, 0.03 * half);
 }
 
 // Clopper-Pearson at the ends has a closed form: k = 0 gives
