@@ -308,6 +308,34 @@ TEST(AnalysisSimulation, UnusableFilesAreListedWithTheirReasons) {
     EXPECT_EQ(j["files"]["read"], 3);
 }
 
+// --effect-between A,B: one power row per design for A − B, whose true
+// difference is 0 here (both conditions have the same truth); a condition
+// no session has is refused, naming the option.
+TEST(AnalysisSimulation, EffectBetweenTwoConditions) {
+    Folder f;
+    write_manifest(f.path(), 1);
+    make_sessions(f.path(), 0, 20, 4, 2.0, 0.1, 2.0);
+    SimulationOptions o = options();
+    o.effect_log10 = 0.5;  // about 10 standard errors of the difference: every session detects it
+    o.effect_between = std::pair<std::string, std::string>{"night-empirical", "night-perceptual"};
+    std::vector<std::string> warnings;
+    const SimulationResults r = analyze_simulation(f.path(), o);
+    ASSERT_EQ(r.power.size(), 1u);
+    const PowerSummary& p = r.power.front();
+    EXPECT_EQ(p.what, "night-empirical − night-perceptual");
+    EXPECT_NEAR(*p.true_difference, 0.0, 1e-12);
+    EXPECT_EQ(p.n_sessions, 20);
+    EXPECT_EQ(*p.power, 1.0);
+    o.effect_between = std::pair<std::string, std::string>{"night-empirical", "no-such-condition"};
+    try {
+        (void)power_analyses(r.sessions, r.manifest, o, warnings);
+        FAIL() << "an unknown condition was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--effect-between"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("no-such-condition"), std::string::npos) << e.what();
+    }
+}
+
 TEST(AnalysisSimulation, AFolderWithoutAManifestIsRefused) {
     Folder f;
     EXPECT_FALSE(is_simulation_folder(f.path()));
