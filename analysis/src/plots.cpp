@@ -5,18 +5,19 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <boost/math/distributions/binomial.hpp>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
 
+#include "atonlab/analysis/simulation.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/display_model.h"
 #include "atonlab/display/fit_json.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/sha256.h"
 #include "csv.h"
+#include "figure_drawer.h"
 #include "gnuplot.h"
 
 namespace atonlab::analysis {
@@ -34,84 +35,13 @@ std::string num(double v) {
     return std::isfinite(v) ? detail::number_text(v) : std::string("NaN");
 }
 
-/// Clopper-Pearson (exact) interval of a binomial proportion k/n (Boost.Math's
-/// find_lower/upper_bound_on_p with the Clopper-Pearson method).
+/// Clopper-Pearson (exact) interval of a binomial proportion k/n (simulation.h, clopper_pearson).
 std::pair<double, double> proportion_interval(int k, int n, double level) {
-    using boost::math::binomial_distribution;
-    const double a = (1.0 - level) / 2.0;
-    const double lo = binomial_distribution<>::find_lower_bound_on_p(n, k, a);
-    const double hi = binomial_distribution<>::find_upper_bound_on_p(n, k, a);
-    return {lo, hi};
+    const std::optional<Interval> ci = clopper_pearson(k, n, level);
+    return ci ? std::pair{ci->lower, ci->upper} : std::pair{0.0, 1.0};
 }
 
-/// Writes one figure: data files are written by the caller into `tmp`; `body`
-/// is the plotting script without terminal and output.
-class Drawer {
-public:
-    Drawer(const fs::path& out_dir, const PlotOptions& o, PlotResult& result)
-        : out_dir_(out_dir), o_(o), result_(result), tmp_("atonlab-analyze-") {}
-
-    const fs::path& tmp() const { return tmp_.path(); }
-
-    /// A data file in the temporary folder (tab-separated), returned as a gnuplot literal.
-    std::string data(const std::string& name, const std::vector<std::vector<std::string>>& rows) {
-        const fs::path p = tmp_.path() / name;
-        std::ofstream out(p);
-        for (const auto& row : rows) {
-            for (std::size_t i = 0; i < row.size(); ++i) out << (i ? "\t" : "") << row[i];
-            out << '\n';
-        }
-        return gp_quote(p.string());
-    }
-
-    bool draw(Figure f, const std::string& body) {
-        if (result_.gnuplot_missing) return false;
-        const fs::path png = fs::path("figures") / (f.id + ".png");
-        const fs::path svg = fs::path("figures") / (f.id + ".svg");
-        const fs::path script = tmp_.path() / (f.id + ".gp");
-        {
-            std::ofstream s(script);
-            s << "set datafile separator '\\t'\n";
-            s << fmt::format("set terminal pngcairo size {},{} noenhanced font 'DejaVu Sans,10' background '#ffffff'\n",
-                             o_.width_px, o_.height_px);
-            s << "set output " << gp_quote((out_dir_ / png).string()) << "\n" << body << "\nunset output\n";
-            s << fmt::format("set terminal svg size {},{} noenhanced font 'DejaVu Sans,10' background '#ffffff'\n",
-                             o_.width_px, o_.height_px);
-            s << "set output " << gp_quote((out_dir_ / svg).string()) << "\n" << body << "\nunset output\n";
-        }
-        const detail::GnuplotRun run = detail::run_gnuplot(o_.gnuplot, script, tmp_.path());
-        if (run.not_found) {
-            result_.gnuplot_missing = true;
-            result_.problems.push_back(
-                fmt::format("gnuplot could not be started ('{}': {}), so the report has no figures; install the Debian "
-                            "package gnuplot-nox (scripts/setup.sh does)",
-                            o_.gnuplot, run.errors));
-            return false;
-        }
-        std::error_code ec;
-        const bool written =
-            fs::file_size(out_dir_ / png, ec) > 0 && !ec && fs::file_size(out_dir_ / svg, ec) > 0 && !ec;
-        if (run.exit_status != 0 || !written) {
-            std::string first = run.errors;
-            if (const auto nl = first.find_last_not_of("\n "); nl != std::string::npos) first.erase(nl + 1);
-            result_.problems.push_back(fmt::format("figure {}: gnuplot failed (exit status {}): {}", f.id,
-                                                   run.exit_status, first.empty() ? "no output file" : first));
-            fs::remove(out_dir_ / png, ec);
-            fs::remove(out_dir_ / svg, ec);
-            return false;
-        }
-        f.png = png;
-        f.svg = svg;
-        result_.figures.push_back(std::move(f));
-        return true;
-    }
-
-private:
-    fs::path out_dir_;
-    const PlotOptions& o_;
-    PlotResult& result_;
-    detail::TempFolder tmp_;
-};
+using Drawer = detail::FigureDrawer;
 
 std::string outcome_label(const ConditionInfo& c) {
     if (c.task == Task::YesNo) return "P(yes)";

@@ -246,6 +246,7 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
     info.ended_at = s.ended_at.value_or("");
     info.status = store::to_string(s.status);
     info.trial_count = s.trial_count;
+    info.simulation_json = s.simulation_json;
     if (!records.empty()) {
         try {
             const nlohmann::json state =

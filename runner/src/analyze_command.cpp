@@ -1,4 +1,6 @@
 // `atonlab analyze STUDY.db... [--csv FILE]... --out DIR [--bootstrap N] [--seed N] [--family F] [--quiet]`
+// `atonlab analyze SIMULATION_DIR --out DIR [--intervals profile|bootstrap] [--effect D] [--effect-between A,B]`
+// (a folder `atonlab simulate` wrote: analyze_simulation.cpp)
 // Offline analysis of response logs (docs/analysis.md): reads study files
 // read-only (and/or CSVs of trials), fits and summarises every condition
 // (analysis/), draws the figures with gnuplot and writes report.html,
@@ -27,6 +29,7 @@
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
+#include "atonlab/analysis/simulation.h"
 #include "atonlab/analysis/study_analysis.h"
 #include "atonlab/display/colour.h"
 #include "atonlab/display/tonemap.h"
@@ -44,7 +47,9 @@ namespace fs = std::filesystem;
 void add_analyze_command(CLI::App& app, AnalyzeOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "analyze", "Analyse study files (or CSVs of trials): fits, report.html, summary.json, CSVs and figures");
-    cmd->add_option("studies", o.studies, "Study files (SQLite; opened read-only; see docs/store.md)");
+    cmd->add_option("studies", o.studies,
+                    "Study files (SQLite; opened read-only; see docs/store.md), or one simulation folder (atonlab "
+                    "simulate's --out)");
     cmd->add_option("--csv", o.csv, "A long-format CSV of trials (docs/analysis.md); may be given several times");
     cmd->add_option("--out", o.out, "Output folder (created if absent)")->required();
     cmd->add_option("--bootstrap", o.bootstrap, "Parametric bootstrap resamples per fit (0: no intervals)")
@@ -62,6 +67,16 @@ void add_analyze_command(CLI::App& app, AnalyzeOptions& o) {
     cmd->add_flag("--salvage", o.salvage,
                   "Read what SQLite can still read of a damaged study file instead of refusing it; the report and "
                   "summary.json say first which file was damaged and how many rows were read");
+    cmd->add_option("--intervals", o.intervals,
+                    "A simulation folder: each session's interval, profile (likelihood, no resampling; the default) "
+                    "or bootstrap (parametric, --bootstrap N resamples, percentile)")
+        ->check(CLI::IsMember({"profile", "bootstrap"}));
+    cmd->add_option("--effect", o.effect,
+                    "A simulation folder: the effect (log10 units) whose power to be detected at alpha = 0.05 is "
+                    "reported");
+    cmd->add_option("--effect-between", o.effect_between,
+                    "A simulation folder: the two conditions A,B the effect lies between (A - B); default: each "
+                    "glare condition's enhancement");
 }
 
 namespace {
@@ -424,6 +439,22 @@ bool is_bad_input(store::StoreErrc k) {
 }  // namespace
 
 int run_analyze(const AnalyzeOptions& o) {
+    if (o.studies.size() == 1 && fs::is_directory(o.studies.front())) {
+        if (!an::is_simulation_folder(o.studies.front()))
+            throw InputError(fmt::format("{} is a folder without simulation.json: atonlab analyze reads study files, "
+                                         "CSVs of trials, or one simulation folder (docs/analysis.md).",
+                                         o.studies.front()));
+        if (!o.csv.empty() || o.salvage)
+            throw InputError(SourceLocation::command_line(o.salvage ? "--salvage" : "--csv"),
+                             "a simulation folder is analysed alone, without --csv or --salvage");
+        return run_analyze_simulation(o);
+    }
+    for (const auto& [given, option] : {std::pair{!o.intervals.empty(), "--intervals"},
+                                        std::pair{o.effect.has_value(), "--effect"},
+                                        std::pair{!o.effect_between.empty(), "--effect-between"}})
+        if (given)
+            throw InputError(SourceLocation::command_line(option),
+                             "this option is for a simulation folder (atonlab analyze DIR), not for study files");
     if (o.studies.empty() && o.csv.empty())
         throw InputError("atonlab analyze needs at least one study file or --csv FILE to read.");
     an::AnalysisOptions ao;

@@ -25,9 +25,15 @@ struct AnalyzeOptions {
     std::string gnuplot = "gnuplot";
     bool quiet = false;
     bool salvage = false;  ///< read what is left of a damaged study file instead of refusing it
+    // A simulation folder (analysis/simulation.h; docs/analysis.md "The simulation report"):
+    std::string intervals;  ///< "profile" (default) or "bootstrap"
+    std::optional<double> effect;  ///< --effect D, log10 units: the power to detect it
+    std::string effect_between;    ///< --effect-between A,B; empty: each glare condition's enhancement
 };
 
 void add_analyze_command(CLI::App& app, AnalyzeOptions& options);
 int run_analyze(const AnalyzeOptions& options);
+/// `atonlab analyze DIR` for a simulation folder (analyze_simulation.cpp).
+int run_analyze_simulation(const AnalyzeOptions& options);
 
 }  // namespace atonlab::runner

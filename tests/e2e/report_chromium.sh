@@ -4,7 +4,9 @@
 # the page does not overflow sideways (document scrollWidth == clientWidth: wide
 # tables scroll inside their own box), every <img> decodes (naturalWidth > 0),
 # and a screenshot at 1280 px is 1280 px wide. INPUT is a trials CSV (analysed
-# with --csv) or a protocol (run headless with the model observer first).
+# with --csv), a protocol (run headless with the model observer first), or the
+# make_simulation_folder tool (a simulation folder of 20 sessions, analysed as
+# `atonlab analyze DIR --effect 0.05`: the simulation report).
 # Exit 77 (a skip) when chromium or gnuplot is not installed (scripts/setup.sh
 # installs both) or, for a protocol, where no GL 4.5 context exists.
 set -uo pipefail
@@ -18,6 +20,9 @@ if [[ "$input" == *.toml ]]; then
   if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context ($(cat "$outdir/run.err"))"; exit 77; fi
   if [ "$status" -ne 0 ]; then echo "atonlab run failed ($status):"; cat "$outdir/run.err"; exit 1; fi
   "$atonlab" analyze "$outdir/study.db" --out "$outdir/report" --bootstrap 100 >"$outdir/out" 2>"$outdir/err"
+elif [[ "$(basename "$input")" == make_simulation_folder ]]; then
+  "$input" "$outdir/sim" 20 4 || { echo "make_simulation_folder failed"; exit 1; }
+  "$atonlab" analyze "$outdir/sim" --out "$outdir/report" --effect 0.05 >"$outdir/out" 2>"$outdir/err"
 else
   "$atonlab" analyze --csv "$input" --out "$outdir/report" --bootstrap 100 >"$outdir/out" 2>"$outdir/err"
 fi

@@ -51,6 +51,9 @@ struct SimObserver {
     double sigma = 0.1;
     double gamma = 0.0;
     std::uint64_t seed = 1;
+    /// Stored as the session's SessionStart::simulation_json (a simulated
+    /// session, docs/simulate.md); empty: an ordinary session.
+    std::string simulation_json;
 };
 
 /// A SimObserver (named arguments without designated initializers, which warn when partial).
@@ -118,6 +121,7 @@ inline store::SessionId run_simulated(const std::filesystem::path& db, const std
     start.calibration = calibration;
     start.scene_text = scene_text;
     start.scene_name = "none.scene.toml";
+    start.simulation_json = obs.simulation_json;
     const store::SessionId session = s.begin_session(start);
     p::Rng rng(obs.seed);
     std::size_t n = 0;

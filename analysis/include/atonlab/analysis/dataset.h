@@ -139,6 +139,10 @@ struct SessionInfo {
     /// Every condition the session's protocol defines, in file order (so a
     /// condition without trials is still reported); empty for a CSV.
     std::vector<std::string> protocol_conditions;
+    /// A simulated session's observer, true values and design (the store's
+    /// sessions.simulation_json, schema v7; docs/simulate.md); none for any
+    /// other session (or a CSV). The simulation report reads it (simulation.h).
+    std::optional<std::string> simulation_json;
 };
 
 /// One photometer reading behind a calibration (the store's calibration_readings).
