@@ -59,6 +59,11 @@ Json condition_json(const ConditionSummary& c) {
     j["coverage"] = or_null(c.coverage);
     j["coverage_ci"] = interval(c.coverage_ci);
     j["width_median"] = or_null(c.width_median);
+    j["widen_factor"] = or_null(c.widen_factor);
+    j["calibrated_intervals"] = c.n_calibrated;
+    j["calibrated_covered"] = c.n_calibrated_covered;
+    j["calibrated_coverage"] = or_null(c.calibrated_coverage);
+    j["calibrated_coverage_ci"] = interval(c.calibrated_coverage_ci);
     j["trials_per_session"] = Json{{"median", or_null(c.trials_median)}, {"p90", or_null(c.trials_p90)}};
     return j;
 }
@@ -89,7 +94,8 @@ const std::vector<std::string>& simulation_csv_columns() {
                                             "mean",           "median",         "bias",           "sd",
                                             "rmse",           "intervals",      "covered",        "coverage",
                                             "coverage_lower", "coverage_upper", "open_intervals", "width_median",
-                                            "trials_median",  "trials_p90"};
+                                            "trials_median",  "trials_p90",     "widen_factor",   "calibrated_coverage",
+                                            "calibrated_lower", "calibrated_upper"};
     return c;
 }
 
@@ -177,7 +183,11 @@ void write_simulation_csv(const std::filesystem::path& file, const SimulationRes
                        std::to_string(c.n_open),
                        cell(c.width_median),
                        cell(c.trials_median),
-                       cell(c.trials_p90)});
+                       cell(c.trials_p90),
+                       cell(c.widen_factor),
+                       cell(c.calibrated_coverage),
+                       c.calibrated_coverage_ci ? detail::number_text(c.calibrated_coverage_ci->lower) : "",
+                       c.calibrated_coverage_ci ? detail::number_text(c.calibrated_coverage_ci->upper) : ""});
     }
     files::write_file_atomically(file, out);
 }

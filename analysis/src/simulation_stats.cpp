@@ -8,6 +8,7 @@
 #include <boost/math/distributions/binomial.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
@@ -49,6 +50,38 @@ std::string design_label(const SimulationManifest& m, int index) {
 }
 
 /// The summary of one design's condition from its sessions' estimates.
+/// How much session e's interval must widen, each side by the same factor of
+/// its own half-width, to hold its truth (<= 1: it holds it already); none
+/// without an interval or a truth, +inf for a side of zero width.
+std::optional<double> needed_widening(const SessionEstimate& e) {
+    if (!e.ci || !e.estimate || !e.truth) return std::nullopt;
+    const double est = *e.estimate, truth = *e.truth;
+    const double side = truth >= est ? e.ci->upper - est : est - e.ci->lower;
+    if (std::abs(truth - est) == 0.0) return 0.0;
+    return side > 0.0 ? std::abs(truth - est) / side : std::numeric_limits<double>::infinity();
+}
+
+/// The calibrated intervals of summarize(): the factor from every session,
+/// and the coverage held out between the two halves.
+void calibrate(ConditionSummary& c, const std::vector<const SessionEstimate*>& es, double level) {
+    std::vector<double> all, half[2];
+    for (std::size_t i = 0; i < es.size(); ++i)
+        if (const std::optional<double> r = needed_widening(*es[i])) {
+            all.push_back(*r);
+            half[i % 2].push_back(*r);
+        }
+    if (all.size() < 20 || half[0].empty() || half[1].empty()) return;  // too few to find a quantile
+    for (std::vector<double>* v : {&all, &half[0], &half[1]}) std::sort(v->begin(), v->end());
+    c.widen_factor = nearest_rank(all, level);
+    for (int h = 0; h < 2; ++h) {
+        const double k = *nearest_rank(half[1 - h], level);  // found on the other half
+        for (double r : half[h]) c.n_calibrated_covered += r <= k ? 1 : 0;
+        c.n_calibrated += static_cast<int>(half[h].size());
+    }
+    c.calibrated_coverage = static_cast<double>(c.n_calibrated_covered) / c.n_calibrated;
+    c.calibrated_coverage_ci = clopper_pearson(c.n_calibrated_covered, c.n_calibrated, level);
+}
+
 ConditionSummary summarize(const std::vector<const SessionEstimate*>& es, double level) {
     ConditionSummary c;
     c.n_sessions = static_cast<int>(es.size());
@@ -92,6 +125,7 @@ ConditionSummary summarize(const std::vector<const SessionEstimate*>& es, double
         c.coverage_ci = clopper_pearson(c.n_covered, c.n_intervals, level);
         c.width_median = median_of(widths);
     }
+    calibrate(c, es, level);
     std::sort(trials.begin(), trials.end());
     c.trials_median = median_of(trials);
     c.trials_p90 = nearest_rank(trials, 0.9);

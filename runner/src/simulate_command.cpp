@@ -21,6 +21,7 @@
 #include "atonlab/store/error.h"
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
+#include "analyze_command.h"
 #include "run_session.h"
 #include "session/progress.h"
 #include "session/stop_signals.h"
@@ -162,12 +163,18 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
     cmd->add_option("--table-cache", o.table_cache,
                     "A folder of decision tables shared between simulations (default DIR/tables)");
     cmd->add_flag("--quiet", o.quiet, "Print nothing but errors");
+    cmd->add_flag("--report", o.report,
+                  "Then write the simulation report into DIR/report (atonlab analyze DIR --out DIR/report)");
+    cmd->add_option("--effect", o.effect,
+                    "With --report: the effect (log10 units) whose power to be detected the report gives");
 }
 
 int run_simulate(const SimulateOptions& o) {
     StopSignals signals;
     if (o.sessions < 1)
         throw InputError(SourceLocation::command_line("--sessions"), "--sessions must be at least 1.");
+    if (o.effect && !o.report)
+        throw InputError(SourceLocation::command_line("--effect"), "--effect is the report's: give --report too.");
     if (!(o.table_bound > 0.0 && o.table_bound <= 0.1))
         throw InputError(SourceLocation::command_line("--table-bound"),
                          fmt::format("--table-bound must be in (0, 0.1] log10 brightness, not {}.", o.table_bound));
@@ -237,7 +244,14 @@ int run_simulate(const SimulateOptions& o) {
                     stop != 0 ? "stopped (run the same command again to continue)" : "done", trials,
                     clock_text(seconds).c_str(), seconds > 0 ? static_cast<double>(trials) / seconds : 0.0,
                     dir.string().c_str(), (dir / "report").string().c_str());
-    return stop != 0 ? 128 + stop : 0;
+    if (stop != 0) return 128 + stop;
+    if (!o.report) return 0;
+    AnalyzeOptions report;
+    report.studies = {dir.string()};
+    report.out = (dir / "report").string();
+    report.effect = o.effect;
+    report.quiet = o.quiet;
+    return run_analyze(report);
 }
 
 }  // namespace atonlab::runner

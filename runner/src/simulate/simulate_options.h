@@ -24,6 +24,8 @@ struct SimulateOptions {
     double table_bound = 0.001;          ///< the decision table's interpolation error bound, log10 brightness
     std::string table_cache;             ///< a folder of tables shared between simulations (default DIR/tables)
     bool quiet = false;
+    bool report = false;          ///< --report: `atonlab analyze DIR --out DIR/report` once every session is done
+    std::optional<double> effect;  ///< --effect D for the report (log10 units)
 };
 
 }  // namespace atonlab::runner

@@ -132,6 +132,17 @@ struct ConditionSummary {
     std::optional<double> coverage;                   ///< n_covered / n_intervals
     std::optional<Interval> coverage_ci;              ///< Clopper-Pearson, at the report's level
     std::optional<double> width_median;               ///< of the intervals, level units
+    /// The design's calibrated interval (docs/analysis.md "Calibrated
+    /// intervals"): the factor by which each side of a session's interval must
+    /// widen so that `level` of the sessions' intervals hold their truth
+    /// (the nearest-rank quantile of each session's needed widening), and the
+    /// coverage of intervals so widened when the factor is found on the other
+    /// half of the sessions (even against odd positions, and back): held out,
+    /// so not covering by construction.
+    std::optional<double> widen_factor;
+    int n_calibrated = 0, n_calibrated_covered = 0;
+    std::optional<double> calibrated_coverage;
+    std::optional<Interval> calibrated_coverage_ci;  ///< Clopper-Pearson
     std::optional<double> trials_median, trials_p90;  ///< the condition's trials per session
 };
 
