@@ -46,7 +46,7 @@ SimulationManifest manifest_of(const std::vector<SimulationDesign>& designs, con
     SimulationManifest m;
     for (const SimulationDesign& d : designs)
         m.designs.push_back(ManifestDesign{d.label, d.protocol_path, store::sha256_hex(d.protocol_text), d.overrides,
-                                           o.render_every_trial ? std::string() : d.table.key});
+                                           o.render_every_trial ? std::string() : d.table_key});
     m.seed = seed;
     m.sessions = o.sessions;
     nlohmann::ordered_json observer;
@@ -188,12 +188,6 @@ int run_simulate(const SimulateOptions& o) {
     const fs::path dir = o.out;
     check_writable(dir);
     const std::optional<SimulationManifest> existing = read_manifest(dir);
-    const fs::path cache = o.table_cache.empty() ? tables_dir(dir) : fs::path(o.table_cache);
-    if (o.render_every_trial) {
-        render_true_values(designs);
-    } else if (!prepare_tables(designs, o, cache)) {
-        return 2;
-    }
     const std::uint64_t seed = o.seed.value_or(designs.front().protocol.seed);
     SimulationManifest manifest = manifest_of(designs, o, seed);
     if (existing) {
@@ -203,6 +197,14 @@ int run_simulate(const SimulateOptions& o) {
                                          "--out.",
                                          dir.string(), diff));
         manifest.sessions = std::max(manifest.sessions, existing->sessions);
+    }
+    // The tables (or, rendering every trial, the true values): renders, once
+    // the folder is known to take this simulation.
+    const fs::path cache = o.table_cache.empty() ? tables_dir(dir) : fs::path(o.table_cache);
+    if (o.render_every_trial) {
+        render_true_values(designs);
+    } else if (!prepare_tables(designs, o, cache)) {
+        return 2;
     }
     // Every check has passed: from here on the folder is written.
     fs::create_directories(dir);

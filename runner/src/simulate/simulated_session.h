@@ -41,6 +41,8 @@ struct SimulationDesign {
     std::string scene_text;
     std::string scene_name;
     protocols::SimulatedObserverParams observer;
+    /// table_key() of this design: known before the table is loaded or built.
+    std::string table_key;
     DecisionTable table;
     /// The model's true value per condition (level units, without the
     /// observer's bias), or why there is none.

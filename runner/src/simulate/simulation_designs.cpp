@@ -138,6 +138,7 @@ std::vector<SimulationDesign> read_designs(const SimulateOptions& o) {
             d.observer = p::observer_params(d.protocol);
             apply_observer_options(d.observer, o.observer);
             fill_frame_facts(d, *in.scene);
+            d.table_key = table_key(d.protocol_text, d.scene_text, "", d.observer.model, o.table_bound);
             designs.push_back(std::move(d));
         }
     }
@@ -147,7 +148,7 @@ std::vector<SimulationDesign> read_designs(const SimulateOptions& o) {
 bool prepare_tables(std::vector<SimulationDesign>& designs, const SimulateOptions& o, const fs::path& cache) {
     std::unique_ptr<gl::Context> context;
     for (SimulationDesign& d : designs) {
-        const std::string key = table_key(d.protocol_text, d.scene_text, "", d.observer.model, o.table_bound);
+        const std::string& key = d.table_key;
         const fs::path file = cache / (key + ".json");
         std::error_code ec;
         if (fs::exists(file, ec)) {
