@@ -256,4 +256,13 @@ std::string Store::protocol_text(SessionId session) const {
     return impl_->read_protocol_text(session, fmt::format("read the protocol of session {}", session.value));
 }
 
+void Store::switch_to_rollback_journal() {
+    const std::string doing = "switch to a rollback journal";
+    impl_->require_writable(doing);
+    const std::string mode = impl_->db->query_text("PRAGMA journal_mode = DELETE", doing);
+    if (mode != "delete")
+        throw StoreError(StoreErrc::other, impl_->path(),
+                         fmt::format("{}: cannot {} (SQLite kept \"{}\")", impl_->path().string(), doing, mode));
+}
+
 }  // namespace atonlab::store

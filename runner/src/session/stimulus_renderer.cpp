@@ -223,8 +223,17 @@ const s::EncodedImage& StimulusRenderer::background_codes(const p::Frame& frame,
     // cached frames serve a whole session.
     p::Frame off = frame;
     const auto on = scene(frame.overrides);
+    std::vector<SceneOverride> offs;
     for (const std::string& name : lights)
-        if (!name.empty()) off.overrides.push_back(judged_off_override(*on, name));
+        if (!name.empty()) offs.push_back(judged_off_override(*on, name));
+    // An override the off ones set again (the level's intensity, where the
+    // level sets a judged light) is shadowed: left out, the frame with the
+    // lights off has the same scene and one cache key for every level, so a
+    // decision table's levels share one background render.
+    std::erase_if(off.overrides, [&](const SceneOverride& o) {
+        return std::any_of(offs.begin(), offs.end(), [&](const SceneOverride& x) { return x.key == o.key; });
+    });
+    off.overrides.insert(off.overrides.end(), offs.begin(), offs.end());
     const std::string key = fmt::format("{}@{:a}", cache_key(off, {}), time_s);
     if (const auto* hit = background_.find(key)) return *hit;
     return background_.put(key, render_codes(*scene(off.overrides), time_s));

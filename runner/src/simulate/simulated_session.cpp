@@ -143,6 +143,7 @@ std::size_t simulate_session(const SimulationDesign& d, std::size_t index, std::
         const st::SessionId session = store.begin_session(start);
         store.record_trials(session, records);
         store.finish_session(session, st::SessionStatus::completed);
+        store.switch_to_rollback_journal();  // its readers leave no -wal and -shm beside it
     }  // closed: SQLite checkpoints the WAL into the file and removes it
     return records.size();
 }

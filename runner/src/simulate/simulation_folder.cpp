@@ -23,6 +23,15 @@ std::string SimulationManifest::json() const {
     Json j;
     j["format"] = "atonlab-simulation";
     j["version"] = 1;
+    // The protocol as the report names it: the file, or the files of several
+    // designs; its SHA-256 when every design has one text.
+    std::string protocols, sha = designs.empty() ? "" : designs.front().protocol_sha256;
+    for (const ManifestDesign& d : designs) {
+        if (protocols.find(d.protocol) == std::string::npos) protocols += (protocols.empty() ? "" : ", ") + d.protocol;
+        if (d.protocol_sha256 != sha) sha = "(one per design)";
+    }
+    j["protocol"] = protocols;
+    j["protocol_sha256"] = sha;
     Json ds = Json::array();
     for (const ManifestDesign& d : designs) {
         Json one;

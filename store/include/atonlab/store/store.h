@@ -111,6 +111,12 @@ public:
     /// stamps ended_at. Throws invalid_argument for `running` or a session that
     /// is not running.
     void finish_session(SessionId session, SessionStatus status);
+    /// Checkpoints the WAL into the file and switches it to a rollback
+    /// journal (journal_mode = DELETE), so that a reader opening it read-only
+    /// leaves no -wal and -shm files beside it: for a file written once and
+    /// then only read, as a simulated session (docs/simulate.md: a simulation
+    /// folder holds a file per session). The next writer switches it back to WAL.
+    void switch_to_rollback_journal();
     /// Reopens a session left running (its process died), crashed or quit, so
     /// record_trial may continue it; counts the resume. Returns the resume point.
     /// A completed session cannot be resumed.
