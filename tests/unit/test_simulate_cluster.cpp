@@ -29,7 +29,7 @@ TEST(SimulateCluster, SharesCoverEverySessionOnce) {
 }
 
 TEST(SimulateCluster, DefaultSessionsPerTaskFitsTheArray) {
-    EXPECT_EQ(default_sessions_per_task(50, 1001), 50u);    // one task: fewer sessions than 100
+    EXPECT_EQ(default_sessions_per_task(50, 1001), 50u);     // one task: fewer sessions than 100
     EXPECT_EQ(default_sessions_per_task(2000, 1001), 100u);  // 20 tasks of 100
     // 1,000,000 sessions: at most 1000 tasks, so 1000 a task.
     EXPECT_EQ(default_sessions_per_task(1000000, 1001), 1000u);
@@ -40,11 +40,11 @@ TEST(SimulateCluster, DefaultSessionsPerTaskFitsTheArray) {
 }
 
 TEST(SimulateCluster, TimeFormatsSbatchAccepts) {
-    for (const char* ok : {"30", "30:15", "2:00:00", "100:00:00", "1-12", "1-12:30", "7-00:00:01", "UNLIMITED",
-                           "infinite"})
+    for (const char* ok :
+         {"30", "30:15", "2:00:00", "100:00:00", "1-12", "1-12:30", "7-00:00:01", "UNLIMITED", "infinite"})
         EXPECT_EQ(slurm_time_problem(ok), "") << ok;
-    for (const char* bad : {"", "1h", "1:2:3:4", "1-", "-5", "1-2-3", "1:60", "1:00:75", "1-24", "0", "00:00",
-                            "1.5", " 30"})
+    for (const char* bad :
+         {"", "1h", "1:2:3:4", "1-", "-5", "1-2-3", "1:60", "1:00:75", "1-24", "0", "00:00", "1.5", " 30"})
         EXPECT_NE(slurm_time_problem(bad), "") << bad;
 }
 
@@ -61,8 +61,8 @@ TEST(SimulateCluster, ArrayListsRuns) {
 }
 
 TEST(SimulateCluster, SqueueLinesOfThisFoldersJobsOnly) {
-    const auto live = live_tasks("41 3 RUNNING\n41 4 PENDING\n52 7 RUNNING\n41 N/A RUNNING\n60 2 RUNNING\n",
-                                 {"41", "52"});
+    const auto live =
+        live_tasks("41 3 RUNNING\n41 4 PENDING\n52 7 RUNNING\n41 N/A RUNNING\n60 2 RUNNING\n", {"41", "52"});
     ASSERT_EQ(live.size(), 3u);
     EXPECT_EQ(live.at(3), "RUNNING");
     EXPECT_EQ(live.at(4), "PENDING");
@@ -71,8 +71,8 @@ TEST(SimulateCluster, SqueueLinesOfThisFoldersJobsOnly) {
 }
 
 TEST(SimulateCluster, SacctLaterJobWins) {
-    const auto a = accounted_tasks("41_3|CANCELLED by 0\n41_4|COMPLETED\n52_3|COMPLETED\n41_[5-9]|PENDING\n",
-                                   {"41", "52"});
+    const auto a =
+        accounted_tasks("41_3|CANCELLED by 0\n41_4|COMPLETED\n52_3|COMPLETED\n41_[5-9]|PENDING\n", {"41", "52"});
     EXPECT_EQ(a.at(3), "COMPLETED");
     EXPECT_EQ(a.at(4), "COMPLETED");
     EXPECT_EQ(a.count(5), 0u);

@@ -2,6 +2,8 @@
 #include "simulate/cluster_jobs.h"
 
 #include <fcntl.h>
+#include <fmt/chrono.h>
+#include <fmt/format.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,8 +11,6 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fmt/chrono.h>
-#include <fmt/format.h>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -86,7 +86,8 @@ ProgramOutput run_program(const std::vector<std::string>& argv) {
 }
 
 std::string utc_now() {
-    return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", std::chrono::floor<std::chrono::seconds>(std::chrono::system_clock::now()));
+    return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}",
+                       std::chrono::floor<std::chrono::seconds>(std::chrono::system_clock::now()));
 }
 
 void write_jobs(const fs::path& dir, const SlurmJobs& s) {
@@ -118,9 +119,9 @@ std::optional<SlurmJobs> read_jobs(const fs::path& dir) {
         if (s.sessions_per_task == 0) throw std::runtime_error("sessions_per_task is 0");
         return s;
     } catch (const std::exception& e) {
-        throw InputError(SourceLocation{jobs_path(dir).string(), 0, 0, ""},
-                         fmt::format("{} is not a job record this atonlab reads ({}).", jobs_path(dir).string(),
-                                     e.what()));
+        throw InputError(
+            SourceLocation{jobs_path(dir).string(), 0, 0, ""},
+            fmt::format("{} is not a job record this atonlab reads ({}).", jobs_path(dir).string(), e.what()));
     }
 }
 
@@ -167,8 +168,8 @@ struct TaskStates {
 TaskStates task_states(const fs::path& dir, const SlurmJobs& s, const std::string& option) {
     TaskStates out;
     const std::map<std::size_t, std::string> queued = queued_tasks(s, option);
-    const ProgramOutput acct = run_program({"sacct", "-n", "-P", "-X", "-o", "JobID,State", "-j",
-                                            fmt::format("{}", fmt::join(job_ids(s), ","))});
+    const ProgramOutput acct = run_program(
+        {"sacct", "-n", "-P", "-X", "-o", "JobID,State", "-j", fmt::format("{}", fmt::join(job_ids(s), ","))});
     if (acct.status == 0) out.accounted = accounted_tasks(acct.output, job_ids(s));
     for (std::size_t t = 0; t < s.tasks; ++t) {
         const auto q = queued.find(t);
@@ -194,7 +195,8 @@ std::optional<std::string> sbatch(const fs::path& dir, const std::string& array)
     if (!array.empty()) argv.push_back("--array=" + array);
     argv.push_back(script_path(dir).string());
     const ProgramOutput r = run_program(argv);
-    std::string id = r.output.substr(r.output.find_last_of('\n') == std::string::npos ? 0 : r.output.find_last_of('\n') + 1);
+    std::string id =
+        r.output.substr(r.output.find_last_of('\n') == std::string::npos ? 0 : r.output.find_last_of('\n') + 1);
     id = id.substr(0, id.find(';'));  // --parsable: "JOBID" or "JOBID;CLUSTER"
     if (r.status != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
         std::fprintf(stderr, "atonlab: sbatch refused %s (exit %d): %s\n", script_path(dir).c_str(), r.status,
@@ -213,9 +215,10 @@ std::string script_text(const SimulateOptions& o, std::uint64_t seed, const Slur
         const bool value = i > 0 && command[i - 1].rfind("--", 0) == 0 && command[i].rfind("--", 0) != 0;
         words += (i == 0 ? "" : value || i == 1 ? " " : " \\\n  ") + shell_quote(command[i]);
     }
-    std::string sbatch_lines = fmt::format("#SBATCH --job-name=atonlab-simulate\n#SBATCH --array=0-{}\n"
-                                           "#SBATCH --output={}\n#SBATCH --cpus-per-task={}\n",
-                                           s.tasks - 1, (dir / "slurm" / "task-%A_%a.out").string(), o.cpus_per_task);
+    std::string sbatch_lines = fmt::format(
+        "#SBATCH --job-name=atonlab-simulate\n#SBATCH --array=0-{}\n"
+        "#SBATCH --output={}\n#SBATCH --cpus-per-task={}\n",
+        s.tasks - 1, (dir / "slurm" / "task-%A_%a.out").string(), o.cpus_per_task);
     if (!o.partition.empty()) sbatch_lines += "#SBATCH --partition=" + o.partition + "\n";
     if (!o.time.empty()) sbatch_lines += "#SBATCH --time=" + o.time + "\n";
     for (const std::string& a : o.sbatch_args) sbatch_lines += "#SBATCH " + a + "\n";
@@ -235,7 +238,8 @@ std::string script_text(const SimulateOptions& o, std::uint64_t seed, const Slur
         "sessions={}  # sessions per design (--sessions)\n"
         "first=$(( SLURM_ARRAY_TASK_ID * per_task ))\n"
         "count=$(( sessions - first < per_task ? sessions - first : per_task ))\n"
-        "echo \"atonlab simulate: task $SLURM_ARRAY_TASK_ID on $(hostname): sessions $first to $(( first + count - 1 ))\"\n"
+        "echo \"atonlab simulate: task $SLURM_ARRAY_TASK_ID on $(hostname): sessions $first to $(( first + count - 1 "
+        "))\"\n"
         "{} \\\n  --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\" --first \"$first\" --count \"$count\" --quiet\n"
         "echo \"atonlab simulate: task $SLURM_ARRAY_TASK_ID done\"\n",
         utc_now(), ATONLAB_VERSION, s.sessions_per_task, s.sessions_per_task, s.sessions_per_task, s.designs,
@@ -270,22 +274,24 @@ std::size_t check_cluster_options(const SimulateOptions& o) {
         throw InputError(SourceLocation::command_line(option), why);
     };
     if (o.first && (o.slurm || o.print_commands))
-        refuse("--first", "--first runs one share of the sessions; --slurm and --print-commands cut all of them "
-                          "into shares: give one or the other.");
+        refuse("--first",
+               "--first runs one share of the sessions; --slurm and --print-commands cut all of them "
+               "into shares: give one or the other.");
     if (o.slurm && o.print_commands)
-        refuse("--print-commands", "--print-commands prints the tasks' commands instead of submitting them: give "
-                                   "--slurm or --print-commands, not both.");
+        refuse("--print-commands",
+               "--print-commands prints the tasks' commands instead of submitting them: give "
+               "--slurm or --print-commands, not both.");
     if (!o.slurm) {
-        for (const auto& [option, given] : {std::pair{"--partition", !o.partition.empty()},
-                                            std::pair{"--time", !o.time.empty()},
-                                            std::pair{"--sbatch-arg", !o.sbatch_args.empty()}})
+        for (const auto& [option, given] :
+             {std::pair{"--partition", !o.partition.empty()}, std::pair{"--time", !o.time.empty()},
+              std::pair{"--sbatch-arg", !o.sbatch_args.empty()}})
             if (given) refuse(option, fmt::format("{} is sbatch's: it needs --slurm.", option));
     }
     if (!o.time.empty())
         if (const std::string why = slurm_time_problem(o.time); !why.empty()) refuse("--time", "--time " + why + ".");
     if (!o.partition.empty() && o.partition.find_first_of(" \t\n'\"\\$`") != std::string::npos)
-        refuse("--partition", fmt::format("--partition '{}' is not a partition name (it holds a space or a quote).",
-                                          o.partition));
+        refuse("--partition",
+               fmt::format("--partition '{}' is not a partition name (it holds a space or a quote).", o.partition));
     for (const std::string& a : o.sbatch_args)
         if (a.empty() || a.front() != '-' || a.find('\n') != std::string::npos)
             refuse("--sbatch-arg", fmt::format("--sbatch-arg '{}' is not an sbatch option: give one option a time, "
@@ -341,9 +347,10 @@ int submit_slurm_array(const SimulateOptions& o, std::uint64_t seed, std::size_t
     if (!id) return 2;
     s.jobs.push_back(SlurmJobs::Job{*id, fmt::format("0-{}", s.tasks - 1), utc_now()});
     write_jobs(dir, s);
-    std::printf("simulate: submitted job %s: %zu array task(s) of %zu session(s) × %zu design(s) (%s); "
-                "see them with: atonlab simulate --status %s\n",
-                id->c_str(), s.tasks, per_task, designs, script_path(dir).c_str(), dir.c_str());
+    std::printf(
+        "simulate: submitted job %s: %zu array task(s) of %zu session(s) × %zu design(s) (%s); "
+        "see them with: atonlab simulate --status %s\n",
+        id->c_str(), s.tasks, per_task, designs, script_path(dir).c_str(), dir.c_str());
     return 0;
 }
 
@@ -358,9 +365,9 @@ int print_slurm_status(const fs::path& dir) {
     std::printf("simulate: %s: %zu task(s) of %zu session(s) × %zu design(s); job(s) %s\n", dir.c_str(), s->tasks,
                 s->sessions_per_task, s->designs, fmt::format("{}", fmt::join(job_ids(*s), ", ")).c_str());
     std::printf("  done     %zu%s\n  running  %zu%s\n  pending  %zu%s\n  failed   %zu%s\n  missing  %zu%s\n",
-                t.done.size(), listed(t.done).c_str(), t.running.size(), listed(t.running).c_str(),
-                t.pending.size(), listed(t.pending).c_str(), t.failed.size(), listed(t.failed).c_str(),
-                t.missing.size(), listed(t.missing).c_str());
+                t.done.size(), listed(t.done).c_str(), t.running.size(), listed(t.running).c_str(), t.pending.size(),
+                listed(t.pending).c_str(), t.failed.size(), listed(t.failed).c_str(), t.missing.size(),
+                listed(t.missing).c_str());
     for (const std::size_t f : t.failed)
         if (const auto a = t.accounted.find(f); a != t.accounted.end())
             std::printf("  task %zu: %s (sacct)\n", f, a->second.c_str());
@@ -376,9 +383,9 @@ int print_slurm_status(const fs::path& dir) {
 int resubmit_slurm_tasks(const fs::path& dir) {
     std::optional<SlurmJobs> s = read_jobs(dir);
     if (!s)
-        throw InputError(SourceLocation::command_line("--resubmit"),
-                         fmt::format("{} has no Slurm job to resubmit ({} is missing).", dir.string(),
-                                     jobs_path(dir).string()));
+        throw InputError(
+            SourceLocation::command_line("--resubmit"),
+            fmt::format("{} has no Slurm job to resubmit ({} is missing).", dir.string(), jobs_path(dir).string()));
     if (!on_path("sbatch"))
         throw InputError(SourceLocation::command_line("--resubmit"),
                          "sbatch is not on PATH: --resubmit submits with Slurm's sbatch. Nothing was written.");

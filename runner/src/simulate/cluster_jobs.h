@@ -20,7 +20,7 @@ namespace atonlab::runner {
 
 /// What DIR/slurm/jobs.json holds.
 struct SlurmJobs {
-    std::size_t sessions = 0;           ///< per design
+    std::size_t sessions = 0;  ///< per design
     std::size_t designs = 0;
     std::size_t sessions_per_task = 0;  ///< K
     std::size_t tasks = 0;              ///< ⌈sessions / K⌉

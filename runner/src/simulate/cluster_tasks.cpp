@@ -32,9 +32,10 @@ std::string slurm_time_problem(const std::string& limit) {
     std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
     if (upper == "UNLIMITED" || upper == "INFINITE") return {};
     if (!std::regex_match(limit, forms))
-        return fmt::format("'{}' is not a Slurm time limit: give MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS "
-                           "(e.g. 90, 1:30:00, 2-12)",
-                           limit);
+        return fmt::format(
+            "'{}' is not a Slurm time limit: give MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS "
+            "(e.g. 90, 1:30:00, 2-12)",
+            limit);
     // Seconds and minutes after a colon are below 60 (sbatch reads 1:75:00 as something else than meant).
     static const std::regex after_colon(R"(:(\d+))");
     for (auto it = std::sregex_iterator(limit.begin(), limit.end(), after_colon); it != std::sregex_iterator(); ++it)
