@@ -240,8 +240,9 @@ std::string script_text(const SimulateOptions& o, std::uint64_t seed, const Slur
         "count=$(( sessions - first < per_task ? sessions - first : per_task ))\n"
         "echo \"atonlab simulate: task $SLURM_ARRAY_TASK_ID on $(hostname): sessions $first to $(( first + count - 1 "
         "))\"\n"
-        "{} \\\n  --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\" --first \"$first\" --count \"$count\" --quiet\n"
-        "echo \"atonlab simulate: task $SLURM_ARRAY_TASK_ID done\"\n",
+        "# exec: atonlab itself receives scancel's and the time limit's SIGTERM, and keeps the sessions it\n"
+        "# finished (a shell in between would die first, and Slurm then kills what is left of the task).\n"
+        "exec {} \\\n  --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\" --first \"$first\" --count \"$count\" --quiet\n",
         utc_now(), ATONLAB_VERSION, s.sessions_per_task, s.sessions_per_task, s.sessions_per_task, s.designs,
         s.sessions, dir.string(), shell_quote(dir.string()), shell_quote(dir.string()), shell_quote(dir.string()),
         sbatch_lines, s.sessions_per_task, s.sessions, words);
