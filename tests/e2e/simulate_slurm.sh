@@ -80,6 +80,8 @@ job=$(sed -n 's/^simulate: submitted job \([0-9]*\):.*/\1/p' "$out/submit.out")
 grep -q "^#SBATCH --array=0-19$" "$dir/simulate.sbatch" || { echo "the script's array is not 0-19:"; cat "$dir/simulate.sbatch"; fail=1; }
 refused second_submission "still queued or running" "" -- \
   "$atonlab" simulate "$protocol" "${heavy[@]}" --sessions $sessions --out "$dir" --slurm
+"$atonlab" simulate --status "$dir" >"$out/status0.out" 2>&1
+grep -q "^  pending  20: 0-19$" "$out/status0.out" || { echo "--status of the held job:"; cat "$out/status0.out"; fail=1; }
 scontrol release "$job"
 
 # Stop a task mid-way: the first seen running, once it has written a session
