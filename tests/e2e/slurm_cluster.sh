@@ -3,7 +3,8 @@
 #   start_slurm DIR   munged, slurmctld and slurmd from DIR's own munge key and
 #                     slurm.conf; exports SLURM_CONF; returns 1 (saying why)
 #                     when the node does not come up
-#   stop_slurm        stops the three daemons it started, by their pids
+#   stop_slurm        cancels the cluster's jobs and stops the three daemons
+#                     it started and slurmd's slurmstepd children, by their pids
 # No accounting (sacct has nothing to say: `atonlab simulate --status` reads
 # the files), proctrack/linuxproc and task/none (no cgroups needed).
 
@@ -88,8 +89,17 @@ CONF
 }
 
 stop_slurm() {
-  local pid
-  for pid in "${slurm_pids[@]}"; do kill "$pid" 2>/dev/null; done
+  local pid steps=()
+  # Jobs still queued (a test that failed mid-way) are cancelled first, and
+  # slurmd's slurmstepd children (one per running step) stopped with it, so
+  # that nothing of this cluster outlives it.
+  if [ ${#slurm_pids[@]} -eq 3 ]; then
+    scancel --quiet --user="$(id -un)" 2>/dev/null
+    for _ in $(seq 1 40); do [ -z "$(squeue -h 2>/dev/null)" ] && break; sleep 0.25; done
+    mapfile -t steps < <(pgrep -P "${slurm_pids[2]}" 2>/dev/null)
+  fi
+  for pid in "${slurm_pids[@]}" "${steps[@]}"; do kill "$pid" 2>/dev/null; done
+  slurm_pids+=("${steps[@]}")
   for pid in "${slurm_pids[@]}"; do
     for _ in $(seq 1 20); do kill -0 "$pid" 2>/dev/null || break; sleep 0.25; done
     kill -9 "$pid" 2>/dev/null
