@@ -23,6 +23,8 @@ packages=(
   xdotool  # the full-screen runner's Xvfb tests send real X key events (XTEST) with it
   python3 sqlite3  # tests only: the README quick-start walk, the fake spotread's transcripts, reading study files from shell tests
   clang libclang-rt-14-dev  # scripts/fuzz.sh: the loaders' fuzz targets (libFuzzer is in libclang-rt-14-dev)
+  parallel  # tests only: `atonlab simulate --print-commands | parallel` (tests/e2e/simulate_cli.sh)
+  slurm-wlm munge  # tests only: `atonlab simulate --slurm` against a one-node Slurm started as root (tests/e2e/simulate_slurm.sh)
   chromium  # the report's layout test renders report.html headless (tests/e2e/report_chromium.sh)
   pybind11-dev python3-dev python3-numpy  # the Python module atonlab (python/, docs/python.md): pybind11, the headers, numpy arrays
   python3-pandas  # the Python module's studies as DataFrames (atonlab.read_study, analyze, check's table)

@@ -25,6 +25,7 @@
 #include "run_session.h"
 #include "session/progress.h"
 #include "session/stop_signals.h"
+#include "simulate/cluster_jobs.h"
 #include "simulate/simulation_designs.h"
 #include "simulate/simulation_folder.h"
 
@@ -136,6 +137,37 @@ std::size_t run_rendered(const std::vector<Pending>& todo, std::uint64_t seed, b
     return trials;
 }
 
+/// --first I --count K: a share inside a simulation set up before (its
+/// manifest written), within its sessions.
+void check_share(const SimulateOptions& o, const std::optional<SimulationManifest>& existing) {
+    if (!existing)
+        throw InputError(SourceLocation::command_line("--first"),
+                         fmt::format("{} holds no simulation.json: a share of the sessions (--first) runs inside a "
+                                     "simulation set up before; run the command without --first and --count, or "
+                                     "with --slurm or --print-commands, first.",
+                                     o.out));
+    if (o.sessions > existing->sessions)
+        throw InputError(SourceLocation::command_line("--sessions"),
+                         fmt::format("--sessions {} is more than the {} of {}'s simulation.json: a share (--first) "
+                                     "never changes the manifest; extend the simulation without --first first.",
+                                     o.sessions, existing->sessions, o.out));
+    if (*o.first >= o.sessions || o.count.value_or(0) < 1)
+        throw InputError(SourceLocation::command_line("--first"),
+                         fmt::format("--first {} --count {} holds no session of the {} per design (indices 0 to {}).",
+                                     *o.first, o.count.value_or(0), o.sessions, o.sessions - 1));
+}
+
+/// --status DIR and --resubmit DIR.
+int run_folder_command(const SimulateOptions& o) {
+    if (!o.status_dir.empty() && !o.resubmit_dir.empty())
+        throw InputError(SourceLocation::command_line("--status"), "give --status or --resubmit, not both.");
+    const std::string option = o.status_dir.empty() ? "--resubmit" : "--status";
+    if (!o.protocols.empty() || !o.out.empty() || o.slurm || o.print_commands)
+        throw InputError(SourceLocation::command_line(option),
+                         fmt::format("{} DIR takes the folder alone: its job's script and record are in it.", option));
+    return o.status_dir.empty() ? resubmit_slurm_tasks(o.resubmit_dir) : print_slurm_status(o.status_dir);
+}
+
 }  // namespace
 
 void add_simulate_command(CLI::App& app, SimulateOptions& o) {
@@ -143,10 +175,9 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
         "simulate",
         "Plan a study: run a protocol N times with simulated observers, one study file per session "
         "(docs/simulate.md); then `atonlab analyze DIR`");
-    cmd->add_option("protocols", o.protocols, "Protocol file(s); several are compared side by side")->required();
-    cmd->add_option("--sessions", o.sessions, "Sessions per design (N >= 1)")->required();
-    cmd->add_option("--out", o.out, "The simulation's folder (created; a run into it again continues it)")
-        ->required();
+    cmd->add_option("protocols", o.protocols, "Protocol file(s); several are compared side by side");
+    cmd->add_option("--sessions", o.sessions, "Sessions per design (N >= 1)");
+    cmd->add_option("--out", o.out, "The simulation's folder (created; a run into it again continues it)");
     cmd->add_option("--seed", o.seed, "Session i has seed S + i (default: the first protocol's seed)");
     cmd->add_option("--jobs", o.jobs, "Worker threads (default: every core)");
     cmd->add_option("--set", o.sets,
@@ -167,14 +198,40 @@ void add_simulate_command(CLI::App& app, SimulateOptions& o) {
                   "Then write the simulation report into DIR/report (atonlab analyze DIR --out DIR/report)");
     cmd->add_option("--effect", o.effect,
                     "With --report: the effect (log10 units) whose power to be detected the report gives");
+    // A share of the sessions, and a cluster (docs/simulate-cluster.md).
+    auto* first = cmd->add_option("--first", o.first,
+                                  "Run session indices [I, I + K) of every design only (a task's share; the folder's "
+                                  "manifest and tables must be there already)");
+    cmd->add_option("--count", o.count, "K, the sessions of --first's share")->needs(first);
+    first->needs("--count");
+    cmd->add_flag("--slurm", o.slurm,
+                  "Build the tables here, then submit the sessions as a Slurm job array (DIR/simulate.sbatch)");
+    cmd->add_flag("--print-commands", o.print_commands,
+                  "Build the tables here, then print one command per task (for GNU parallel) instead of running");
+    cmd->add_option("--partition", o.partition, "--slurm: the partition (sbatch --partition)");
+    cmd->add_option("--time", o.time, "--slurm: each task's time limit (MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS)");
+    cmd->add_option("--cpus-per-task", o.cpus_per_task, "--slurm, --print-commands: a task's cores and worker threads "
+                                                        "(default 1)");
+    cmd->add_option("--sessions-per-task", o.sessions_per_task,
+                    "--slurm, --print-commands: sessions of each design a task runs (default: at least 100, and "
+                    "few enough tasks for the cluster's MaxArraySize)");
+    cmd->add_option("--sbatch-arg", o.sbatch_args, "--slurm: an sbatch option written into the script, e.g. "
+                                                   "--sbatch-arg=--mem=2G (repeatable)");
+    cmd->add_option("--status", o.status_dir, "Show the tasks of DIR's Slurm job: done, running, failed, missing");
+    cmd->add_option("--resubmit", o.resubmit_dir, "Submit DIR's failed and missing Slurm tasks again");
 }
 
 int run_simulate(const SimulateOptions& o) {
+    if (!o.status_dir.empty() || !o.resubmit_dir.empty()) return run_folder_command(o);
     StopSignals signals;
+    if (o.protocols.empty())
+        throw InputError(SourceLocation::command_line("protocols"), "give the protocol file(s) to simulate.");
+    if (o.out.empty()) throw InputError(SourceLocation::command_line("--out"), "--out DIR is needed.");
     if (o.sessions < 1)
         throw InputError(SourceLocation::command_line("--sessions"), "--sessions must be at least 1.");
     if (o.effect && !o.report)
         throw InputError(SourceLocation::command_line("--effect"), "--effect is the report's: give --report too.");
+    const std::size_t per_task = check_cluster_options(o);  // before anything is made or written
     if (!(o.table_bound > 0.0 && o.table_bound <= 0.1))
         throw InputError(SourceLocation::command_line("--table-bound"),
                          fmt::format("--table-bound must be in (0, 0.1] log10 brightness, not {}.", o.table_bound));
@@ -188,6 +245,7 @@ int run_simulate(const SimulateOptions& o) {
     const fs::path dir = o.out;
     check_writable(dir);
     const std::optional<SimulationManifest> existing = read_manifest(dir);
+    if (o.first) check_share(o, existing);
     const std::uint64_t seed = o.seed.value_or(designs.front().protocol.seed);
     SimulationManifest manifest = manifest_of(designs, o, seed);
     if (existing) {
@@ -201,20 +259,33 @@ int run_simulate(const SimulateOptions& o) {
     // The tables (or, rendering every trial, the true values): renders, once
     // the folder is known to take this simulation.
     const fs::path cache = o.table_cache.empty() ? tables_dir(dir) : fs::path(o.table_cache);
+    SimulateOptions table_options = o;
+    table_options.quiet = o.quiet || o.print_commands;  // stdout holds the commands only
     if (o.render_every_trial) {
         render_true_values(designs);
-    } else if (!prepare_tables(designs, o, cache)) {
+    } else if (!prepare_tables(designs, table_options, cache)) {
         return 2;
     }
-    // Every check has passed: from here on the folder is written.
+    // Every check has passed: from here on the folder is written. A share
+    // (--first) only reads the manifest and tables: tasks of one array may
+    // start at once, and the command that cut them into shares wrote both.
     fs::create_directories(dir);
-    if (!o.render_every_trial) save_tables(designs, cache);
-    files::write_file_atomically(manifest_path(dir), manifest.json());
+    if (!o.first) {
+        if (!o.render_every_trial) save_tables(designs, cache);
+        files::write_file_atomically(manifest_path(dir), manifest.json());
+    }
+    if (o.slurm) return submit_slurm_array(o, seed, designs.size(), per_task);
+    if (o.print_commands) {
+        print_task_commands(o, seed, per_task);
+        return 0;
+    }
+    const std::size_t lo = o.first.value_or(0);
+    const std::size_t hi = o.first ? std::min(o.sessions, lo + o.count.value_or(0)) : o.sessions;
     std::vector<Pending> todo;
     std::size_t before = 0;
     for (const SimulationDesign& d : designs) {
         fs::create_directories(session_file(dir, d.index, 0).parent_path());
-        for (std::size_t i = 0; i < o.sessions; ++i) {
+        for (std::size_t i = lo; i < hi; ++i) {
             const fs::path file = session_file(dir, d.index, i);
             if (fs::exists(file)) {
                 ++before;

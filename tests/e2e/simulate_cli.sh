@@ -5,7 +5,8 @@
 # show is refused as `atonlab run` refuses it; a run killed mid-way continues
 # where it stopped, and its sessions equal an uninterrupted run's; a folder
 # holding another simulation is refused and left as it was; more sessions
-# extend a simulation. Exit 77 (a skip) where no GL 4.5 context exists.
+# extend a simulation; --print-commands' commands, run by GNU parallel, make
+# the uninterrupted run's sessions. Exit 77 (a skip) where no GL 4.5 context exists.
 set -uo pipefail
 atonlab=$1 src=$2 out=$3
 protocol=$src/tests/data/simulate/sim_2afc.toml
@@ -68,6 +69,35 @@ if ta != tb:
     diff = [k for k in sorted(set(ta) | set(tb)) if ta.get(k) != tb.get(k)]
     print(f"{len(diff)} sessions differ from the uninterrupted run's, e.g. {diff[:3]}"); sys.exit(1)
 print("the continued run's 400 sessions equal the uninterrupted run's, none lost or duplicated")
+PY
+
+# --print-commands: one command per task, run here by GNU parallel; the
+# sessions equal the uninterrupted run's (docs/simulate-cluster.md).
+"$atonlab" simulate "$protocol" --sessions 40 --sessions-per-task 15 --out "$out/commands" --table-cache "$out/cache" \
+  --print-commands >"$out/commands.txt" 2>"$out/commands.err" || { echo "--print-commands failed"; cat "$out/commands.err"; fail=1; }
+[ "$(wc -l <"$out/commands.txt")" -eq 3 ] || { echo "--print-commands printed not 3 commands:"; cat "$out/commands.txt"; fail=1; }
+grep -q -- "--first 30 --count 10 --quiet$" "$out/commands.txt" || { echo "the last share is not 30 + 10:"; cat "$out/commands.txt"; fail=1; }
+if command -v parallel >/dev/null; then
+  parallel --will-cite --jobs 2 <"$out/commands.txt" || { echo "parallel's commands failed"; fail=1; }
+elif [ "${CI:-}" = true ]; then
+  echo "GNU parallel is not installed (scripts/setup.sh installs it)"; fail=1
+else
+  bash "$out/commands.txt" || { echo "the printed commands failed"; fail=1; }
+fi
+python3 - "$out/whole" "$out/commands" <<'PY' || fail=1
+import glob, os, sqlite3, sys
+def trials(f):
+    con = sqlite3.connect(f"file:{f}?mode=ro", uri=True)
+    t = con.execute("select group_concat(level || ':' || response || ':' || test_on_left, ' ') "
+                    "from (select * from trials order by trial_index)").fetchone()[0]
+    con.close()
+    return t
+names = sorted(os.path.relpath(f, sys.argv[2]) for f in glob.glob(os.path.join(sys.argv[2], "sessions", "*", "*.db")))
+expected = [f"sessions/00/session-{i:06}.db" for i in range(40)]
+if names != expected: print(f"the printed commands wrote {len(names)} sessions, not 0 to 39"); sys.exit(1)
+diff = [n for n in names if trials(os.path.join(sys.argv[1], n)) != trials(os.path.join(sys.argv[2], n))]
+if diff: print(f"{len(diff)} sessions of the printed commands differ from the uninterrupted run's, e.g. {diff[:3]}"); sys.exit(1)
+print("the printed commands' 40 sessions equal the uninterrupted run's")
 PY
 
 # Another protocol into the folder: refused, nothing changed.

@@ -26,6 +26,19 @@ struct SimulateOptions {
     bool quiet = false;
     bool report = false;          ///< --report: `atonlab analyze DIR --out DIR/report` once every session is done
     std::optional<double> effect;  ///< --effect D for the report (log10 units)
+
+    // A share of the sessions and a cluster (docs/simulate-cluster.md).
+    std::optional<std::size_t> first;       ///< --first I: run session indices [I, I + count) of every design only
+    std::optional<std::size_t> count;       ///< --count K (with --first)
+    bool slurm = false;                     ///< submit the sessions as a Slurm job array
+    bool print_commands = false;            ///< print one `atonlab simulate … --first I --count K` per task
+    std::string partition;                  ///< --partition P (sbatch's)
+    std::string time;                       ///< --time T, each task's limit in Slurm's format
+    std::size_t cpus_per_task = 1;          ///< --cpus-per-task C: the task's worker threads too
+    std::size_t sessions_per_task = 0;      ///< --sessions-per-task K (0: chosen, docs/simulate-cluster.md)
+    std::vector<std::string> sbatch_args;   ///< --sbatch-arg ARG: written into the script as #SBATCH ARG
+    std::string status_dir;                 ///< --status DIR
+    std::string resubmit_dir;               ///< --resubmit DIR
 };
 
 }  // namespace atonlab::runner

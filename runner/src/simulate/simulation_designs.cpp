@@ -165,6 +165,13 @@ bool prepare_tables(std::vector<SimulationDesign>& designs, const SimulateOption
                              file.string().c_str(), e.what());
             }
         }
+        if (o.first)  // an array task: building here would race the other tasks and cost each the build
+            throw InputError(SourceLocation::command_line("--first"),
+                             fmt::format("design {}'s decision table {} is not in {}: a share of the sessions "
+                                         "(--first) never builds a table; build it first with the same command "
+                                         "without --first and --count (--slurm and --print-commands build it "
+                                         "before any task runs).",
+                                         d.index, file.filename().string(), cache.string()));
         if (!context) context = gl::create_headless_context();
         RunOptions ro;
         ro.protocol = d.protocol_path;
