@@ -266,7 +266,12 @@ std::string toml_value(const py::handle& value, const std::string& key) {
             text += (text.size() > 1 ? ", " : " ") + std::string(py::str(k)) + " = " + toml_value(v, key);
         return text + " }";
     }
-    // numpy scalars and other numbers: as a float
+    // numpy scalars (np.int64, np.float32, np.bool_) and 0-d arrays: their
+    // Python value, so an integer stays an integer and a bool a bool.
+    if (py::hasattr(value, "dtype") && py::hasattr(value, "item") &&
+        (!py::isinstance<py::array>(value) || value.cast<py::array>().ndim() == 0))
+        return toml_value(value.attr("item")(), key);
+    // Other numbers: as a float
     if (PyNumber_Check(value.ptr()) && py::hasattr(value, "__float__"))
         return toml_value(py::float_(py::reinterpret_borrow<py::object>(value)), key);
     throw InputError(SourceLocation::command_line("overrides", key),

@@ -169,7 +169,7 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
 int run_session(const RunOptions& o) {
     // Installed first: a signal during the setup ends the session before its first trial.
     StopSignals signals;
-    const bool person = !o.model_observer && o.script.empty();
+    const bool person = !o.model_observer && o.script.empty() && !o.custom_observer;
     const std::string code = checked_observer_code(o);
     // --- Load and validate everything before the first trial.
     SessionInputs in = load_session_inputs(o);
