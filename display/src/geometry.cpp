@@ -1,10 +1,11 @@
 #include "atonlab/display/geometry.h"
-#include "atonlab/display/solid_angle.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
 #include <numbers>
+
+#include "atonlab/display/solid_angle.h"
 
 namespace atonlab::display {
 

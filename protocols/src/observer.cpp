@@ -3,19 +3,18 @@
 
 #include <fmt/format.h>
 
-#include <glm/geometric.hpp>
-#include <glm/vec3.hpp>
-
-#include "atonlab/display/solid_angle.h"
-
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/special_functions/erf.hpp>
 #include <boost/math/tools/roots.hpp>
 #include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+
+#include "atonlab/display/solid_angle.h"
 
 namespace atonlab::protocols {
 
@@ -53,8 +52,8 @@ void validate_image(const DisplayedImage& image) {
                                                 image.luminance_cd_m2.size(), image.background_cd_m2.size()));
     if (!(image.focal_px >= 0.0) || !std::isfinite(image.focal_px) || !std::isfinite(image.principal_px.x) ||
         !std::isfinite(image.principal_px.y))
-        throw std::invalid_argument(fmt::format("a displayed image's focal length must be >= 0 px, not {}",
-                                                image.focal_px));
+        throw std::invalid_argument(
+            fmt::format("a displayed image's focal length must be >= 0 px, not {}", image.focal_px));
 }
 
 WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_deg, bool annulus) {
@@ -70,8 +69,9 @@ WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_de
     double reach = annulus ? 2.0 * r : r;
     const glm::dvec3 centre_dir = exact ? direction(image, centre) : glm::dvec3(0.0);
     if (exact) {
-        const double theta = std::min(angle_between(centre_dir, glm::dvec3(0, 0, 1)) + outer_deg * std::numbers::pi / 180.0,
-                                      std::numbers::pi / 2.0 * 0.99);
+        const double theta =
+            std::min(angle_between(centre_dir, glm::dvec3(0, 0, 1)) + outer_deg * std::numbers::pi / 180.0,
+                     std::numbers::pi / 2.0 * 0.99);
         reach /= std::cos(theta) * std::cos(theta);
     }
     const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - reach)));

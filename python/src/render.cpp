@@ -144,7 +144,8 @@ std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::opti
         stimuli::SceneTemplate scene_template = stimuli::SceneTemplate::load(path);
         stimuli::Scene scene = scene_template.instantiate(list);
         stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
-        source = std::make_shared<SceneSource>(SceneSource{std::move(scene_template), std::move(list), std::move(scene)});
+        source =
+            std::make_shared<SceneSource>(SceneSource{std::move(scene_template), std::move(list), std::move(scene)});
     }
     return std::make_unique<PyScene>(path, std::move(source));
 }
@@ -174,8 +175,7 @@ GlUse::~GlUse() {
 }
 
 void bind_render(py::module_& m) {
-    py::class_<PyFrame>(m, "Frame",
-                        "One rendered frame: the scene-referred image and what the display is sent.")
+    py::class_<PyFrame>(m, "Frame", "One rendered frame: the scene-referred image and what the display is sent.")
         .def_readonly("hdr", &PyFrame::hdr,
                       "H×W×3 float32: linear Rec.709 (sRGB primaries, D65), absolute cd/m² (Y = 0.2126 R + 0.7152 G "
                       "+ 0.0722 B is the luminance); row 0 is the top. A view of the frame's own memory (no copy).")
@@ -189,9 +189,10 @@ void bind_render(py::module_& m) {
         .def_readonly("render_s", &PyFrame::render_s,
                       "Wall-clock seconds spent in the library: the render, the read-back of the image and the codes "
                       "(an 8-bit display's as bytes), without the Python call around it.")
-        .def_readonly("metadata", &PyFrame::metadata,
-                      "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
-                      "camera, scene, time_s, software, glare, tonemap, ...")
+        .def_readonly(
+            "metadata", &PyFrame::metadata,
+            "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
+            "camera, scene, time_s, software, glare, tonemap, ...")
         .def_readonly("display", &PyFrame::display,
                       "The display as numbers: name, peak_cd_m2, black_cd_m2, transfer (the channels' law: "
                       "\"srgb\", \"pq\", \"gog\", \"lut\"; a list of three where they differ), "

@@ -9,23 +9,23 @@
 #include <algorithm>
 #include <cmath>
 #include <csignal>
-#include <stdexcept>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include "analyze_command.h"
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/psychometric.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "bindings.h"
-#include "analyze_command.h"
 #include "check_command.h"
-#include "run_command.h"
 #include "displayability.h"
+#include "run_command.h"
 #include "run_session.h"
 #include "session/session_inputs.h"
 #include "session/stop_signals.h"
@@ -85,9 +85,10 @@ protocols::Answer answer_of(const py::object& r, protocols::Task task) {
             throw InputError(where, "the observer's response time must be a finite number of seconds >= 0");
     }
     if (!py::isinstance<py::str>(word))
-        throw InputError(where, "the observer must return a response word (\"left\", \"right\", \"yes\", "
-                                "\"no\", ...) or (word, response_time_s), not " +
-                                    std::string(py::str(py::repr(r))));
+        throw InputError(where,
+                         "the observer must return a response word (\"left\", \"right\", \"yes\", "
+                         "\"no\", ...) or (word, response_time_s), not " +
+                             std::string(py::str(py::repr(r))));
     const std::string text = word.cast<std::string>();
     const std::optional<protocols::Response> response = protocols::parse_response_word(text);
     bool fits = false;
@@ -135,8 +136,8 @@ struct ObserverRaised : std::runtime_error {
 py::dict run(const std::string& protocol, const std::string& db, const std::string& observer, bool headless,
              const std::optional<py::function>& progress, const std::optional<std::string>& script,
              const std::optional<std::int64_t>& resume, bool resume_last, const std::optional<std::uint64_t>& seed,
-             const std::optional<std::uint64_t>& observer_seed, bool allow_undisplayable, bool true_pse,
-             bool verbose, const std::optional<py::function>& custom, const std::string& custom_name) {
+             const std::optional<std::uint64_t>& observer_seed, bool allow_undisplayable, bool true_pse, bool verbose,
+             const std::optional<py::function>& custom, const std::string& custom_name) {
     runner::RunOptions o;
     o.protocol = protocol;
     o.db = db;

@@ -1,10 +1,10 @@
 #include "atonlab/stimuli/footprint.h"
 
-#include "atonlab/display/solid_angle.h"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include "atonlab/display/solid_angle.h"
 
 namespace atonlab::stimuli {
 namespace {

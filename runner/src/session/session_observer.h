@@ -33,7 +33,7 @@ public:
                     protocols::ModelObserverParams params = {});
 
     bool model() const noexcept { return model_; }
-    bool custom() const noexcept { return static_cast<bool>(custom_); }  ///< RunOptions::custom_observer answers
+    bool custom() const noexcept { return static_cast<bool>(custom_); }       ///< RunOptions::custom_observer answers
     bool person() const noexcept { return !model_ && !script_ && !custom_; }  ///< a person answers at the screen
     /// What the trials store as the observer's kind: "model", "custom", "script" or "person".
     std::string_view kind() const noexcept;
