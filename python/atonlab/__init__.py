@@ -130,7 +130,14 @@ def run(protocol, db, observer="model", headless=True, progress=None, *, script=
     stops the command: the trial being shown is finished and committed, the
     session is marked quit and the study file closed, then KeyboardInterrupt
     is raised; run(..., resume_last=True) continues it to the same trials as
-    an uninterrupted run. Returns {"completed", "status", "exit_status", "db"}.
+    an uninterrupted run. Returns {"completed", "status", "exit_status", "db",
+    "conditions"}: conditions lists what the session found, one dict per
+    condition (pandas.DataFrame(result["conditions"]) makes it a table):
+    condition, estimate (the mean of its tracks' estimates, the procedure's
+    units; None without one), tracks, method, n_tracks, finished, responses,
+    and for a model observer's completed session with true_pse the model's
+    true_value (its PSE, or its level at the procedure's target probability,
+    true_kind says which; None with true_value_why where it has none).
 
     observer may also be a callable, your own observer (docs/python.md "Your
     own observer"): observer(trial) gets each trial's facts and what the model

@@ -29,6 +29,7 @@
 #include "run_session.h"
 #include "session/session_inputs.h"
 #include "session/stop_signals.h"
+#include "session/summary.h"
 
 namespace atonlab::python {
 
@@ -184,6 +185,9 @@ py::dict run(const std::string& protocol, const std::string& db, const std::stri
             runner::request_stop(SIGINT);
         }
     };
+    // What the session found, handed over as it ends (returned as "conditions").
+    std::vector<runner::ConditionSummary> found;
+    o.on_summary = [&found](const std::vector<runner::ConditionSummary>& s) { found = s; };
     int status = 0;
     {
         py::gil_scoped_release release;
@@ -215,6 +219,23 @@ py::dict run(const std::string& protocol, const std::string& db, const std::stri
     out["status"] = status == 0 ? "completed" : status == 6 ? "ended by the observer" : "stopped";
     out["exit_status"] = status;
     out["db"] = db;
+    const auto optional = [](const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::none(); };
+    py::list conditions;
+    for (const runner::ConditionSummary& c : found) {
+        py::dict row;
+        row["condition"] = c.condition;
+        row["estimate"] = optional(c.estimate);
+        row["tracks"] = c.tracks;
+        row["method"] = c.method;
+        row["n_tracks"] = c.n_tracks;
+        row["finished"] = c.finished;
+        row["responses"] = c.responses;
+        row["true_value"] = optional(c.true_value);
+        row["true_kind"] = c.true_kind;
+        row["true_value_why"] = c.true_value_why;
+        conditions.append(row);
+    }
+    out["conditions"] = conditions;
     return out;
 }
 

@@ -14,6 +14,7 @@ from conftest import SOURCE, atonlab
 pd = pytest.importorskip("pandas", reason="missing tool: python3-pandas")
 
 TINY = SOURCE / "tests" / "data" / "run" / "tiny_2afc.toml"  # 3 trials, two-interval 2AFC
+SMALL = SOURCE / "tests" / "data" / "run" / "small_2afc.toml"  # 2 conditions of 12 trials
 
 
 def brighter(trial):
@@ -88,3 +89,25 @@ def test_an_exception_stops_the_run_and_resume_gives_the_same_trials(gl, tmp_pat
 def test_a_wrong_answer_names_the_observer(gl, tmp_path):
     with pytest.raises(atonlab.InputError, match="answered \"yes\", which does not fit a 2afc trial"):
         atonlab.run(TINY, tmp_path / "wrong.db", observer=lambda trial: "yes")
+
+
+def test_run_returns_what_it_found(gl, tmp_path, capfd):
+    """The per-condition estimates and the model's true PSEs of
+    tests/data/run/small_2afc.toml (two conditions, 12 trials each): the
+    numbers `atonlab run` prints at its end (verbose=True prints them here)."""
+    capfd.readouterr()
+    result = atonlab.run(SMALL, tmp_path / "model.db", verbose=True)
+    printed = capfd.readouterr().out
+    assert [c["condition"] for c in result["conditions"]] == ["dark-empirical", "dusk-perceptual"]
+    for c in result["conditions"]:
+        assert c["n_tracks"] == 1 and c["responses"] == 12 and c["true_kind"] == "PSE"
+        estimate = "no estimate" if c["estimate"] is None else f"{c['estimate']:.3f}"
+        line = (f"{c['condition']:<24} {estimate} [{c['method']}; {c['finished']} of 1 tracks finished, 12 "
+                f"responses]; model's true PSE {c['true_value']:.3f}")
+        assert line in printed, printed
+        # The estimate is the procedure's: the mean of its track's.
+        assert c["estimate"] is None or c["estimate"] == pytest.approx(np.mean(c["tracks"]))
+    assert result["conditions"][1]["estimate"] is not None
+    # A custom observer has no true values.
+    result = atonlab.run(TINY, tmp_path / "custom.db", observer=brighter)
+    assert result["conditions"][0]["true_value"] is None and result["conditions"][0]["responses"] == 3

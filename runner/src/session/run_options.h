@@ -6,11 +6,14 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
 
 namespace atonlab::runner {
+
+struct ConditionSummary;  // session/summary.h
 
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
 /// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
@@ -61,6 +64,10 @@ struct RunOptions {
     /// so that a resumed session answers as an uninterrupted one would.
     std::function<protocols::Answer(const protocols::ScheduledTrial&, const protocols::Shown&)> custom_observer;
     std::string custom_observer_name;  ///< stored in each trial's state as "observer_name"
+    /// Called once the session has ended (completed or stopped by a signal or
+    /// the observer) with what it found per condition (session/summary.h), the
+    /// model's true values included where `true_pse` and the session completed.
+    std::function<void(const std::vector<ConditionSummary>&)> on_summary;
 
     // On screen (without --headless; docs/running.md "On screen").
     int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary
