@@ -139,13 +139,27 @@ std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::opti
             list.emplace_back(key, toml_value(v, key), SourceLocation::command_line("overrides", key));
         }
     std::shared_ptr<SceneSource> source;
-    {
+    try {
         py::gil_scoped_release release;
         stimuli::SceneTemplate scene_template = stimuli::SceneTemplate::load(path);
         stimuli::Scene scene = scene_template.instantiate(list);
         stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
         source =
             std::make_shared<SceneSource>(SceneSource{std::move(scene_template), std::move(list), std::move(scene)});
+    } catch (const InputError& e) {
+        // An override's error names the `overrides` argument (its origin) and echoes the value given.
+        const std::optional<SourceLocation> where = e.where();
+        if (overrides && where && where->option == "overrides")
+            for (const auto& [k, v] : *overrides) {
+                const std::string key = py::str(k);
+                if (where->key == key || where->key.starts_with(key + ".") || where->key.starts_with(key + "[")) {
+                    std::string message = e.message();
+                    if (message.ends_with('.')) message.pop_back();
+                    throw InputError(*where,
+                                     message + " (the value given: " + std::string(py::str(py::repr(v))) + ").");
+                }
+            }
+        throw;
     }
     return std::make_unique<PyScene>(path, std::move(source));
 }

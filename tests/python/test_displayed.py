@@ -100,3 +100,13 @@ def test_dir_lists_only_atonlabs_names():
     names = dir(atonlab)
     assert {"Scene", "Frame", "run", "check", "read_study"} <= set(names)
     assert not {"json", "math", "os", "tempfile"} & set(names)
+
+
+def test_an_overrides_error_names_the_argument_and_echoes_the_value():
+    with pytest.raises(atonlab.InputError) as e:
+        atonlab.Scene.load(str(QUICKSTART_SCENE), {"display.width_px": 1920.5})
+    assert e.value.option == "overrides" and e.value.key == "display.width_px"
+    assert "--set" not in str(e.value) and "(the value given: 1920.5)" in str(e.value), str(e.value)
+    with pytest.raises(atonlab.InputError) as e:
+        atonlab.Scene.load(str(QUICKSTART_SCENE), {"light.test.intensity_cd": -1.0})
+    assert e.value.option == "overrides" and "(the value given: -1.0)" in str(e.value), str(e.value)
