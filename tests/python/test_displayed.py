@@ -110,3 +110,14 @@ def test_an_overrides_error_names_the_argument_and_echoes_the_value():
     with pytest.raises(atonlab.InputError) as e:
         atonlab.Scene.load(str(QUICKSTART_SCENE), {"light.test.intensity_cd": -1.0})
     assert e.value.option == "overrides" and "(the value given: -1.0)" in str(e.value), str(e.value)
+
+
+def test_metadata_is_typed(gl):
+    frame = atonlab.Scene.load(str(QUICKSTART_SCENE), {**SMALL, "camera.yaw_deg": 2.5}).render(time_s=1.25)
+    m = frame.metadata
+    assert m["time_s"] == 1.25 and isinstance(m["time_s"], float)
+    # The pinhole of a veridical camera: the viewing distance in pixel pitches, 0.9 m × 480 px / 0.598 m.
+    assert m["camera"]["focal_px"] == pytest.approx(0.9 * 480 / 0.598, rel=1e-4)
+    assert m["camera"]["position_m"] == [0.0, 3.0, 0.0] and m["camera"]["yaw_deg"] == 2.5
+    assert m["tonemap"]["operator"] == "empirical" and m["tonemap"]["bits"] == 8.0
+    assert isinstance(m["software"], str)
