@@ -18,6 +18,7 @@ import tempfile
 from ._atonlab import (  # noqa: F401  (re-exported)
     Frame,
     InputError,
+    InputFileNotFoundError,
     NoContextError,
     Scene,
     StudyFileError,
@@ -31,7 +32,7 @@ from ._atonlab import (  # noqa: F401  (re-exported)
 )
 from . import _atonlab
 
-__all__ = ["Scene", "Frame", "InputError", "NoContextError", "StudyFileError", "tonemap", "glare", "psf",
+__all__ = ["Scene", "Frame", "InputError", "InputFileNotFoundError", "NoContextError", "StudyFileError", "tonemap", "glare", "psf",
            "light", "read_exr", "write_exr", "check", "run", "read_study", "analyze", "fit", "Check", "Analysis",
            "Fit", "__version__"]
 

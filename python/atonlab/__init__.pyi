@@ -20,6 +20,9 @@ class InputError(ValueError):
     option: Optional[str]
     message: Optional[str]
 
+class InputFileNotFoundError(InputError, FileNotFoundError):
+    """An input file that does not exist: an InputError and a FileNotFoundError (filename names it)."""
+
 class NoContextError(RuntimeError):
     """No OpenGL 4.5 context can be made on this machine."""
 

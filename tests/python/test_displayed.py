@@ -121,3 +121,17 @@ def test_metadata_is_typed(gl):
     assert m["camera"]["position_m"] == [0.0, 3.0, 0.0] and m["camera"]["yaw_deg"] == 2.5
     assert m["tonemap"]["operator"] == "empirical" and m["tonemap"]["bits"] == 8.0
     assert isinstance(m["software"], str)
+
+
+def test_a_missing_file_is_an_input_error_and_file_not_found(tmp_path):
+    missing = tmp_path / "no-such.scene.toml"
+    for call in (lambda: atonlab.Scene.load(str(missing)), lambda: atonlab.check(tmp_path / "no-such.toml")):
+        with pytest.raises(FileNotFoundError) as e:
+            call()
+        assert isinstance(e.value, atonlab.InputError) and "no-such" in str(e.value) and "no-such" in e.value.filename
+    # An error inside a file that exists is an InputError only.
+    bad = tmp_path / "bad.scene.toml"
+    bad.write_text("[display]\nwidth_px = \"wide\"\n")
+    with pytest.raises(atonlab.InputError) as e:
+        atonlab.Scene.load(str(bad))
+    assert not isinstance(e.value, FileNotFoundError)
