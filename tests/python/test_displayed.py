@@ -135,3 +135,31 @@ def test_a_missing_file_is_an_input_error_and_file_not_found(tmp_path):
     with pytest.raises(atonlab.InputError) as e:
         atonlab.Scene.load(str(bad))
     assert not isinstance(e.value, FileNotFoundError)
+
+
+def test_a_typo_in_a_protocol_is_reported_before_any_gl_work(tmp_path):
+    """run() reads and checks the protocol before it makes the GL context: with
+    no EGL vendor library (no context can be made) a typo still raises the
+    InputError naming its key, not NoContextError, and no study file is made."""
+    import os
+    import subprocess
+    import sys
+    from conftest import BINARY
+    typo = tmp_path / "typo.toml"
+    typo.write_text((RUN / "tiny_2afc.toml").read_text().replace("max_trials = 3", "max_trails = 3"))
+    (tmp_path / "small.scene.toml").write_text((RUN / "small.scene.toml").read_text())  # the protocol's scene
+    env = {**os.environ, "__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "none.json")}
+    c = subprocess.run([BINARY, "render", str(RUN / "small.scene.toml"), "-o", str(tmp_path / "x.exr")],
+                       capture_output=True, text=True, env=env)
+    if c.returncode != 3:
+        pytest.skip("not applicable: this machine's EGL does not honour __EGL_VENDOR_LIBRARY_FILENAMES")
+    code = ("import sys, atonlab\n"
+            "try:\n"
+            "    atonlab.run(sys.argv[1], sys.argv[2])\n"
+            "except atonlab.InputError as e:\n"
+            "    print('InputError', e.key)\n")
+    r = subprocess.run([sys.executable, "-c", code, str(typo), str(tmp_path / "x.db")], capture_output=True,
+                       text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("InputError") and "max_trails" in r.stdout, r.stdout
+    assert not (tmp_path / "x.db").exists()
