@@ -46,7 +46,7 @@ INCLUDES_ALLOWED = {
     "common": {"common"},
     "display": {"display", "common"},
     "stimuli": {"stimuli", "display", "common"},
-    "protocols": {"protocols", "common"},
+    "protocols": {"protocols", "display", "common"},
     "store": {"store", "common"},
     "analysis": {"analysis", "store", "protocols", "display", "common"},
     "bench": {"bench", "stimuli", "display", "common"},

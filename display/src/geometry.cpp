@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "atonlab/display/solid_angle.h"
+
 namespace atonlab::display {
 
 double DisplayGeometry::fov_x_rad() const {
@@ -26,6 +28,13 @@ double DisplayGeometry::pixels_per_degree() const {
 std::string DisplayGeometry::describe() const {
     return fmt::format("{} x {} px, {:.4g} x {:.4g} m at {:.4g} m: {:.1f} px/deg at the centre", width_px, height_px,
                        width_m, height_m(), viewing_distance_m, pixels_per_degree());
+}
+
+double pixel_solid_angle_sr(double x0, double y0, double focal_px) {
+    const double f = focal_px;
+    auto corner = [f](double x, double y) { return std::atan(x * y / (f * std::sqrt(x * x + y * y + f * f))); };
+    const double x1 = x0 + 1.0, y1 = y0 + 1.0;
+    return corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0);
 }
 
 }  // namespace atonlab::display

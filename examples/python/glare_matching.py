@@ -2,7 +2,9 @@
 """Glare matching from Python: the README's quick start as a script.
 
 Renders the quick start's two frames (the test light with the eye's glare
-beside the reference without, and both without), runs the quick start
+beside the reference without, and both without), plots the displayed
+luminance of a red and a white light at 0.01 cd/m² (what the display's codes
+show, and the light each adds at the eye as `atonlab check` sums it), runs the quick start
 headless with the model observer, reads the study into pandas, fits the
 psychometric function and plots it; the figures are saved into --out.
 
@@ -14,6 +16,7 @@ import argparse
 import pathlib
 
 import matplotlib
+import matplotlib.colors
 
 matplotlib.use("Agg")  # files, no window
 import matplotlib.pyplot as plt  # noqa: E402
@@ -62,6 +65,44 @@ def show_frames(out):
     return frames
 
 
+# The issue's question: at 0.01 cd/m², a red light (the test) beside a white
+# one (the reference), both 0.05 cd, with and without the eye's glare.
+RED_WHITE = {"eye.adaptation_cd_m2": 0.01, "environment.luminance_cd_m2": 0.01, "light.test.intensity_cd": 0.05,
+             "light.test.colour": "red", "light.reference.intensity_cd": 0.05, "tonemap.operator": "perceptual"}
+
+
+def show_red_and_white(out):
+    """displayed.png: the displayed luminance (cd/m², the codes decoded through
+    the display model) around a red and a white light, without and with glare,
+    and a row through both; the titles give the light each adds at the eye."""
+    fig, axes = plt.subplots(2, 3, figsize=(11, 6.5), gridspec_kw={"width_ratios": [1, 1, 2]})
+    for row, glare in zip(axes, ("none", "wave-optics")):
+        frame = atonlab.Scene.load(SCENE, {**RED_WHITE, "light.test.glare": glare,
+                                           "light.reference.glare": glare}).render()
+        shown = frame.displayed_cd_m2
+        lum = shown.sum(axis=2)  # the channels add (docs/python.md)
+        peak = frame.display["peak_cd_m2"]
+        h = lum.shape[0]
+        for ax, x_m, name in ((row[0], -43.74, "red (test)"), (row[1], 43.74, "white (reference)")):
+            im = ax.imshow(crop(lum, frame, x_m, 32), interpolation="nearest", cmap="magma",
+                           norm=matplotlib.colors.LogNorm(vmin=max(lum.min(), 1e-3), vmax=peak))
+            light = "test" if x_m < 0 else "reference"
+            ax.set_title(f"{name}, glare {glare}\nadds {frame.added_lux(light):.3g} lx at the eye", fontsize=9)
+            ax.set_axis_off()
+        fig.colorbar(im, ax=row[1], label="displayed cd/m²", fraction=0.046)
+        deg = (np.arange(lum.shape[1]) - lum.shape[1] / 2) * frame.deg_per_px
+        for c, colour in enumerate(("red", "green", "blue")):
+            row[2].semilogy(deg, shown[h // 2, :, c] + 1e-4, color=colour, lw=0.8, label=f"{colour} channel")
+        row[2].set_xlim(-6, 6)
+        row[2].set_xlabel("degrees from the centre (row through both lights)")
+        row[2].set_ylabel("cd/m² (+1e-4)")
+        row[2].axhline(peak * 0.2126, color="red", ls=":", lw=0.6, label="red channel's white")
+        row[2].legend(fontsize=7, loc="upper center")
+    fig.tight_layout()
+    fig.savefig(out / "displayed.png", dpi=100)
+    plt.close(fig)
+
+
 def run_study(out):
     db = out / "quickstart.db"
     db.unlink(missing_ok=True)
@@ -104,9 +145,11 @@ def main():
     out = pathlib.Path(parser.parse_args().out)
     out.mkdir(parents=True, exist_ok=True)
     show_frames(out)
+    show_red_and_white(out)
     db = run_study(out)
     trials, f = fit_and_plot(db, out)
-    print(f"{len(trials)} trials; figures: {out / 'frames.png'}, {out / 'psychometric.png'}")
+    print(f"{len(trials)} trials; figures: {out / 'frames.png'}, {out / 'displayed.png'}, "
+          f"{out / 'psychometric.png'}")
 
 
 if __name__ == "__main__":

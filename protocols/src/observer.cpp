@@ -8,9 +8,13 @@
 #include <boost/math/special_functions/erf.hpp>
 #include <boost/math/tools/roots.hpp>
 #include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+
+#include "atonlab/display/solid_angle.h"
 
 namespace atonlab::protocols {
 
@@ -21,12 +25,22 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 struct WindowSums {
     double window_lux = 0.0;     ///< Σ L Ω inside the window
     double background_lux = 0.0; ///< Σ L_off Ω inside the window (0 without a background image)
-    std::size_t window_px = 0;   ///< pixels inside
+    double window_sr = 0.0;      ///< Σ Ω inside the window
     double annulus_cd_m2 = 0.0;  ///< Σ L over the annulus r < d <= 2r
     std::size_t annulus_px = 0;
 };
 
-WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_deg, bool annulus) {
+/// The direction (unit vector) from the eye through image point p (pixels).
+glm::dvec3 direction(const DisplayedImage& image, glm::dvec2 p) {
+    return glm::normalize(glm::dvec3(p - image.principal_px, image.focal_px));
+}
+
+/// The angle (radians) between unit vectors a and b: 2 asin(|a − b| / 2), exact for small angles too.
+double angle_between(glm::dvec3 a, glm::dvec3 b) {
+    return 2.0 * std::asin(std::min(1.0, 0.5 * glm::length(a - b)));
+}
+
+void validate_image(const DisplayedImage& image) {
     if (image.width <= 0 || image.height <= 0 || !(image.deg_per_px > 0.0) ||
         image.luminance_cd_m2.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height))
         throw std::invalid_argument(
@@ -36,31 +50,57 @@ WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_de
     if (image.has_background() && image.background_cd_m2.size() != image.luminance_cd_m2.size())
         throw std::invalid_argument(fmt::format("a displayed image's background needs {} values, not {}",
                                                 image.luminance_cd_m2.size(), image.background_cd_m2.size()));
+    if (!(image.focal_px >= 0.0) || !std::isfinite(image.focal_px) || !std::isfinite(image.principal_px.x) ||
+        !std::isfinite(image.principal_px.y))
+        throw std::invalid_argument(
+            fmt::format("a displayed image's focal length must be >= 0 px, not {}", image.focal_px));
+}
+
+WindowSums sums(const DisplayedImage& image, glm::dvec2 centre, double radius_deg, bool annulus) {
+    validate_image(image);
     if (!(radius_deg > 0.0) || !std::isfinite(radius_deg))
         throw std::invalid_argument(fmt::format("the window radius must be > 0 degrees, not {}", radius_deg));
-    const double r = radius_deg / image.deg_per_px;  // pixels
-    const double outer = annulus ? 2.0 * r : r;
-    const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - outer)));
-    const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(centre.x + outer)));
-    const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - outer)));
-    const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(centre.y + outer)));
-    const double omega = image.pixel_sr();
+    const bool exact = image.focal_px > 0.0;
+    const double r = radius_deg / image.deg_per_px;  // pixels at the principal point
+    const double outer_deg = annulus ? 2.0 * radius_deg : radius_deg;
+    // Exact geometry: a pixel θ off-axis subtends cos²θ (radially) of the
+    // centre's angle, so the window reaches 1/cos² further in pixels; search
+    // that far (θ the light's angle plus the window's, capped below 90°).
+    double reach = annulus ? 2.0 * r : r;
+    const glm::dvec3 centre_dir = exact ? direction(image, centre) : glm::dvec3(0.0);
+    if (exact) {
+        const double theta =
+            std::min(angle_between(centre_dir, glm::dvec3(0, 0, 1)) + outer_deg * std::numbers::pi / 180.0,
+                     std::numbers::pi / 2.0 * 0.99);
+        reach /= std::cos(theta) * std::cos(theta);
+    }
+    const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - reach)));
+    const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(centre.x + reach)));
+    const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - reach)));
+    const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(centre.y + reach)));
+    const double radius_rad = radius_deg * std::numbers::pi / 180.0;
     WindowSums s;
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
-            const double dx = x + 0.5 - centre.x;
-            const double dy = y + 0.5 - centre.y;
-            const double d2 = dx * dx + dy * dy;
+            const glm::dvec2 p{x + 0.5, y + 0.5};
+            // The pixel's distance from the light, in units of the window's radius.
+            double rel = 0.0;
+            if (exact) {
+                rel = angle_between(direction(image, p), centre_dir) / radius_rad;
+            } else {
+                rel = glm::length(p - centre) / r;
+            }
             const double l = image.at(x, y);
-            if (d2 <= r * r) {
+            if (rel <= 1.0) {
+                const double omega = image.pixel_sr(x, y);
                 s.window_lux += l * omega;
+                s.window_sr += omega;
                 if (image.has_background())
                     s.background_lux +=
                         image.background_cd_m2[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
                                                static_cast<std::size_t>(x)] *
                         omega;
-                ++s.window_px;
-            } else if (annulus && d2 <= outer * outer) {
+            } else if (annulus && rel <= 2.0) {
                 s.annulus_cd_m2 += l;
                 ++s.annulus_px;
             }
@@ -143,7 +183,8 @@ const View& view_at(const Shown& shown, std::size_t i) {
 
 }  // namespace
 
-double DisplayedImage::pixel_sr() const {
+double DisplayedImage::pixel_sr(int x, int y) const {
+    if (focal_px > 0.0) return display::pixel_solid_angle_sr(x - principal_px.x, y - principal_px.y, focal_px);
     const double a = deg_per_px * std::numbers::pi / 180.0;
     return a * a;
 }
@@ -168,7 +209,7 @@ double increment_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_
     }
     const WindowSums s = sums(image, centre_px, radius_deg, true);
     const double background = s.annulus_px > 0 ? s.annulus_cd_m2 / static_cast<double>(s.annulus_px) : 0.0;
-    return s.window_lux - background * static_cast<double>(s.window_px) * image.pixel_sr();
+    return s.window_lux - background * s.window_sr;
 }
 
 // ---------------------------------------------------------------------------

@@ -18,6 +18,7 @@ import tempfile
 from ._atonlab import (  # noqa: F401  (re-exported)
     Frame,
     InputError,
+    InputFileNotFoundError,
     NoContextError,
     Scene,
     StudyFileError,
@@ -31,9 +32,14 @@ from ._atonlab import (  # noqa: F401  (re-exported)
 )
 from . import _atonlab
 
-__all__ = ["Scene", "Frame", "InputError", "NoContextError", "StudyFileError", "tonemap", "glare", "psf",
+__all__ = ["Scene", "Frame", "InputError", "InputFileNotFoundError", "NoContextError", "StudyFileError", "tonemap", "glare", "psf",
            "light", "read_exr", "write_exr", "check", "run", "read_study", "analyze", "fit", "Check", "Analysis",
            "Fit", "__version__"]
+
+
+def __dir__():
+    """atonlab's own names (PEP 562): not the standard modules it uses."""
+    return sorted(__all__)
 
 
 def _paths(paths):
@@ -109,7 +115,8 @@ def check(protocol, display=None, db=None):
 # run
 
 def run(protocol, db, observer="model", headless=True, progress=None, *, script=None, resume=None,
-        resume_last=False, seed=None, observer_seed=None, allow_undisplayable=False, true_pse=True, verbose=False):
+        resume_last=False, seed=None, observer_seed=None, allow_undisplayable=False, true_pse=True, verbose=False,
+        observer_code=None, observer_name=None):
     """Runs one session of a protocol into the study file db, as `atonlab run`
     does (docs/running.md): every trial committed before the next is shown.
 
@@ -124,12 +131,37 @@ def run(protocol, db, observer="model", headless=True, progress=None, *, script=
     stops the command: the trial being shown is finished and committed, the
     session is marked quit and the study file closed, then KeyboardInterrupt
     is raised; run(..., resume_last=True) continues it to the same trials as
-    an uninterrupted run. Returns {"completed", "status", "exit_status", "db"}.
+    an uninterrupted run. Returns {"completed", "status", "exit_status", "db",
+    "conditions"}: conditions lists what the session found, one dict per
+    condition (pandas.DataFrame(result["conditions"]) makes it a table):
+    condition, estimate (the mean of its tracks' estimates, the procedure's
+    units; None without one), tracks, method, n_tracks, finished, responses,
+    and for a model observer's completed session with true_pse the model's
+    true_value (its PSE, or its level at the procedure's target probability,
+    true_kind says which; None with true_value_why where it has none).
+
+    observer may also be a callable, your own observer (docs/python.md "Your
+    own observer"): observer(trial) gets each trial's facts and what the model
+    observer would see (trial["views"]: each judged light's window of
+    displayed luminance, cd/m²) and returns a response word ("left", "right",
+    "yes", "no", ...) or (word, response_time_s). It is stored with the code
+    observer_code (default "custom") and, in each trial's state, the kind
+    "custom" and observer_name (default the callable's __name__). An exception
+    it raises ends the session there: that trial is not stored, every
+    committed one is kept, the session stays open, and the exception is
+    raised; run(..., resume_last=True) continues it.
     Raises InputError, StudyFileError, NoContextError. The GIL is released
     while the session runs; nothing is printed on stdout unless verbose."""
+    custom = None
+    if callable(observer):
+        custom = observer
+        observer_name = observer_name or getattr(observer, "__name__", type(observer).__name__)
+        observer = observer_code or "custom"
+    elif observer_code is not None or observer_name is not None:
+        raise InputError("observer_code and observer_name are for a callable observer")
     return _atonlab._run(os.fspath(protocol), os.fspath(db), observer, headless, progress,
                          None if script is None else os.fspath(script), resume, resume_last, seed, observer_seed,
-                         allow_undisplayable, true_pse, verbose)
+                         allow_undisplayable, true_pse, verbose, custom, observer_name or "")
 
 
 # ---------------------------------------------------------------------------

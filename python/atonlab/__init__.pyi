@@ -20,6 +20,9 @@ class InputError(ValueError):
     option: Optional[str]
     message: Optional[str]
 
+class InputFileNotFoundError(InputError, FileNotFoundError):
+    """An input file that does not exist: an InputError and a FileNotFoundError (filename names it)."""
+
 class NoContextError(RuntimeError):
     """No OpenGL 4.5 context can be made on this machine."""
 
@@ -37,6 +40,10 @@ class Frame:
     time_s: float  # scene time, s
     render_s: float  # wall-clock s inside the library
     metadata: dict[str, Any]  # the EXR header's attributes
+    display: dict[str, Any]  # the display as numbers: peak_cd_m2, black_cd_m2, transfer, bits, primaries_xy, ...
+    @property
+    def displayed_cd_m2(self) -> npt.NDArray[np.float32]: ...  # H×W×3: what each channel emits, cd/m²
+    def added_lux(self, light: str, radius_deg: float = 0.5) -> float: ...  # `atonlab check`'s "adds", lx
 
 class Scene:
     """A scene file with its overrides applied."""
@@ -101,11 +108,13 @@ class Check:
 
 def check(protocol: _Path, display: Optional[Mapping[str, float]] = None, db: Optional[_Path] = None) -> Check: ...
 
-def run(protocol: _Path, db: _Path, observer: str = "model", headless: bool = True,
-        progress: Optional[Callable[[int, Optional[int]], None]] = None, *, script: Optional[_Path] = None,
-        resume: Optional[int] = None, resume_last: bool = False, seed: Optional[int] = None,
-        observer_seed: Optional[int] = None, allow_undisplayable: bool = False, true_pse: bool = True,
-        verbose: bool = False) -> dict[str, Any]: ...
+def run(protocol: _Path, db: _Path,
+        observer: Union[str, Callable[[dict[str, Any]], Union[str, tuple[str, float]]]] = "model",
+        headless: bool = True, progress: Optional[Callable[[int, Optional[int]], None]] = None, *,
+        script: Optional[_Path] = None, resume: Optional[int] = None, resume_last: bool = False,
+        seed: Optional[int] = None, observer_seed: Optional[int] = None, allow_undisplayable: bool = False,
+        true_pse: bool = True, verbose: bool = False, observer_code: Optional[str] = None,
+        observer_name: Optional[str] = None) -> dict[str, Any]: ...
 
 CATEGORY_MAX_VALUES: int
 CATEGORY_MAX_FRACTION: float

@@ -6,8 +6,13 @@
 
 #include <mutex>
 #include <string>
+#include <vector>
 
+#include "atonlab/common/scene_override.h"
+#include "atonlab/display/display_model.h"
 #include "atonlab/stimuli/image_io.h"
+#include "atonlab/stimuli/scene.h"
+#include "atonlab/stimuli/scene_file.h"
 
 namespace atonlab::python {
 
@@ -44,6 +49,16 @@ py::dict metadata_dict(const stimuli::ExrMetadata& meta);
 /// A Python value (bool, int, float, str, list, tuple, dict) as TOML value
 /// text, for a scene override. `key` names it in an InputError.
 std::string toml_value(const py::handle& value, const std::string& key);
+
+/// A frame's display as numbers (Frame.display; displayed.cpp).
+py::dict display_dict(const stimuli::Scene& scene, int bits);
+/// H×W×3 codes (uint8 for bits <= 8, else uint16) decoded through the display
+/// model: what each channel of each pixel emits, cd/m² (Frame.displayed_cd_m2).
+py::array displayed_cd_m2(const py::array& codes, const display::DisplayModel& model, int bits);
+/// The light (lx) `light` adds within radius_deg of it, as `atonlab check`
+/// computes it (Frame.added_lux). Takes a GlUse. Throws InputError.
+double added_lux(const stimuli::SceneTemplate& scene_template, const std::vector<SceneOverride>& overrides,
+                 const stimuli::Scene& scene, const std::string& light, double radius_deg);
 
 void bind_exceptions(py::module_& m);
 void bind_render(py::module_& m);

@@ -7,6 +7,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -233,13 +234,78 @@ stimuli::ImageRGBA32F image_from_array(const py::array& array, const char* name)
     return image;
 }
 
+namespace {
+
+/// text as a number when all of it is one (C locale), else nullopt.
+std::optional<double> number_of(const std::string& text) {
+    if (text.empty()) return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end != text.c_str() + text.size()) return std::nullopt;
+    return v;
+}
+
+/// One metadata value typed: a number as a float, "[a, b, c]" as a list of them, else the text.
+py::object typed_value(const std::string& text) {
+    if (const std::optional<double> v = number_of(text)) return py::float_(*v);
+    if (text.size() >= 2 && text.front() == '[' && text.back() == ']') {
+        py::list items;
+        std::string item;
+        for (const char c : text.substr(1, text.size() - 2) + ",") {
+            if (c != ',') {
+                item += c;
+                continue;
+            }
+            const std::size_t a = item.find_first_not_of(' '), b = item.find_last_not_of(' ');
+            const std::string trimmed = a == std::string::npos ? std::string() : item.substr(a, b - a + 1);
+            if (!trimmed.empty()) items.append(typed_value(trimmed));
+            item.clear();
+        }
+        return items;
+    }
+    return py::str(text);
+}
+
+/// "k=v k=[a, b] ..." (the camera and tonemap attributes) as a dict of typed values.
+py::dict key_values(const std::string& text) {
+    py::dict d;
+    std::size_t i = 0;
+    while (i < text.size()) {
+        while (i < text.size() && text[i] == ' ') ++i;
+        const std::size_t eq = text.find('=', i);
+        if (eq == std::string::npos) break;
+        const std::string key = text.substr(i, eq - i);
+        std::size_t end = eq + 1;
+        if (end < text.size() && text[end] == '[') {
+            end = text.find(']', end);
+            end = end == std::string::npos ? text.size() : end + 1;
+        } else {
+            end = std::min(text.find(' ', end), text.size());
+        }
+        d[py::str(key)] = typed_value(text.substr(eq + 1, end - eq - 1));
+        i = end;
+    }
+    return d;
+}
+
+}  // namespace
+
 py::dict metadata_dict(const stimuli::ExrMetadata& meta) {
     py::dict d;
     d["units"] = meta.units;
     d["degreesPerPixel"] = meta.degrees_per_pixel;
     if (meta.adaptation_cd_m2) d["adaptationLuminance"] = *meta.adaptation_cd_m2;
     if (meta.wavelength_nm) d["wavelength"] = *meta.wavelength_nm;
-    for (const auto& [k, v] : meta.strings) d[py::str(k)] = v;
+    // Typed (docs/python.md): the camera and the tone mapper as dicts of their
+    // settings, a number (time_s) as a float, any other text as it is.
+    for (const auto& [k, v] : meta.strings) {
+        if (k == "camera" || k == "tonemap")
+            d[py::str(k)] = key_values(v);
+        else if (const std::optional<double> number = number_of(v))
+            d[py::str(k)] = *number;
+        else
+            d[py::str(k)] = v;
+    }
     return d;
 }
 
@@ -266,7 +332,12 @@ std::string toml_value(const py::handle& value, const std::string& key) {
             text += (text.size() > 1 ? ", " : " ") + std::string(py::str(k)) + " = " + toml_value(v, key);
         return text + " }";
     }
-    // numpy scalars and other numbers: as a float
+    // numpy scalars (np.int64, np.float32, np.bool_) and 0-d arrays: their
+    // Python value, so an integer stays an integer and a bool a bool.
+    if (py::hasattr(value, "dtype") && py::hasattr(value, "item") &&
+        (!py::isinstance<py::array>(value) || value.cast<py::array>().ndim() == 0))
+        return toml_value(value.attr("item")(), key);
+    // Other numbers: as a float
     if (PyNumber_Check(value.ptr()) && py::hasattr(value, "__float__"))
         return toml_value(py::float_(py::reinterpret_borrow<py::object>(value)), key);
     throw InputError(SourceLocation::command_line("overrides", key),

@@ -5,6 +5,9 @@
 // raises atonlab.StudyFileError (an OSError) with `file`.
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
+#include <system_error>
+
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/error.h"
@@ -15,6 +18,7 @@ namespace atonlab::python {
 namespace {
 
 PyObject* g_input_error = nullptr;
+PyObject* g_input_file_not_found = nullptr;  // an InputError and a FileNotFoundError
 PyObject* g_no_context = nullptr;
 PyObject* g_study_file_error = nullptr;
 
@@ -33,15 +37,22 @@ py::object optional_text(const std::string& s) {
 
 /// Raises InputError(what()) with the location's parts as attributes (None where unknown).
 void raise_input_error(const InputError& e) {
-    py::object instance = py::reinterpret_steal<py::object>(PyObject_CallFunction(g_input_error, "s", e.what()));
-    if (!instance) throw py::error_already_set();
     const SourceLocation where = e.where().value_or(SourceLocation{});
+    // An error about a whole file (no line) that is not there: a missing file,
+    // also a FileNotFoundError (InputFileNotFoundError).
+    std::error_code ec;
+    const bool missing =
+        !where.file.empty() && where.line == 0 && !std::filesystem::exists(std::filesystem::path(where.file), ec);
+    PyObject* type = missing ? g_input_file_not_found : g_input_error;
+    py::object instance = py::reinterpret_steal<py::object>(PyObject_CallFunction(type, "s", e.what()));
+    if (!instance) throw py::error_already_set();
+    if (missing) instance.attr("filename") = py::str(where.file);
     instance.attr("file") = optional_text(where.file);
     instance.attr("line") = where.line > 0 ? py::object(py::int_(where.line)) : py::object(py::none());
     instance.attr("key") = optional_text(where.key);
     instance.attr("option") = optional_text(where.option);
     instance.attr("message") = py::str(e.message());
-    PyErr_SetObject(g_input_error, instance.ptr());
+    PyErr_SetObject(type, instance.ptr());
 }
 
 void raise_study_file_error(const store::StoreError& e) {
@@ -61,6 +72,12 @@ void bind_exceptions(py::module_& m) {
         "prints; e.file, e.line (1-based) and e.key say where, e.option names the argument or command-line option "
         "that gave the value (None where unknown).",
         PyExc_ValueError);
+    py::tuple file_bases = py::make_tuple(py::handle(g_input_error), py::handle(PyExc_FileNotFoundError));
+    g_input_file_not_found = new_exception(
+        m, "InputFileNotFoundError",
+        "An input file that does not exist (a scene, protocol, script or image file): an InputError and a "
+        "FileNotFoundError (e.filename names it).",
+        file_bases.ptr());
     g_no_context = new_exception(
         m, "NoContextError",
         "No OpenGL 4.5 context can be made on this machine (rendering, psf, check and run need one); str(e) says why.",

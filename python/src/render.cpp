@@ -29,6 +29,13 @@ namespace {
 /// still alive when the interpreter exits hold GL objects of it).
 gl::Context* g_context = nullptr;
 
+/// What a scene was loaded from: a frame renders its lights' windows again from it (Frame.added_lux).
+struct SceneSource {
+    stimuli::SceneTemplate scene_template;
+    std::vector<SceneOverride> overrides;
+    stimuli::Scene scene;
+};
+
 struct PyFrame {
     py::array hdr;       ///< H×W×3 float32, cd/m², a view of `rgba`'s memory
     py::array rgba;      ///< H×W×4 float32, the frame's own buffer (A is 1)
@@ -38,12 +45,16 @@ struct PyFrame {
     double time_s = 0.0;
     double render_s = 0.0;  ///< wall-clock s inside the library (render, read back), for the overhead bench
     py::dict metadata;
+    py::dict display;  ///< display_dict()
+    std::shared_ptr<const SceneSource> source;
+    py::object displayed;  ///< displayed_cd_m2, made on first use (None until then)
 };
 
 /// A loaded scene and, once rendered, its pipeline (GL objects of the module's context).
 class PyScene {
 public:
-    PyScene(std::string path, stimuli::Scene scene) : path_(std::move(path)), scene_(std::move(scene)) {}
+    PyScene(std::string path, std::shared_ptr<const SceneSource> source)
+        : path_(std::move(path)), source_(std::move(source)), scene_(source_->scene) {}
     ~PyScene() {
         if (!pipeline_) return;
         // The pipeline's GL objects are deleted with the module's context
@@ -89,6 +100,9 @@ public:
         out.time_s = time_s;
         out.metadata = metadata_dict(frame->meta);
         out.bits = codes.bits;
+        out.display = display_dict(scene_, codes.bits);
+        out.source = source_;
+        out.displayed = py::none();
         out.codes = codes.bits <= 8 ? owned_array(std::move(codes8), codes.height, codes.width)
                                     : owned_array(std::move(codes.rgb), codes.height, codes.width);
         out.hdr = rgb_view(std::move(frame->hdr));
@@ -111,7 +125,8 @@ private:
     }
 
     std::string path_;
-    stimuli::Scene scene_;
+    std::shared_ptr<const SceneSource> source_;
+    const stimuli::Scene& scene_;  ///< source_'s
     std::unique_ptr<stimuli::Pipeline> pipeline_;
 };
 
@@ -123,13 +138,30 @@ std::unique_ptr<PyScene> load(const std::filesystem::path& file, const std::opti
             const std::string key = py::str(k);
             list.emplace_back(key, toml_value(v, key), SourceLocation::command_line("overrides", key));
         }
-    stimuli::Scene scene;
-    {
+    std::shared_ptr<SceneSource> source;
+    try {
         py::gil_scoped_release release;
-        scene = stimuli::load_scene(path, list);
+        stimuli::SceneTemplate scene_template = stimuli::SceneTemplate::load(path);
+        stimuli::Scene scene = scene_template.instantiate(list);
         stimuli::validate_output_settings(scene.output, scene.adaptation_cd_m2);
+        source =
+            std::make_shared<SceneSource>(SceneSource{std::move(scene_template), std::move(list), std::move(scene)});
+    } catch (const InputError& e) {
+        // An override's error names the `overrides` argument (its origin) and echoes the value given.
+        const std::optional<SourceLocation> where = e.where();
+        if (overrides && where && where->option == "overrides")
+            for (const auto& [k, v] : *overrides) {
+                const std::string key = py::str(k);
+                if (where->key == key || where->key.starts_with(key + ".") || where->key.starts_with(key + "[")) {
+                    std::string message = e.message();
+                    if (message.ends_with('.')) message.pop_back();
+                    throw InputError(*where,
+                                     message + " (the value given: " + std::string(py::str(py::repr(v))) + ").");
+                }
+            }
+        throw;
     }
-    return std::make_unique<PyScene>(path, std::move(scene));
+    return std::make_unique<PyScene>(path, std::move(source));
 }
 
 }  // namespace
@@ -157,8 +189,7 @@ GlUse::~GlUse() {
 }
 
 void bind_render(py::module_& m) {
-    py::class_<PyFrame>(m, "Frame",
-                        "One rendered frame: the scene-referred image and what the display is sent.")
+    py::class_<PyFrame>(m, "Frame", "One rendered frame: the scene-referred image and what the display is sent.")
         .def_readonly("hdr", &PyFrame::hdr,
                       "H×W×3 float32: linear Rec.709 (sRGB primaries, D65), absolute cd/m² (Y = 0.2126 R + 0.7152 G "
                       "+ 0.0722 B is the luminance); row 0 is the top. A view of the frame's own memory (no copy).")
@@ -172,9 +203,36 @@ void bind_render(py::module_& m) {
         .def_readonly("render_s", &PyFrame::render_s,
                       "Wall-clock seconds spent in the library: the render, the read-back of the image and the codes "
                       "(an 8-bit display's as bytes), without the Python call around it.")
-        .def_readonly("metadata", &PyFrame::metadata,
-                      "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
-                      "camera, scene, time_s, software, glare, tonemap, ...")
+        .def_readonly(
+            "metadata", &PyFrame::metadata,
+            "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
+            "camera, scene, time_s, software, glare, tonemap, ...")
+        .def_readonly("display", &PyFrame::display,
+                      "The display as numbers: name, peak_cd_m2, black_cd_m2, transfer (the channels' law: "
+                      "\"srgb\", \"pq\", \"gog\", \"lut\"; a list of three where they differ), "
+                      "channel_white_cd_m2 and channel_black_cd_m2 (R, G, B), bits, primaries_xy (red, green, blue "
+                      "and white CIE 1931 xy: Rec.709 with D65), width_px, height_px, width_m, viewing_distance_m "
+                      "and focal_px (the viewing distance in pixel pitches).")
+        .def_property_readonly(
+            "displayed_cd_m2",
+            [](PyFrame& f) {
+                if (f.displayed.is_none() && !f.codes.is_none())
+                    f.displayed = displayed_cd_m2(f.codes.cast<py::array>(), f.source->scene.output.display, f.bits);
+                return f.displayed;
+            },
+            "H×W×3 float32: what each pixel's red, green and blue emit (cd/m²), the codes decoded through the "
+            "display model; their sum is the luminance the pixel shows (dither and clipping included). Row 0 is "
+            "the top.")
+        .def(
+            "added_lux",
+            [](const PyFrame& f, const std::string& light, double radius_deg) {
+                return added_lux(f.source->scene_template, f.source->overrides, f.source->scene, light, radius_deg);
+            },
+            py::arg("light"), py::arg("radius_deg") = 0.5,
+            "The light (lx) the scene light or disc `light` adds at the observer's eye within radius_deg of it: "
+            "Σ (L − L_off) · Ω over the window's pixels, L the displayed luminance with the light and L_off "
+            "without it (the same frame and dither), Ω each pixel's own solid angle; `atonlab check`'s number "
+            "(its 'adds' column), rendered the same way at scene time 0. Negative where it takes light away.")
         .def("__repr__", [](const PyFrame& f) {
             return "<atonlab.Frame " + std::to_string(f.hdr.shape(1)) + "x" + std::to_string(f.hdr.shape(0)) + ", " +
                    std::to_string(f.deg_per_px) + " deg/px>";

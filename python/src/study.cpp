@@ -6,29 +6,101 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include "analyze_command.h"
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/psychometric.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/protocols/observer.h"
+#include "atonlab/protocols/protocol_schedule.h"
 #include "bindings.h"
-#include "analyze_command.h"
 #include "check_command.h"
-#include "run_command.h"
 #include "displayability.h"
+#include "run_command.h"
 #include "run_session.h"
+#include "session/session_inputs.h"
 #include "session/stop_signals.h"
+#include "session/summary.h"
 
 namespace atonlab::python {
 
 namespace an = atonlab::analysis;
 
 namespace {
+
+/// What a custom observer is given for one trial (docs/python.md "Your own observer").
+py::dict trial_dict(const protocols::ScheduledTrial& t, const protocols::Shown& shown) {
+    py::dict d;
+    d["step"] = t.step;
+    d["block_index"] = t.block;
+    d["condition"] = t.condition_id;
+    d["procedure"] = t.procedure_id;
+    d["task"] = std::string(protocols::to_string(t.task));
+    d["level"] = t.proposal.level;
+    d["adjusted_view"] = t.stimulus.adjusted_view ? py::object(py::int_(*t.stimulus.adjusted_view)) : py::none();
+    py::list views;
+    for (std::size_t i = 0; i < shown.views.size(); ++i) {
+        const protocols::View& v = shown.views[i];
+        const protocols::DisplayedImage& img = *v.image;
+        const auto window = [&img](const std::vector<float>& values) -> py::object {
+            if (values.empty()) return py::none();
+            py::array_t<float> a({py::ssize_t{img.height}, py::ssize_t{img.width}});
+            std::copy(values.begin(), values.end(), a.mutable_data());
+            return a;
+        };
+        py::dict view;
+        const protocols::StimulusView& sv = t.stimulus.views.at(i);
+        view["role"] = std::string(protocols::to_string(sv.role));
+        view["light"] = sv.light;
+        view["frame"] = sv.frame;
+        view["displayed_cd_m2"] = window(img.luminance_cd_m2);
+        view["background_cd_m2"] = window(img.background_cd_m2);
+        view["light_px"] = py::make_tuple(v.light_px.x, v.light_px.y);
+        view["deg_per_px"] = img.deg_per_px;
+        view["focal_px"] = img.focal_px;
+        view["principal_px"] = py::make_tuple(img.principal_px.x, img.principal_px.y);
+        views.append(view);
+    }
+    d["views"] = views;
+    return d;
+}
+
+/// A custom observer's return value: a response word, or (word, response time in s).
+protocols::Answer answer_of(const py::object& r, protocols::Task task) {
+    const auto where = SourceLocation::command_line("observer");
+    py::object word = r;
+    protocols::Answer a;
+    if (py::isinstance<py::tuple>(r) && py::len(r) == 2) {
+        word = r.cast<py::tuple>()[0];
+        a.response_time_s = r.cast<py::tuple>()[1].cast<double>();
+        if (!(a.response_time_s >= 0.0) || !std::isfinite(a.response_time_s))
+            throw InputError(where, "the observer's response time must be a finite number of seconds >= 0");
+    }
+    if (!py::isinstance<py::str>(word))
+        throw InputError(where,
+                         "the observer must return a response word (\"left\", \"right\", \"yes\", "
+                         "\"no\", ...) or (word, response_time_s), not " +
+                             std::string(py::str(py::repr(r))));
+    const std::string text = word.cast<std::string>();
+    const std::optional<protocols::Response> response = protocols::parse_response_word(text);
+    bool fits = false;
+    for (const protocols::Action act : protocols::task_actions(task))
+        fits = fits || (response && protocols::response_of(act) == *response);
+    if (!fits)
+        throw InputError(where, "the observer answered \"" + text + "\", which does not fit a " +
+                                    std::string(protocols::to_string(task)) + " trial");
+    a.response = *response;
+    return a;
+}
 
 bool is_csv(const std::string& path) {
     return std::filesystem::path(path).extension() == ".csv";
@@ -56,17 +128,38 @@ std::tuple<std::string, std::string, std::string> check(const std::string& proto
             runner::displayability_refusal(d, protocol)};
 }
 
+/// Thrown through the session engine when the custom observer raised: the
+/// session ends there and run() raises the Python exception.
+struct ObserverRaised : std::runtime_error {
+    ObserverRaised() : std::runtime_error("the observer raised an exception") {}
+};
+
 py::dict run(const std::string& protocol, const std::string& db, const std::string& observer, bool headless,
              const std::optional<py::function>& progress, const std::optional<std::string>& script,
              const std::optional<std::int64_t>& resume, bool resume_last, const std::optional<std::uint64_t>& seed,
-             const std::optional<std::uint64_t>& observer_seed, bool allow_undisplayable, bool true_pse,
-             bool verbose) {
+             const std::optional<std::uint64_t>& observer_seed, bool allow_undisplayable, bool true_pse, bool verbose,
+             const std::optional<py::function>& custom, const std::string& custom_name) {
     runner::RunOptions o;
     o.protocol = protocol;
     o.db = db;
-    o.model_observer = observer == "model" && !script;
+    o.model_observer = observer == "model" && !script && !custom;
     if (script) o.script = *script;
     if (!o.model_observer) o.observer = observer == "model" ? std::string() : observer;
+    // The custom observer (docs/python.md "Your own observer"): its exception
+    // is kept and raised once the session has let go of the study file.
+    std::optional<py::error_already_set> observer_raised;
+    if (custom) {
+        o.custom_observer = [&](const protocols::ScheduledTrial& t, const protocols::Shown& shown) {
+            py::gil_scoped_acquire gil;
+            try {
+                return answer_of((*custom)(trial_dict(t, shown)), t.task);
+            } catch (py::error_already_set& e) {
+                observer_raised = std::move(e);
+                throw ObserverRaised();
+            }
+        };
+        o.custom_observer_name = custom_name;
+    }
     o.headless = headless;
     o.resume = resume;
     o.resume_last = resume_last;
@@ -92,13 +185,25 @@ py::dict run(const std::string& protocol, const std::string& db, const std::stri
             runner::request_stop(SIGINT);
         }
     };
+    // What the session found, handed over as it ends (returned as "conditions").
+    std::vector<runner::ConditionSummary> found;
+    o.on_summary = [&found](const std::vector<runner::ConditionSummary>& s) { found = s; };
     int status = 0;
     {
         py::gil_scoped_release release;
+        // The protocol, its scene and the observer read and checked first: a
+        // typo is reported before the GL context is made (seconds on llvmpipe
+        // the first time).
+        (void)runner::checked_observer_code(o);
+        (void)runner::load_session_inputs(o);
         std::optional<GlUse> gl;
         if (headless) gl.emplace();
-        status = runner::run_session(o);
+        try {
+            status = runner::run_session(o);
+        } catch (const ObserverRaised&) {
+        }
     }
+    if (observer_raised) throw std::move(*observer_raised);
     if (raised) throw std::move(*raised);
     if (status >= 128) {
         // A Ctrl-C (or SIGTERM) the session caught itself: every committed trial is kept.
@@ -114,6 +219,23 @@ py::dict run(const std::string& protocol, const std::string& db, const std::stri
     out["status"] = status == 0 ? "completed" : status == 6 ? "ended by the observer" : "stopped";
     out["exit_status"] = status;
     out["db"] = db;
+    const auto optional = [](const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::none(); };
+    py::list conditions;
+    for (const runner::ConditionSummary& c : found) {
+        py::dict row;
+        row["condition"] = c.condition;
+        row["estimate"] = optional(c.estimate);
+        row["tracks"] = c.tracks;
+        row["method"] = c.method;
+        row["n_tracks"] = c.n_tracks;
+        row["finished"] = c.finished;
+        row["responses"] = c.responses;
+        row["true_value"] = optional(c.true_value);
+        row["true_kind"] = c.true_kind;
+        row["true_value_why"] = c.true_value_why;
+        conditions.append(row);
+    }
+    out["conditions"] = conditions;
     return out;
 }
 
@@ -232,7 +354,8 @@ void bind_study(py::module_& m) {
     m.def("_check", &check, py::arg("protocol"), py::arg("sets"), py::arg("db"));
     m.def("_run", &run, py::arg("protocol"), py::arg("db"), py::arg("observer"), py::arg("headless"),
           py::arg("progress"), py::arg("script"), py::arg("resume"), py::arg("resume_last"), py::arg("seed"),
-          py::arg("observer_seed"), py::arg("allow_undisplayable"), py::arg("true_pse"), py::arg("verbose"));
+          py::arg("observer_seed"), py::arg("allow_undisplayable"), py::arg("true_pse"), py::arg("verbose"),
+          py::arg("custom"), py::arg("custom_name"));
     m.def("_write_trials_csv", &write_trials_csv, py::arg("paths"), py::arg("csv"), py::arg("salvage"));
     m.def("_analyze", &analyze, py::arg("paths"), py::arg("out"), py::arg("bootstrap"), py::arg("seed"),
           py::arg("family"), py::arg("threads"), py::arg("salvage"));

@@ -47,7 +47,7 @@ LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, con
         // What the model observer sums (observer.h window_light_lux), signed:
         // Σ (L − L_off) · Ω over its window.
         s.added_lux = p::increment_illuminance_lux(w.image, w.light_px, renderer.window_radius_deg());
-        s.resolution_lux = w.code_step_cd_m2 * w.image.pixel_sr();
+        s.resolution_lux = w.code_step_cd_m2 * w.image.pixel_sr(w.brightest_px.x, w.brightest_px.y);
         end.lights.push_back(std::move(s));
     }
     return end;

@@ -10,26 +10,27 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/present/presenter.h"
 #include "atonlab/present/screen_presenter.h"
 #include "atonlab/present/text.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/simulated_observer.h"
-#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/store.h"
 #include "calibrate/calibration_policy.h"
-#include "displayability.h"
 #include "calibrate/profile_location.h"
+#include "displayability.h"
 #include "session/display_record.h"
 #include "session/progress.h"
 #include "session/resume.h"
+#include "session/session_display.h"
 #include "session/session_inputs.h"
 #include "session/stop_signals.h"
 #include "session/summary.h"
 #include "session/trial_loop.h"
-#include "session/session_display.h"
 
 namespace atonlab::runner {
 
@@ -108,7 +109,9 @@ void print_screen(const RunOptions& o, const present::ScreenPresenter& screen, c
 
 /// How the session ended, its timings and the per-condition summary, on stdout.
 void print_session_end(const RunOptions& o, const SessionParts& s, const p::Schedule& schedule,
-                       const TrialLoopResult& loop, bool completed, int stop) {
+                       const TrialLoopResult& loop, bool completed, int stop,
+                       const std::vector<ConditionSummary>& summary, bool with_true, std::size_t true_frames,
+                       double true_s) {
     const std::size_t total = schedule.history().size();
     std::printf("%s after %zu trials (%zu in this run, %s)\n",
                 completed           ? "completed"
@@ -123,13 +126,10 @@ void print_session_end(const RunOptions& o, const SessionParts& s, const p::Sche
         "study file %.1f s\n",
         s.renderer.frames_rendered(), s.renderer.frames_requested(), s.renderer.render_seconds(), loop.snapshot_s,
         loop.store_s);
-    const std::size_t frames_before = s.renderer.frames_rendered();
-    const auto summarising = std::chrono::steady_clock::now();
-    const bool with_true = completed && s.observer.model() && o.true_pse;
-    print_summary(s.protocol, schedule, &s.renderer, s.observer, with_true);
+    print_summary(summary);
     if (with_true)
-        std::printf("  (the true values took %zu more frames, %.1f s; --no-true-pse skips them)\n",
-                    s.renderer.frames_rendered() - frames_before, seconds_since(summarising));
+        std::printf("  (the true values took %zu more frames, %.1f s; --no-true-pse skips them)\n", true_frames,
+                    true_s);
     std::printf("\nstudy file: %s, session %lld (%s)%s\n", o.db.c_str(), static_cast<long long>(s.session.value),
                 completed ? "completed" : "quit",
                 completed ? "" : fmt::format("; continue with --resume {}", s.session.value).c_str());
@@ -169,7 +169,7 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
 int run_session(const RunOptions& o) {
     // Installed first: a signal during the setup ends the session before its first trial.
     StopSignals signals;
-    const bool person = !o.model_observer && o.script.empty();
+    const bool person = !o.model_observer && o.script.empty() && !o.custom_observer;
     const std::string code = checked_observer_code(o);
     // --- Load and validate everything before the first trial.
     SessionInputs in = load_session_inputs(o);
@@ -260,7 +260,17 @@ int run_session(const RunOptions& o) {
         store.finish_session(session, completed ? st::SessionStatus::completed : st::SessionStatus::quit);
         if (completed && stop == 0) display.text_screen(protocol.screens.end, "", "end");
         signals.restore();
-        if (!o.quiet) print_session_end(o, parts, schedule, loop, completed, stop);
+        // What the session found: printed, and handed to the caller (RunOptions::on_summary).
+        const bool with_true = completed && observer.model() && o.true_pse;
+        const std::size_t frames_before = renderer.frames_rendered();
+        const auto summarising = std::chrono::steady_clock::now();
+        std::vector<ConditionSummary> summary;
+        if (!o.quiet || o.on_summary) summary = summarise(protocol, schedule, &renderer, observer, with_true);
+        const std::size_t true_frames = renderer.frames_rendered() - frames_before;
+        const double true_s = seconds_since(summarising);
+        if (!o.quiet)
+            print_session_end(o, parts, schedule, loop, completed, stop, summary, with_true, true_frames, true_s);
+        if (o.on_summary) o.on_summary(summary);
         if (loop.observer_quit && !completed) return 6;
         return completed ? 0 : 128 + stop;
     } catch (const st::StoreError& e) {

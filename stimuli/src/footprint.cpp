@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "atonlab/display/solid_angle.h"
+
 namespace atonlab::stimuli {
 namespace {
 
@@ -64,11 +66,7 @@ double sphere_solid_angle_sr(double radius_m, double distance_m) {
 }
 
 double pixel_solid_angle_sr(double x0, double y0, double f) {
-    // Solid angle of the rectangle [0,x]×[0,y] on the plane z = f seen from the
-    // origin: atan(x y / (f sqrt(x² + y² + f²))); combine the four corners.
-    auto corner = [f](double x, double y) { return std::atan(x * y / (f * std::sqrt(x * x + y * y + f * f))); };
-    const double x1 = x0 + 1.0, y1 = y0 + 1.0;
-    return corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0);
+    return display::pixel_solid_angle_sr(x0, y0, f);  // one home: display/solid_angle.h
 }
 
 Footprint light_footprint(glm::dvec3 v, double radius_m, double focal_px, int width, int height) {

@@ -61,7 +61,7 @@ void TreeEdits::undo() noexcept {
 /// it, or "--set KEY".
 [[noreturn]] void override_error(const SceneOverride& o, const std::string& message) {
     SourceLocation where = o.origin;
-    if (where.file.empty()) where = SourceLocation::command_line(std::string(kSetOption));
+    if (where.file.empty() && where.option.empty()) where = SourceLocation::command_line(std::string(kSetOption));
     where.key = o.key;
     throw InputError(std::move(where), message);
 }

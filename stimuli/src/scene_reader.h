@@ -148,19 +148,19 @@ public:
 protected:
     void relocate(SourceLocation& w, std::string& message) const override {
         // A type error in an override that was not valid TOML says so.
-        if (w.option == kSetOption && message.ends_with("got a string."))
+        if (w.from_command_line() && message.ends_with("got a string."))
             if (auto it = string_fallbacks_.find(w.key); it != string_fallbacks_.end())
                 message = message.substr(0, message.size() - 1) + it->second + ".";
     }
 
 public:
-
     /// Records an applied override: its key as typed and its schema key
     /// ("light.buoy.intensity_cd" -> "light[0].intensity_cd"), and where it
-    /// was written when a file gave it (SceneOverride::origin).
+    /// was written when a file or an argument other than --set gave it
+    /// (SceneOverride::origin: the Python module's `overrides`).
     void note_override(const std::string& typed, const std::string& schema_key, const SourceLocation& origin) {
         override_keys_[typed] = schema_key;
-        if (origin.file.empty())
+        if (origin.file.empty() && (origin.option.empty() || origin.option == kSetOption))
             origins_.erase(typed);
         else
             origins_[typed] = origin;
@@ -184,13 +184,15 @@ private:
         std::string key = typed;
         if (auto it = override_keys_.find(typed); it != override_keys_.end() && schema_key.starts_with(it->second))
             key += schema_key.substr(it->second.size());
-        if (auto it = origins_.find(typed); it != origins_.end())
+        if (auto it = origins_.find(typed); it != origins_.end()) {
+            if (it->second.file.empty()) return SourceLocation::command_line(it->second.option, key);
             return {it->second.file, it->second.line, it->second.column, key};
+        }
         return SourceLocation::command_line(std::string(kSetOption), key);
     }
 
     std::map<std::string, std::string> override_keys_;
-    std::map<std::string, SourceLocation> origins_;  // typed key -> where a file wrote it
+    std::map<std::string, SourceLocation> origins_;  // typed key -> where a file (or an argument) wrote it
     std::map<const toml::node*, std::string> made_for_override_;
     std::map<std::string, std::string> string_fallbacks_;
 };

@@ -18,7 +18,7 @@ def test_glare_matching_example(gl, tmp_path):
     r = subprocess.run([sys.executable, str(SOURCE / "examples" / "python" / "glare_matching.py"), "--out",
                         str(tmp_path)], capture_output=True, text=True, timeout=900)
     assert r.returncode == 0, r.stderr
-    for name in ("frames.png", "psychometric.png", "quickstart.db"):
+    for name in ("frames.png", "displayed.png", "psychometric.png", "quickstart.db"):
         assert (tmp_path / name).stat().st_size > 1000, name
     pse = float(re.search(r"PSE (-?[0-9.]+) log10 cd", r.stdout).group(1))
     # 22 staircase trials: the fit's PSE within 0.15 log10 of the true one

@@ -69,11 +69,14 @@ def test_a_bad_override_names_its_key(gl):
     with pytest.raises(atonlab.InputError) as e:
         atonlab.Scene.load(str(QUICKSTART_SCENE), {"camera.yaw_deg": "north"})
     assert isinstance(e.value, ValueError)
-    # An override is a `--set` value to the scene reader: the same option, key and sentence.
-    assert e.value.key == "camera.yaw_deg" and e.value.option == "--set" and e.value.file is None
+    # An override is read as a `--set` value is: the command's sentence, naming
+    # the `overrides` argument instead of --set and echoing the value given.
+    assert e.value.key == "camera.yaw_deg" and e.value.option == "overrides" and e.value.file is None
     r = cli("render", QUICKSTART_SCENE, "-o", "unused.exr", "--set", 'camera.yaw_deg="north"', check=False)
     assert r.returncode == 2
-    assert "atonlab: " + str(e.value) == r.stderr.strip()
+    command = r.stderr.strip().removeprefix("atonlab: ")
+    assert str(e.value) == command.replace("--set", "overrides", 1).removesuffix(".") + " (the value given: 'north')."
+
 
 
 def test_psf_equals_the_command_line(gl, tmp_path):

@@ -58,7 +58,7 @@ double disc_sr(const DisplayedImage& img, glm::dvec2 centre, double radius_deg) 
             const double dx = x + 0.5 - centre.x, dy = y + 0.5 - centre.y;
             n += dx * dx + dy * dy <= r * r ? 1 : 0;
         }
-    return n * img.pixel_sr();
+    return n * img.pixel_sr(0, 0);
 }
 
 /// A Gaussian blob of peak `amplitude` cd/m² and sd `sigma_deg`.
@@ -114,6 +114,66 @@ TEST(Brightness, IncrementSubtractsTheSurround) {
     EXPECT_NEAR(window_illuminance_lux(img, c, 0.4), e_window, 1e-5 * e_window);
     // No light: no increment.
     EXPECT_NEAR(increment_illuminance_lux(blank(201, 0.01, 0.5), c, 0.4), 0.0, 1e-15);
+}
+
+// A light on a flat screen θ off the line of sight: a 2 × 2-pixel patch of
+// luminance L (as the renderer draws a light without glare) has the intensity
+// I = L · A · cos θ towards the eye (A its area, a Lambertian screen) and lies
+// D / cos θ away (D the viewing distance), so the illuminance at the eye is
+// I / (D / cos θ)² (the inverse-square and cosine laws). With each pixel's own
+// solid angle the window's sum reproduces that; a centre pixel's Ω would be
+// 1/cos³θ high (1.15 % at 5°, 21 % at 20°).
+TEST(Brightness, ExactPixelSolidAnglesReproduceInverseSquare) {
+    const double width_m = 0.598, distance_m = 0.9;
+    const int width_px = 1920;
+    const double pitch_m = width_m / width_px;
+    const double focal_px = distance_m / pitch_m;
+    const double l = 37.0;  // cd/m²
+    for (const double theta_deg : {0.0, 5.0, 20.0}) {
+        for (const double azimuth_deg : {0.0, 45.0, 180.0}) {
+            SCOPED_TRACE(testing::Message() << theta_deg << " deg off-axis, azimuth " << azimuth_deg << " deg");
+            const double theta = theta_deg * kDegToRad, phi = azimuth_deg * kDegToRad;
+            DisplayedImage img = blank(101, 180.0 / std::numbers::pi / focal_px);
+            img.focal_px = focal_px;
+            const glm::dvec2 c(50.0, 50.0);  // the patch's centre: pixels 49 and 50 in x and y
+            const double off_px = focal_px * std::tan(theta);
+            img.principal_px = c - off_px * glm::dvec2(std::cos(phi), std::sin(phi));
+            for (int y = 49; y <= 50; ++y)
+                for (int x = 49; x <= 50; ++x) img.luminance_cd_m2[static_cast<std::size_t>(y * 101 + x)] = l;
+            const double intensity_cd = l * 4.0 * pitch_m * pitch_m * std::cos(theta);
+            const double slant_m = distance_m / std::cos(theta);
+            const double expected_lux = intensity_cd / (slant_m * slant_m);
+            // The patch spans 2 pixels: cos³ varies across it by ~(1/focal)², far below 1e-6.
+            EXPECT_NEAR(window_illuminance_lux(img, c, 0.5), expected_lux, 1e-6 * expected_lux);
+            EXPECT_NEAR(window_light_lux(img, c, 0.5), expected_lux, 1e-6 * expected_lux);
+            EXPECT_NEAR(increment_illuminance_lux(img, c, 0.5), expected_lux, 1e-6 * expected_lux);
+        }
+    }
+}
+
+// The window of an image with its geometry is a circle of visual angle: at
+// 20° off-axis along x a pixel 0.5° away radially lies 0.5° / cos²20° · (px
+// per degree at the centre) pixels away, tangentially 0.5° / cos 20° ·.
+TEST(Brightness, ExactWindowIsACircleOfVisualAngle) {
+    const double focal_px = 2000.0;
+    const double dpp = 180.0 / std::numbers::pi / focal_px;
+    DisplayedImage img = blank(201, dpp);
+    img.focal_px = focal_px;
+    const double theta = 20.0 * kDegToRad;
+    const glm::dvec2 c(100.5, 100.5);  // pixel (100, 100)'s centre
+    img.principal_px = c - glm::dvec2(focal_px * std::tan(theta), 0.0);
+    // Radially (x): the pixel centre at angle 20° + δ lies at f tan(20° + δ).
+    auto radial_px = [&](double delta_deg) {
+        return focal_px * (std::tan(theta + delta_deg * kDegToRad) - std::tan(theta));
+    };
+    const int inside = static_cast<int>(std::floor(radial_px(0.49)));
+    const int outside = static_cast<int>(std::ceil(radial_px(0.51)));
+    ASSERT_GT(outside, static_cast<int>(std::ceil(0.51 / dpp)));  // beyond a pixel circle of 0.5°
+    img.luminance_cd_m2[static_cast<std::size_t>(100 * 201 + 100 + inside)] = 1.0f;
+    EXPECT_GT(window_illuminance_lux(img, c, 0.5), 0.0);
+    img.luminance_cd_m2[static_cast<std::size_t>(100 * 201 + 100 + inside)] = 0.0f;
+    img.luminance_cd_m2[static_cast<std::size_t>(100 * 201 + 100 + outside)] = 1.0f;
+    EXPECT_EQ(window_illuminance_lux(img, c, 0.5), 0.0);
 }
 
 TEST(Brightness, RefusesMalformedImages) {

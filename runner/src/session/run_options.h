@@ -6,10 +6,14 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "atonlab/protocols/observer.h"
+#include "atonlab/protocols/protocol_schedule.h"
 
 namespace atonlab::runner {
+
+struct ConditionSummary;  // session/summary.h
 
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
 /// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
@@ -49,6 +53,21 @@ struct RunOptions {
     /// and the schedule's bound (the Python module's progress callback and its
     /// Ctrl-C check); it may call request_stop() (session/stop_signals.h).
     std::function<void(std::size_t stored, std::optional<std::size_t> bound)> after_trial;
+    /// A custom observer (the Python module's run(observer=callable), docs/python.md
+    /// "Your own observer"): when set it answers every trial, shown what the model
+    /// observer is shown (each judged light's window of displayed luminance,
+    /// session_observer.h shown_for) with the trial's facts. Its trials are stored
+    /// with observer kind "custom" and custom_observer_name; `observer` is the code.
+    /// An exception it throws ends the session there: that trial is neither
+    /// answered nor stored, the committed ones are kept and the session stays
+    /// open for --resume. Its answers should depend on what it is shown alone,
+    /// so that a resumed session answers as an uninterrupted one would.
+    std::function<protocols::Answer(const protocols::ScheduledTrial&, const protocols::Shown&)> custom_observer;
+    std::string custom_observer_name;  ///< stored in each trial's state as "observer_name"
+    /// Called once the session has ended (completed or stopped by a signal or
+    /// the observer) with what it found per condition (session/summary.h), the
+    /// model's true values included where `true_pse` and the session completed.
+    std::function<void(const std::vector<ConditionSummary>&)> on_summary;
 
     // On screen (without --headless; docs/running.md "On screen").
     int monitor = 0;                          ///< GLFW's monitor index; 0 is the primary

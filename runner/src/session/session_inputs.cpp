@@ -30,7 +30,7 @@ bool valid_observer_code(std::string_view code) {
 
 std::string checked_observer_code(const RunOptions& o) {
     // A person answers at the screen; the model or a script answer anywhere.
-    const bool person = !o.model_observer && o.script.empty();
+    const bool person = !o.model_observer && o.script.empty() && !o.custom_observer;
     if (person && o.headless)
         throw InputError(SourceLocation::command_line("--headless"),
                          "a headless run has no screen for a person: give --model-observer or --script FILE with "

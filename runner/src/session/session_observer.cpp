@@ -28,9 +28,24 @@ p::Shown shown_for(const p::ScheduledTrial& t, StimulusRenderer& renderer,
 
 SessionObserver::SessionObserver(const RunOptions& o, std::uint64_t observer_seed,
                                  std::optional<p::ScriptedObserver> script, p::ModelObserverParams params)
-    : model_(o.model_observer), seed_(observer_seed), params_(params), script_(std::move(script)) {}
+    : model_(o.model_observer && !o.custom_observer),
+      seed_(observer_seed),
+      params_(params),
+      script_(std::move(script)),
+      custom_(o.custom_observer),
+      custom_name_(o.custom_observer_name) {}
+
+std::string_view SessionObserver::kind() const noexcept {
+    if (model_) return "model";
+    if (custom_) return "custom";
+    return script_ ? "script" : "person";
+}
 
 p::Answer SessionObserver::answer(const p::ScheduledTrial& t, StimulusRenderer* renderer) {
+    if (custom_) {
+        std::vector<std::shared_ptr<const FrameViews>> frames;
+        return custom_(t, shown_for(t, *renderer, frames));
+    }
     if (!model_) return script_->answer(p::Shown{t.task, {}, t.stimulus.adjusted_view});
     const std::string match = fmt::format("{}#{}", t.procedure_id, t.proposal.trial);
     if (!current_ || t.task != p::Task::Adjust || match != match_) {

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "atonlab/protocols/observer.h"
@@ -32,7 +33,11 @@ public:
                     protocols::ModelObserverParams params = {});
 
     bool model() const noexcept { return model_; }
-    bool person() const noexcept { return !model_ && !script_; }  ///< a person answers at the screen
+    bool custom() const noexcept { return static_cast<bool>(custom_); }       ///< RunOptions::custom_observer answers
+    bool person() const noexcept { return !model_ && !script_ && !custom_; }  ///< a person answers at the screen
+    /// What the trials store as the observer's kind: "model", "custom", "script" or "person".
+    std::string_view kind() const noexcept;
+    const std::string& custom_name() const noexcept { return custom_name_; }
     std::uint64_t seed() const noexcept { return seed_; }
     const protocols::ModelObserverParams& params() const noexcept { return params_; }
 
@@ -49,6 +54,8 @@ private:
     std::uint64_t seed_;
     protocols::ModelObserverParams params_{};
     std::optional<protocols::ScriptedObserver> script_;
+    std::function<protocols::Answer(const protocols::ScheduledTrial&, const protocols::Shown&)> custom_;
+    std::string custom_name_;
     std::unique_ptr<protocols::ModelObserver> current_;
     std::string match_;
 };

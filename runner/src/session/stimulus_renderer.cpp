@@ -10,6 +10,7 @@
 #include <glm/common.hpp>
 #include <glm/vector_relational.hpp>
 #include <map>
+#include <numbers>
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/tonemap.h"
@@ -252,7 +253,11 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
     const s::FrameRenderer& rendered = pipeline_.frame();
     const std::vector<s::LightDrawRecord> draws = rendered.read_light_draws();
     const s::CameraProjection proj = rendered.projection();
-    const double dpp = proj.degrees_per_pixel_at_centre();
+    // The observer's eye sees the screen's pixels: their solid angles follow
+    // from the display's geometry (its viewing distance in pixel pitches), the
+    // camera's projection for a veridical camera.
+    const double eye_focal_px = sc.display.focal_px();
+    const double dpp = 180.0 / std::numbers::pi / eye_focal_px;
     if (hdr) *hdr = rendered.read_hdr();
     const int half = static_cast<int>(std::ceil(2.0 * window_radius_deg_ / dpp)) + 2;
     const int n = 2 * half + 1;
@@ -295,6 +300,8 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         w.image.deg_per_px = dpp;
         const int x0 = static_cast<int>(std::floor(centre.x)) - half;
         const int y0 = static_cast<int>(std::floor(centre.y)) - half;
+        w.image.focal_px = eye_focal_px;
+        w.image.principal_px = glm::dvec2(0.5 * codes.width - x0, 0.5 * codes.height - y0);
         w.light_px = centre - glm::dvec2(x0, y0);
         w.frame_px = centre;
         const bool on_screen = !behind && std::isfinite(centre.x) && std::isfinite(centre.y);

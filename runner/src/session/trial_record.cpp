@@ -116,8 +116,11 @@ std::string stimulus_json(const p::Protocol& protocol, const p::Condition& c, co
 
 std::string state_json(const p::Schedule& schedule, const SessionObserver& observer, double answer_rt_s,
                        const std::optional<p::Response>& answer, const std::string& input, std::size_t step) {
-    return state_json(schedule, observer.person() ? "person" : observer.model() ? "model" : "script", observer.seed(),
-                      answer_rt_s, answer, input, step);
+    std::string json = state_json(schedule, observer.kind(), observer.seed(), answer_rt_s, answer, input, step);
+    if (!observer.custom()) return json;
+    Json j = Json::parse(json);
+    j["observer_name"] = observer.custom_name();
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string state_json(const p::Schedule& schedule, std::string_view observer_kind, std::uint64_t observer_seed,

@@ -26,13 +26,26 @@
 namespace atonlab::protocols {
 
 /// A displayed-luminance image. Pixel (x, y) covers [x, x+1) x [y, y+1) in
-/// pixel coordinates, row-major (index y * width + x), and subtends
-/// deg_per_px x deg_per_px degrees of visual angle (square pixels,
-/// small-angle: solid angle (deg_per_px · π/180)² sr).
+/// pixel coordinates, row-major (index y * width + x). With focal_px > 0 the
+/// pixels lie on a flat screen seen from the eye at focal_px pixel pitches
+/// (the viewing distance), principal_px straight ahead: each pixel subtends its
+/// own exact solid angle (display/solid_angle.h pixel_solid_angle_sr; about
+/// cos³θ of the centre's at θ off-axis) and a window of radius r degrees
+/// holds the pixels whose centres are within r degrees of visual angle of the
+/// light's direction. With focal_px = 0 (an image without that geometry) every
+/// pixel subtends deg_per_px x deg_per_px degrees (square pixels,
+/// small-angle: solid angle (deg_per_px · π/180)² sr) and the window is a
+/// circle of r / deg_per_px pixels.
 struct DisplayedImage {
     int width = 0;
     int height = 0;
-    double deg_per_px = 0.0;
+    double deg_per_px = 0.0;  ///< at the principal point (the screen's centre)
+    /// The viewing distance in pixel pitches (DisplayGeometry::focal_px(),
+    /// the camera's focal length for a veridical camera); 0: small-angle pixels.
+    double focal_px = 0.0;
+    /// Where the line of sight meets the screen at right angles, in this
+    /// image's pixel coordinates (row 0 at the top; may lie outside the image).
+    glm::dvec2 principal_px{0.0};
     std::vector<float> luminance_cd_m2;  ///< width * height values, cd/m², >= 0
     /// What the same pixels show with the judged light off (cd/m²): empty, or
     /// width * height values. When given, a light's brightness and increment
@@ -43,11 +56,12 @@ struct DisplayedImage {
 
     float at(int x, int y) const { return luminance_cd_m2[static_cast<std::size_t>(y) * width + x]; }
     bool has_background() const noexcept { return !background_cd_m2.empty(); }
-    /// Solid angle of one pixel, sr.
-    double pixel_sr() const;
+    /// Solid angle of pixel (x, y), sr: exact with focal_px > 0, else (deg_per_px · π/180)².
+    double pixel_sr(int x, int y) const;
 };
 
-/// Σ L · Ω over the pixels whose centre lies within radius_deg of centre_px:
+/// Σ L · Ω_px over the pixels whose centre lies within radius_deg of centre_px
+/// (DisplayedImage: the angle and each pixel's own Ω_px):
 /// the illuminance (lux) that window of the image puts at the eye.
 double window_illuminance_lux(const DisplayedImage& image, glm::dvec2 centre_px, double radius_deg);
 
