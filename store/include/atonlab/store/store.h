@@ -97,6 +97,15 @@ public:
     /// stamps ended_at. Throws invalid_argument for `running` or a session that
     /// is not running.
     void finish_session(SessionId session, SessionStatus status);
+    /// Ends a running session as `quit` because the runner stopped it before
+    /// its end (not the observer: docs/running.md, "Missed frames and
+    /// timeouts"): stamps ended_at and appends `stop`, a JSON object, to the
+    /// session's stop_json array with a "stopped_at" time (UTC) added. One
+    /// transaction. The array keeps every stop of the session: resume_session()
+    /// leaves it as it is, so a session stopped, resumed and completed says
+    /// when and why it stopped on the way. Throws invalid_argument for a
+    /// session that is not running or a `stop` that is not a JSON object.
+    void stop_session(SessionId session, std::string_view stop);
     /// Reopens a session left running (its process died), crashed or quit, so
     /// record_trial may continue it; counts the resume. Returns the resume point.
     /// A completed session cannot be resumed.
