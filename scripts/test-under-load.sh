@@ -73,11 +73,14 @@ if [ "$busy" -gt 0 ]; then
 fi
 
 echo "test-under-load: $busy busy process(es) (stress-ng --cpu $busy) on $(nproc) core(s); ctest -R '$regex' -j $jobs"
+# The machine may be shared: its load before the tests (1, 5, 15 min averages), stressors included.
+echo "test-under-load: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 start=$SECONDS
 status=0
 ctest --test-dir "$build_dir" -R "$regex" --parallel "$jobs" --output-on-failure --output-junit "$junit" \
   >"$log" 2>&1 || status=$?
 wall=$((SECONDS - start))
+echo "test-under-load: load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 stop_stressors
 
 # Each test's result and time, from the JUnit file CTest wrote.
@@ -93,7 +96,11 @@ except (OSError, ET.ParseError) as e:
     sys.exit(0)
 rows = []
 for c in cases:
-    status = c.get("status") or ("failed" if c.find("failure") is not None else "run")
+    # CTest's JUnit: status "run" (passed), "fail", "notrun" / "disabled"; a skip has <skipped/>.
+    raw = c.get("status") or ""
+    status = {"run": "passed", "fail": "FAILED", "notrun": "not-run", "disabled": "not-run"}.get(raw, raw)
+    if c.find("failure") is not None:
+        status = "FAILED"
     if c.find("skipped") is not None:
         status = "skipped"
     rows.append((c.get("name"), status, float(c.get("time") or 0.0)))

@@ -36,6 +36,11 @@ void add_run_command(CLI::App& app, RunOptions& o) {
         "run",
         "Run a protocol's session, full screen for a person (--observer ID) or headless with a model or scripted "
         "observer, logging every trial to a study file");
+    cmd->footer(
+        "Exit status (docs/running.md): 0 completed; 2 bad input; 3 no OpenGL 4.5 context or no window; 4 the study "
+        "file failed; 5 the display's timing was refused (the refresh measurement, or --strict-timing's presentation "
+        "margin); 6 the observer ended the session; 7 the runner stopped it: presentations kept missing their refresh "
+        "([timing] max_missed_in_a_row, max_missed_fraction; continue with --resume-last); 128 + N stopped by signal N.");
     cmd->add_option("protocol", o.protocol, "Protocol file (TOML; see docs/protocol-file.md)")->required();
     cmd->add_option("--db", o.db, "Study file (SQLite; created if absent; see docs/store.md)")->required();
     auto* profiles = cmd->add_option("--profiles", o.profiles,

@@ -378,6 +378,7 @@ TEST_F(runner, AStalledTrialIsMarkedAndRepeatedAndThePeriodIsMeasured) {
             EXPECT_EQ(trials[i + 1].test_on_left, trials[i].test_on_left) << i;
         }
     const auto missed = std::count_if(trials.begin(), trials.end(), [](const TrialRecord& t) { return t.response == "missed"; });
+    std::printf("exit status %d: %zu trials stored, %ld missed\n", code, trials.size(), static_cast<long>(missed));
     if (code == 7) {
         EXPECT_EQ(session.status, store::SessionStatus::quit);
         ASSERT_TRUE(session.stop_json.has_value());
