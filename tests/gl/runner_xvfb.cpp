@@ -241,9 +241,9 @@ TEST_F(runner, KeyboardAnswersReachTheProcedureWithTheProtocolsMapping) {
         EXPECT_EQ(trials[i].response, responses[i]);
         EXPECT_EQ(state_field(trials[i], "input"), inputs[i]);
         EXPECT_EQ(state_field(trials[i], "observer"), "person");
-        // Onset to the key press: after the stimulus began, within the test's 30 s.
+        // Onset to the key press: after the stimulus began, within the 300 s the test waits for a screen (a hang's bound).
         EXPECT_GT(trials[i].response_time_s, 0.0);
-        EXPECT_LT(trials[i].response_time_s, 30.0);
+        EXPECT_LT(trials[i].response_time_s, 300.0);
         EXPECT_GT(trials[i].onset_time_s, last_onset);
         last_onset = trials[i].onset_time_s;
         // 0.1 s intervals are 6 frames at the measured ~60 Hz, the 0.05 s blank 3:
