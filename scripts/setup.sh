@@ -29,6 +29,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy  # the Python module atonlab (python/, docs/python.md): pybind11, the headers, numpy arrays
   python3-pandas  # the Python module's studies as DataFrames (atonlab.read_study, analyze, check's table)
   python3-pytest python3-matplotlib  # the Python module's tests, and examples/python/glare_matching.py's figures (Agg)
+  stress-ng  # scripts/test-under-load.sh: the GL and runner tests beside N busy processes (docs/measured.md)
 )
 
 missing=()

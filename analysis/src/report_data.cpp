@@ -316,6 +316,9 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
             o["allowed_undisplayable"] = s.allowed_undisplayable;
             o["undisplayable_conditions"] = s.undisplayable;
         }
+        o["presentation_margin"] = s.presentation_margin ? Json(*s.presentation_margin) : Json(nullptr);
+        o["stops"] = s.stops;
+        o["stop_reason"] = s.stop_reason.empty() ? Json(nullptr) : Json(s.stop_reason);
         j["sessions"].push_back(std::move(o));
     }
     j["conditions"] = Json::array();

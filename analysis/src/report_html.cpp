@@ -336,17 +336,22 @@ std::string sessions_html(const Dataset& d, const StudyResults& r, Footnotes& no
     std::string h;
     h += "<h2>Sessions and frame timing</h2>\n<div class=\"table-wrap\"><table>\n<tr><th>session</th>"
          "<th>observer</th><th>answered by</th><th>protocol</th><th>status</th><th>started</th><th>trials</th>"
-         "<th>dropped frames</th><th>trials with drops</th><th>missed deadlines</th><th>display check</th></tr>\n";
+         "<th>dropped frames</th><th>trials with drops</th><th>missed deadlines</th><th>presentation margin</th>"
+         "<th>stopped by the runner</th><th>display check</th></tr>\n";
     for (const SessionInfo& s : d.sessions) {
         const SessionTiming* t = nullptr;
         for (const SessionTiming& x : r.timing)
             if (x.session == s.key) t = &x;
         h += fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
-            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
+            "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+            "<td>{}</td><td>{}</td></tr>\n",
             esc(s.key), esc(s.observer), esc(s.answered_by.empty() ? "(not recorded)" : s.answered_by),
             esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0, t ? t->dropped_frames : 0,
             t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
+            s.presentation_margin ? fmt::format("{:.0f} %", *s.presentation_margin * 100.0) : std::string("—"),
+            s.stops == 0 ? std::string("no")
+                         : esc(fmt::format("{} time(s); last: {}", s.stops, s.stop_text)),
             !s.displayable   ? std::string("not recorded")
             : *s.displayable ? std::string("displayable")
                              : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",

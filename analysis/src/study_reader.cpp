@@ -23,6 +23,25 @@ namespace atonlab::analysis {
 
 namespace {
 
+/// The runner's stops (sessions.stop_json, an array of stop records): how
+/// many, the last one's reason, and a sentence for it (a note on the report).
+void read_stops(const std::string& text, std::int64_t id, const std::string& file, SessionInfo& info, Dataset& d) {
+    const nlohmann::json j = store::parse_json(text, fmt::format("stop_json of session {}", id));
+    if (!j.is_array() || j.empty()) return;
+    const nlohmann::json& last = j.back();
+    info.stops = static_cast<int>(j.size());
+    info.stop_reason = store::string_at(last, "/reason").value_or("?");
+    const double period_ms = store::number_at(last, "/refresh_period_s").value_or(0.0) * 1e3;
+    info.stop_text = fmt::format(
+        "{}: {} of {} presentations missed their refresh, {} refreshes lost (worst {}, {:.0f} ms)",
+        info.stop_reason == "missed_in_a_row" ? "missed presentations in a row" : "too many missed presentations",
+        store::number_at(last, "/missed_this_run").value_or(0), store::number_at(last, "/presented_this_run").value_or(0),
+        store::number_at(last, "/dropped_frames").value_or(0), store::number_at(last, "/worst_dropped_frames").value_or(0),
+        store::number_at(last, "/worst_dropped_frames").value_or(0) * period_ms);
+    d.notes.push_back(fmt::format("{} session {} was stopped by the runner {} time(s), last at trial {}: {}", file, id,
+                                  info.stops, store::number_at(last, "/trials_stored").value_or(0), info.stop_text));
+}
+
 /// A TOML value as the protocol wrote it in an override: a number, or a quoted
 /// string (the protocol loader accepts nothing else for the keys read here).
 std::optional<double> toml_number(std::string_view v) {
@@ -268,12 +287,14 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         for (const nlohmann::json& c : store::array_at(j, "/conditions"))
             if (!store::boolean_at(c, "/displayable").value_or(true))
                 info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
+        if (const auto m = store::number_at(j, "/presentation/margin")) info.presentation_margin = *m;
         if (info.displayable == false)
             d.notes.push_back(fmt::format(
                 "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "
                 "display (docs/running.md, \"Displayability\"); their estimates say little about the observer",
                 file, s.id.value, fmt::join(info.undisplayable, ", ")));
     }
+    if (s.stop_json) read_stops(*s.stop_json, s.id.value, file, info, d);
     info.scene_name = s.scene_name;
     info.scene_sha256 = s.scene_sha256.value_or("");
     std::optional<SceneLights> scene;

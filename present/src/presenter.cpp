@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 
 namespace atonlab::present {
 
@@ -76,6 +78,27 @@ std::optional<InputEvent> Presenter::wait(const Screen* screen, double since_s, 
         // Wake at least every 0.25 s to check the interrupt (a signal).
         wait_events(deadline_s ? std::min(*deadline_s, now + 0.25) : now + 0.25);
     }
+}
+
+std::vector<ShowTiming> Presenter::time_showing(const Screen& screen, int times, double extra_s) {
+    std::vector<ShowTiming> out;
+    clock_.idle();
+    clock_.clear_intervals();
+    flip();  // the first showing starts right after a refresh, as a trial's flips do
+    for (int i = 0; i < times; ++i) {
+        Screen fresh = screen;  // a new picture object: uploaded again, not taken from the presenter's cache
+        if (screen.picture) fresh.picture = std::make_shared<stimuli::EncodedImage>(*screen.picture);
+        const double t0 = now_s();
+        const std::unique_ptr<Prepared> p = prepare(fresh);
+        const double t1 = now_s();
+        draw(*p, 0.0);
+        if (extra_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(extra_s));
+        finish();
+        const double t2 = now_s();
+        flip();
+        out.push_back({t1 - t0, t2 - t1});
+    }
+    return out;
 }
 
 // ---------------------------------------------------------------------------

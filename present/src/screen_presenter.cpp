@@ -282,6 +282,10 @@ void ScreenPresenter::draw(const Prepared& prepared, double t_s) {
     for (const PreparedScreen::Box& b : p.boxes) gl_->draw_codes(b.codes, b.w, b.h, b.x, b.y, p.screen.bits);
 }
 
+void ScreenPresenter::finish() {
+    glFinish();
+}
+
 double ScreenPresenter::flip() {
     window_->swap_buffers();
     // glFinish after the swap: with vsync the driver blocks here until the

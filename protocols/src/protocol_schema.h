@@ -28,7 +28,7 @@ inline constexpr std::string_view kDisplayKeys[] = {"width_px",           "heigh
                                              "viewing_distance_m", "name",      "max_calibration_age_days"};
 inline constexpr std::string_view kTimingKeys[] = {"stimulus_s",          "inter_stimulus_s", "inter_trial_s",
                                             "response_timeout_s",  "repeat_missed",    "refresh_hz",
-                                            "adaptation_skippable"};
+                                            "adaptation_skippable", "max_missed_in_a_row", "max_missed_fraction"};
 inline constexpr std::string_view kScreenKeys[] = {"instructions", "break",         "end",     "text_cd_m2",
                                             "cue_cd_m2",    "text_size_deg", "fixation"};
 inline constexpr std::string_view kResponseKeys[] = {"keys", "gamepad"};

@@ -118,6 +118,14 @@ void read_timing(const Document& doc, const Section& root, Protocol& p) {
     }
     if (const toml::node* n = s.get("repeat_missed"))
         p.timing.repeat_missed = doc.boolean(n, s.key_path("repeat_missed"));
+    if (auto v = s.integer("max_missed_in_a_row", 1, 1000000)) p.timing.max_missed_in_a_row = *v;
+    if (auto v = s.number("max_missed_fraction")) {
+        if (!(*v > 0.0 && *v <= 1.0))
+            s.fail("max_missed_fraction",
+                   fmt::format("the share of a session's trials that may miss must be above 0 and at most 1, not {}.",
+                               *v));
+        p.timing.max_missed_fraction = *v;
+    }
     if (auto v = s.number("refresh_hz")) {
         if (!(*v >= 1.0 && *v <= 1000.0))
             s.fail("refresh_hz", fmt::format("the refresh rate must be 1 to 1000 Hz, not {}.", *v));

@@ -545,11 +545,18 @@ int run_analyze(const AnalyzeOptions& o) {
             if (!h.reliable && !h.reason.empty()) line += "; unreliable: " + h.reason;
             std::printf("%s\n", line.c_str());
         }
-        for (const an::SessionInfo& s : data.sessions)
+        for (const an::SessionInfo& s : data.sessions) {
             if (s.displayable == false)
                 std::printf(
                     "  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
                     s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
+            if (s.presentation_margin)
+                std::printf("  session %s: presentation margin %.0f %% of a refresh\n", s.key.c_str(),
+                            *s.presentation_margin * 100.0);
+            if (s.stops > 0)
+                std::printf("  session %s was stopped by the runner %d time(s) (status %s); last: %s\n", s.key.c_str(),
+                            s.stops, s.status.c_str(), s.stop_text.c_str());
+        }
         const std::size_t notes = results.warnings.size() + plots.problems.size() + ctx.problems.size();
         if (notes) std::printf("%zu note(s) and warning(s): see the report\n", notes);
         std::printf("report: %s\n", (out_dir / "report.html").string().c_str());

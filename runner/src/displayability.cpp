@@ -249,7 +249,7 @@ std::string displayability_refusal(const Displayability& d, const std::string& p
     return out;
 }
 
-std::string displayability_json(const Displayability& d, bool allowed) {
+std::string displayability_json(const Displayability& d, bool allowed, const std::string& presentation_json) {
     using Json = nlohmann::ordered_json;
     Json conditions = Json::array();
     for (const ConditionDisplayability& c : d.conditions) {
@@ -285,7 +285,8 @@ std::string displayability_json(const Displayability& d, bool allowed) {
                  {"window_radius_deg", d.window_radius_deg},
                  {"displayable", d.displayable()},
                  {"allowed_undisplayable", allowed},
-                 {"conditions", std::move(conditions)}};
+                 {"conditions", std::move(conditions)},
+                 {"presentation", presentation_json.empty() ? Json(nullptr) : Json::parse(presentation_json)}};
     return store::dump_json(j);
 }
 

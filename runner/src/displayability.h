@@ -117,6 +117,9 @@ std::string displayability_refusal(const Displayability& d, const std::string& p
 
 /// The JSON stored with the session (sessions.displayability_json; docs/store.md).
 /// `allowed`: the session ran with --allow-undisplayable.
-std::string displayability_json(const Displayability& d, bool allowed);
+/// presentation_json: on screen, the presentation margin measured before the
+/// first trial (session/presentation_margin.h), stored as "presentation";
+/// empty: none (headless), stored as null.
+std::string displayability_json(const Displayability& d, bool allowed, const std::string& presentation_json = {});
 
 }  // namespace atonlab::runner

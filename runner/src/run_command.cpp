@@ -4,7 +4,7 @@
 // each trial committed to the study file before the next is shown
 // (docs/running.md). The engine is run_session.cpp; this file is the command
 // line and the exit statuses of a study-file failure (4) and of a display whose
-// timing is refused (5).
+// timing is refused (5: the refresh measurement, or --strict-timing's margin).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -36,6 +36,11 @@ void add_run_command(CLI::App& app, RunOptions& o) {
         "run",
         "Run a protocol's session, full screen for a person (--observer ID) or headless with a model or scripted "
         "observer, logging every trial to a study file");
+    cmd->footer(
+        "Exit status (docs/running.md): 0 completed; 2 bad input; 3 no OpenGL 4.5 context or no window; 4 the study "
+        "file failed; 5 the display's timing was refused (the refresh measurement, or --strict-timing's presentation "
+        "margin); 6 the observer ended the session; 7 the runner stopped it: presentations kept missing their refresh "
+        "([timing] max_missed_in_a_row, max_missed_fraction; continue with --resume-last); 128 + N stopped by signal N.");
     cmd->add_option("protocol", o.protocol, "Protocol file (TOML; see docs/protocol-file.md)")->required();
     cmd->add_option("--db", o.db, "Study file (SQLite; created if absent; see docs/store.md)")->required();
     auto* profiles = cmd->add_option("--profiles", o.profiles,
@@ -101,6 +106,10 @@ void add_run_command(CLI::App& app, RunOptions& o) {
         ->group(screen);
     cmd->add_option("--font", o.font, "TrueType font for the screens (default DejaVu Sans, fonts-dejavu-core)")
         ->group(screen);
+    cmd->add_flag("--strict-timing", o.strict_timing,
+                  "Refuse to start (exit status 5) when a prepared frame of the protocol's heaviest condition cannot "
+                  "be shown within one refresh (docs/running.md, \"Presentation margin\"); without it, warned about")
+        ->group(screen);
     cmd->add_flag("--trace", o.trace, "Print what each screen waits for (\"trace: ...\" lines on stdout)")
         ->group(screen);
 
@@ -110,9 +119,17 @@ void add_run_command(CLI::App& app, RunOptions& o) {
                     "Stall this many refreshes after the stimulus onset of the trial --inject-stall-at-trial names")
         ->check(CLI::Range(1, 600))
         ->group(testing);
-    cmd->add_option("--inject-stall-at-trial", o.inject_stall_at_trial,
-                    "The trial (the study file's trial_index, from 0) whose stimulus stalls")
-        ->check(CLI::NonNegativeNumber)
+    auto* stall_at = cmd->add_option("--inject-stall-at-trial", o.inject_stall_at_trial,
+                                     "The trial (the study file's trial_index, from 0) whose stimulus stalls")
+                         ->check(CLI::NonNegativeNumber)
+                         ->group(testing);
+    cmd->add_flag("--inject-stall-every-trial", o.inject_stall_every_trial,
+                  "Stall the stimulus of every trial by --inject-stall-frames (headless too)")
+        ->excludes(stall_at)
+        ->group(testing);
+    cmd->add_option("--inject-frame-cost-ms", o.inject_frame_cost_ms,
+                    "On screen: the presentation margin's timed frames each take this much longer (a sleep), ms")
+        ->check(kFinite & CLI::Range(0.0, 1000.0))
         ->group(testing);
     cmd->add_option("--capture-trial", o.capture_trial,
                     "Capture every frame of this trial (trial_index) as it is shown, into --capture-dir (PNG: the drawn back buffer)")

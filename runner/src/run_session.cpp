@@ -24,6 +24,7 @@
 #include "calibrate/profile_location.h"
 #include "displayability.h"
 #include "session/display_record.h"
+#include "session/presentation_margin.h"
 #include "session/progress.h"
 #include "session/resume.h"
 #include "session/session_display.h"
@@ -113,9 +114,11 @@ void print_session_end(const RunOptions& o, const SessionParts& s, const p::Sche
                        const std::vector<ConditionSummary>& summary, bool with_true, std::size_t true_frames,
                        double true_s) {
     const std::size_t total = schedule.history().size();
+    const bool missed_stop = loop.missed && loop.missed->reached();
     std::printf("%s after %zu trials (%zu in this run, %s)\n",
-                completed           ? "completed"
+                completed            ? "completed"
                 : loop.observer_quit ? "ended by the observer"
+                : missed_stop        ? "stopped: presentations kept missing their refresh"
                                      : fmt::format("stopped by signal {}", stop).c_str(),
                 total, s.progress.done_here(), clock_text(s.progress.seconds()).c_str());
     if (loop.rows != total)
@@ -135,11 +138,37 @@ void print_session_end(const RunOptions& o, const SessionParts& s, const p::Sche
                 completed ? "" : fmt::format("; continue with --resume {}", s.session.value).c_str());
 }
 
+/// The presentation margin (session/presentation_margin.h), printed (with a
+/// warning under 50 %) and returned as stored; under --strict-timing a frame
+/// that cannot be shown within the refresh refuses the session (exit 5).
+std::string measured_margin(const RunOptions& o, present::ScreenPresenter& screen, StimulusRenderer& renderer,
+                            const p::Protocol& protocol, const Displayability& displayability, int bits) {
+    const PresentationMargin m =
+        measure_margin(screen, renderer, protocol, displayability, bits, 30, o.inject_frame_cost_ms * 1e-3);
+    if (!o.quiet) {
+        std::printf("%s\n", margin_text(m).c_str());
+        std::fflush(stdout);
+    }
+    if (m.margin() < 0.0 && o.strict_timing)
+        throw present::DisplayTimingRefused(fmt::format(
+            "a prepared frame of condition \"{}\" takes {:.2f} ms to show (median of {}), longer than the {:.2f} ms "
+            "refresh: under --strict-timing the session is not started (nothing was written); close other programs, "
+            "check that the GPU driver is in use, or run without --strict-timing (late trials are then marked).",
+            m.condition, m.show_s * 1e3, m.times, m.period_s * 1e3));
+    if (m.margin() < kMarginWarning)
+        std::fprintf(stderr,
+                     "atonlab: warning: presentation margin %.0f %% (under %.0f %%): showing a frame takes %.2f ms of "
+                     "the %.2f ms refresh, so a busy machine will miss refreshes; close other programs%s.\n",
+                     m.margin() * 100.0, kMarginWarning * 100.0, m.show_s * 1e3, m.period_s * 1e3,
+                     o.strict_timing ? "" : " (--strict-timing refuses a screen where a frame cannot be shown in time)");
+    return margin_json(m);
+}
+
 /// Opens the study file for writing (every check has passed) and begins the
 /// session, or reopens the resumed one.
 st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const SessionToRun& run,
                               const SessionInputs& in, const std::string& code, const Displayability& displayability,
-                              const SessionCalibration& calibration) {
+                              const SessionCalibration& calibration, const std::string& margin) {
     if (run.resumed) {
         const st::ResumePoint rp = store.resume_session(run.session);
         if (static_cast<std::size_t>(rp.next_trial_index) != run.logged.size())
@@ -156,7 +185,7 @@ st::SessionId begin_or_reopen(st::Store& store, const RunOptions& o, const Sessi
     start.scene_text = in.scene_text;
     start.scene_name = in.protocol.scene.filename().string();
     start.seed = run.seed;
-    start.displayability_json = displayability_json(displayability, o.allow_undisplayable);
+    start.displayability_json = displayability_json(displayability, o.allow_undisplayable, margin);
     start.simulation_json = o.simulation_json;
     start.calibration = calibration.calibration     ? *calibration.calibration
                         : calibration.from_profiles ? copy_into_study(store, *calibration.from_profiles)
@@ -219,12 +248,17 @@ int run_session(const RunOptions& o) {
     // A level range that cannot produce a match is refused, before anything is written.
     const Displayability displayability = check_displayability(renderer, protocol);
     if (!displayability_allows(displayability, o)) return 2;
+    // On screen: how much of a refresh showing a frame leaves (may refuse, exit 5).
+    const std::string margin_record = screen ? measured_margin(o, *screen, renderer, protocol, displayability,
+                                                             in.display_scene.output.encode.bits)
+                                           : std::string();
 
     // --- Every check has passed: open the study file for writing (creating it
     // if it does not exist), then begin or reopen the session.
     existing.reset();
     st::Store store = st::Store::create_or_open(o.db, store_options);
-    const st::SessionId session = begin_or_reopen(store, o, run, in, code, displayability, calibration);
+    const st::SessionId session =
+        begin_or_reopen(store, o, run, in, code, displayability, calibration, margin_record);
     // From here on a StoreError names the session to continue.
     try {
         reshow_open_match(observer, renderer, replayed, run.logged);
@@ -257,7 +291,13 @@ int run_session(const RunOptions& o) {
             run_trials(parts, schedule, run.logged.size(), replayed.previous_ended_trial, run.resumed);
         const int stop = stop_signal();
         const bool completed = schedule.finished();
-        store.finish_session(session, completed ? st::SessionStatus::completed : st::SessionStatus::quit);
+        const bool missed_stop = !completed && loop.missed->reached();
+        if (missed_stop) {
+            // Kept with the session (sessions.stop_json), for analyze and the report.
+            store.stop_session(session, loop.missed->record(loop.rows, margin_record));
+        } else {
+            store.finish_session(session, completed ? st::SessionStatus::completed : st::SessionStatus::quit);
+        }
         if (completed && stop == 0) display.text_screen(protocol.screens.end, "", "end");
         signals.restore();
         // What the session found: printed, and handed to the caller (RunOptions::on_summary).
@@ -271,6 +311,10 @@ int run_session(const RunOptions& o) {
         if (!o.quiet)
             print_session_end(o, parts, schedule, loop, completed, stop, summary, with_true, true_frames, true_s);
         if (o.on_summary) o.on_summary(summary);
+        if (missed_stop) {
+            std::fprintf(stderr, "atonlab: %s\n", loop.missed->message(session.value).c_str());
+            return 7;
+        }
         if (loop.observer_quit && !completed) return 6;
         return completed ? 0 : 128 + stop;
     } catch (const st::StoreError& e) {

@@ -220,6 +220,31 @@ void Store::finish_session(SessionId session, SessionStatus status) {
     tx.commit();
 }
 
+void Store::stop_session(SessionId session, std::string_view stop) {
+    const std::string doing = fmt::format("record why session {} stopped", session.value);
+    impl_->require_writable(doing);
+    sql::Transaction tx(*impl_->db, sql::Transaction::Kind::write, doing);
+    const SessionStatus now = impl_->status_of(session, doing);
+    if (now != SessionStatus::running) {
+        impl_->invalid(doing, fmt::format("session {} is {}, not running", session.value, to_string(now)));
+    }
+    {
+        sql::Use check(impl_->db->cached("SELECT CASE WHEN json_valid(?1) THEN json_type(?1) = 'object' ELSE 0 END"));
+        check->bind(1, stop);
+        check->step(doing);
+        if (check->int64(0) != 1) impl_->invalid(doing, "the stop record is not a JSON object");
+    }
+    // Appended ('$[#]': after the last element) to what earlier stops left.
+    sql::Use s(impl_->db->cached(
+        "UPDATE sessions SET status = 'quit', ended_at = " ATONLAB_STORE_NOW ", stop_json = "
+        "json_insert(COALESCE(stop_json, '[]'), '$[#]', json_set(json(?2), '$.stopped_at', " ATONLAB_STORE_NOW "))"
+        " WHERE id = ?1"));
+    s->bind(1, session.value);
+    s->bind(2, stop);
+    s->run(doing);
+    tx.commit();
+}
+
 ResumePoint Store::resume_session(SessionId session) {
     const std::string doing = fmt::format("resume session {}", session.value);
     impl_->require_writable(doing);

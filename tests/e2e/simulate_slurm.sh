@@ -54,7 +54,7 @@ status=$?
 if [ "$status" -eq 3 ]; then echo "no GPU: no OpenGL 4.5 context for the decision table ($(tail -1 "$out/local.out"))"; exit 77; fi
 [ "$status" -eq 0 ] || { echo "the local run failed:"; cat "$out/local.out"; exit 1; }
 refused share_builds "never builds a table" "" -- \
-  "$atonlab" simulate "$protocol" --sessions 5 --out "$out/local" --first 0 --count 5 --table-cache "$out/empty-cache"
+  "$atonlab" simulate "$protocol" "${heavy[@]}" --sessions 5 --out "$out/local" --first 0 --count 5 --table-cache "$out/empty-cache"
 
 . "$src/tests/e2e/slurm_cluster.sh"
 cluster=$(mktemp -d /tmp/atonlab-slurm.XXXXXX)

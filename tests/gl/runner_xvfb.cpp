@@ -22,10 +22,12 @@
 //    code, the frame `atonlab render` makes headless from the same overrides,
 //    and the frame the same session run headless captures.
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -42,6 +44,7 @@
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/stimuli/image_io.h"
+#include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 #include "../support/skip.h"
 
@@ -90,8 +93,11 @@ Child spawn(const std::vector<std::string>& args, const fs::path& out, const fs:
     return c;
 }
 
-/// Waits for the child (killing it after `limit_s`); its exit status.
-int finish(const Child& c, double limit_s = 60.0) {
+/// Waits for the child (killing it after `limit_s`); its exit status. The
+/// limit only ends a hang: a run here takes at most ~15 s on the 2-core
+/// development VM, and 600 s holds on a machine ten times slower or loaded
+/// (scripts/test-under-load.sh); nothing passes or fails by its speed.
+int finish(const Child& c, double limit_s = 600.0) {
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
     int status = 0;
     while (waitpid(c.pid, &status, WNOHANG) == 0) {
@@ -113,9 +119,10 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 }
 
 /// Waits until the child's stdout holds `line` `times` times (the runner
-/// traces what each screen waits for); false if it exits first or after 30 s.
+/// traces what each screen waits for); false if it exits first or after 300 s
+/// (a hang: each screen comes within seconds, ten times that on a loaded machine).
 bool wait_for(const Child& c, const std::string& line, std::size_t times = 1) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(300);
     while (std::chrono::steady_clock::now() < until) {
         if (count_of(file_bytes(c.out), line) >= times) return true;
         int status = 0;
@@ -126,7 +133,7 @@ bool wait_for(const Child& c, const std::string& line, std::size_t times = 1) {
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    ADD_FAILURE() << "no \"" << line << "\" within 30 s\n" << file_bytes(c.out) << file_bytes(c.err);
+    ADD_FAILURE() << "no \"" << line << "\" within 300 s\n" << file_bytes(c.out) << file_bytes(c.err);
     return false;
 }
 
@@ -165,8 +172,10 @@ std::string state_field(const TrialRecord& t, const std::string& key) {
     return t.procedure_state_json.substr(at + tag.size(), end - at - tag.size());
 }
 
-/// The trials the schedule proposes for these answers, checked against the stored ones.
-void expect_schedule(const fs::path& protocol_file, std::uint64_t seed, const std::vector<TrialRecord>& trials) {
+/// The trials the schedule proposes for these answers, checked against the
+/// stored ones; `complete`: they finish the schedule (else a prefix of it).
+void expect_schedule(const fs::path& protocol_file, std::uint64_t seed, const std::vector<TrialRecord>& trials,
+                     bool complete = true) {
     const protocols::Protocol protocol = protocols::load_protocol(protocol_file);
     protocols::Schedule schedule(protocol, seed);
     for (const TrialRecord& t : trials) {
@@ -185,8 +194,11 @@ void expect_schedule(const fs::path& protocol_file, std::uint64_t seed, const st
         ASSERT_TRUE(words.count(t.response)) << t.response;
         schedule.record(words.at(t.response));
     }
-    EXPECT_TRUE(schedule.finished());
+    EXPECT_EQ(schedule.finished(), complete);
 }
+
+/// "measured 16.6535 ms ± 0.1234 ms": the period and SD the runner reported, ms (defined below).
+std::pair<double, double> measured(const std::string& out);
 
 // --- Keys ----------------------------------------------------------------------
 
@@ -210,6 +222,9 @@ TEST_F(runner, KeyboardAnswersReachTheProcedureWithTheProtocolsMapping) {
     ASSERT_TRUE(wait_for(c, "waiting for continue (end)"));
     press("space");
     ASSERT_EQ(finish(c), 0) << file_bytes(c.out) << file_bytes(c.err);
+    const double period_ms = measured(file_bytes(c.out)).first;
+    ASSERT_GT(period_ms, 0.0) << file_bytes(c.out);
+    const long n_stim = std::max(1L, std::lround(100.0 / period_ms)), n_isi = std::lround(50.0 / period_ms);
 
     Store s = Store::open_read_only(db());
     const auto sessions = s.sessions();
@@ -226,17 +241,20 @@ TEST_F(runner, KeyboardAnswersReachTheProcedureWithTheProtocolsMapping) {
         EXPECT_EQ(trials[i].response, responses[i]);
         EXPECT_EQ(state_field(trials[i], "input"), inputs[i]);
         EXPECT_EQ(state_field(trials[i], "observer"), "person");
-        // Onset to the key press: after the stimulus began, within the test's 30 s.
+        // Onset to the key press: after the stimulus began, within the 300 s the test waits for a screen (a hang's bound).
         EXPECT_GT(trials[i].response_time_s, 0.0);
-        EXPECT_LT(trials[i].response_time_s, 30.0);
+        EXPECT_LT(trials[i].response_time_s, 300.0);
         EXPECT_GT(trials[i].onset_time_s, last_onset);
         last_onset = trials[i].onset_time_s;
-        // 0.1 s intervals are 6 frames at the measured ~60 Hz, the 0.05 s blank 3.
-        EXPECT_NE(trials[i].stimulus_json.find("\"stimulus_frames\":6"), std::string::npos) << trials[i].stimulus_json;
+        // 0.1 s intervals are 6 frames at the measured ~60 Hz, the 0.05 s blank 3:
+        // whole refreshes at the period the runner measured (on a loaded
+        // machine the software vsync's period measures longer, and so fewer).
+        EXPECT_NE(trials[i].stimulus_json.find(fmt::format("\"stimulus_frames\":{}", n_stim)), std::string::npos)
+            << trials[i].stimulus_json;
     }
-    EXPECT_NE(trials[0].stimulus_json.find("\"inter_stimulus_frames\":3"), std::string::npos);
+    EXPECT_NE(trials[0].stimulus_json.find(fmt::format("\"inter_stimulus_frames\":{}", n_isi)), std::string::npos);
     // A 2AFC answer comes after the second interval's onset: at least 6 + 3 frames after the first.
-    EXPECT_GT(trials[0].response_time_s, 9.0 / 61.0);
+    EXPECT_GT(trials[0].response_time_s, static_cast<double>(n_stim + n_isi) * period_ms * 1e-3 * 60.0 / 61.0);
     expect_schedule(protocol, 11, trials);
 }
 
@@ -328,7 +346,6 @@ TEST_F(runner, AdjustmentKeysStepTheLevelWhileTheIntervalsAlternate) {
 
 // --- Timing --------------------------------------------------------------------
 
-/// "measured 16.6535 ms ± 0.1234 ms": the period and SD the runner reported, ms.
 std::pair<double, double> measured(const std::string& out) {
     const auto at = out.find("measured ");
     if (at == std::string::npos) return {0.0, 0.0};
@@ -341,16 +358,29 @@ std::pair<double, double> measured(const std::string& out) {
 TEST_F(runner, AStalledTrialIsMarkedAndRepeatedAndThePeriodIsMeasured) {
     const fs::path protocol = kData / "screen_stall.toml";
     const Child c = start(protocol, {"--model-observer", "--inject-stall-frames", "6", "--inject-stall-at-trial", "1"});
-    ASSERT_EQ(finish(c), 0) << file_bytes(c.out) << file_bytes(c.err);
+    // 0: completed. 7: on a loaded machine (scripts/test-under-load.sh) other
+    // presentations missed too and the run stopped at the protocol's bound
+    // (default: more than ceil(10 % of 4) = 1 missed), as it should (issue 41).
+    const int code = finish(c);
+    ASSERT_TRUE(code == 0 || code == 7) << code << "\n" << file_bytes(c.out) << file_bytes(c.err);
     const auto [period_ms, sd_ms] = measured(file_bytes(c.out));
     std::printf("measured under Xvfb (software vsync 60 Hz): %.4f ms ± %.4f ms\n", period_ms, sd_ms);
-    // The software vsync ticks every 1/60 s; the mean of the kept intervals is
-    // that (missed ticks are rejected), whatever the machine's load.
-    EXPECT_NEAR(period_ms, 1000.0 / 60.0, 0.5) << file_bytes(c.out);
+    // The software vsync ticks every 1/60 s; where its flips were regular (the
+    // SD under the 1 ms the sync test asks for: this test skips that test), the
+    // mean of the kept intervals is that. On a loaded machine its timer wakes
+    // late, the intervals are irregular and the mean is not the tick (a real
+    // session would be refused, exit 5): not checked then, the load being no
+    // error of the program (the estimate itself is tested on synthetic
+    // timestamps, unit.RefreshEstimate.*).
+    if (sd_ms < 1.0)
+        EXPECT_NEAR(period_ms, 1000.0 / 60.0, 0.5) << file_bytes(c.out);
+    else
+        std::printf("loaded machine: flips irregular (SD %.3f ms), the period is not checked\n", sd_ms);
 
     Store s = Store::open_read_only(db());
-    const auto trials = s.trials(s.sessions()[0].id);
-    ASSERT_GE(trials.size(), 5u) << "4 trials and the repeat";
+    const store::SessionRecord session = s.sessions()[0];
+    const auto trials = s.trials(session.id);
+    ASSERT_GE(trials.size(), 2u) << "the stalled trial is stored";
     const TrialRecord& stalled = trials[1];
     EXPECT_TRUE(stalled.missed_deadline);
     EXPECT_GE(stalled.dropped_frames, 5);
@@ -364,9 +394,73 @@ TEST_F(runner, AStalledTrialIsMarkedAndRepeatedAndThePeriodIsMeasured) {
             EXPECT_EQ(trials[i + 1].level, trials[i].level) << i;
             EXPECT_EQ(trials[i + 1].test_on_left, trials[i].test_on_left) << i;
         }
-    EXPECT_EQ(std::count_if(trials.begin(), trials.end(), [](const TrialRecord& t) { return t.response != "missed"; }),
-              4);
+    const auto missed = std::count_if(trials.begin(), trials.end(), [](const TrialRecord& t) { return t.response == "missed"; });
+    std::printf("exit status %d: %zu trials stored, %ld missed\n", code, trials.size(), static_cast<long>(missed));
+    if (code == 7) {
+        EXPECT_EQ(session.status, store::SessionStatus::quit);
+        ASSERT_TRUE(session.stop_json.has_value());
+        EXPECT_NE(session.stop_json->find("\"reason\":\"missed_"), std::string::npos) << *session.stop_json;
+        EXPECT_LE(missed, 2) << "at most one missed is allowed: the second stops the run";
+        expect_schedule(protocol, 5, trials, false);
+        return;
+    }
+    EXPECT_EQ(static_cast<long>(trials.size()) - missed, 4);
     expect_schedule(protocol, 5, trials);
+}
+
+/// The presentation margin displayability_json stored ("presentation"), parsed.
+nlohmann::json stored_margin(const fs::path& db) {
+    Store s = Store::open_read_only(db);
+    const auto j = store::parse_json(s.sessions().at(0).displayability_json.value_or("{}"));
+    return j.contains("presentation") ? j.at("presentation") : nlohmann::json();
+}
+
+TEST_F(runner, ThePresentationMarginIsMeasuredStoredAndShown) {
+    const fs::path protocol = kData / "screen_stall.toml";
+    const Child c = start(protocol, {"--model-observer"});
+    const int code = finish(c);
+    ASSERT_TRUE(code == 0 || code == 7) << code << "\n" << file_bytes(c.out) << file_bytes(c.err);
+    const std::string out = file_bytes(c.out);
+    EXPECT_NE(out.find("presentation margin"), std::string::npos) << out;
+    const nlohmann::json m = stored_margin(db());
+    ASSERT_TRUE(m.is_object()) << "on screen the margin is stored with the session";
+    EXPECT_EQ(m.at("condition"), "pair");
+    EXPECT_EQ(m.at("animated"), false);
+    EXPECT_EQ(m.at("times"), 30);
+    // The period is the start-up measurement's (printed to 4 decimals in ms).
+    EXPECT_NEAR(m.at("period_s").get<double>() * 1e3, measured(out).first, 1e-4);
+    const double show = m.at("show_s").get<double>(), period = m.at("period_s").get<double>();
+    EXPECT_GT(show, 0.0);
+    EXPECT_GT(m.at("draw_s").get<double>(), 0.0);
+    EXPECT_GE(m.at("upload_s").get<double>(), 0.0);
+    EXPECT_GE(m.at("worst_show_s").get<double>(), show);
+    EXPECT_DOUBLE_EQ(m.at("margin").get<double>(), 1.0 - show / period);
+    // analyze shows it, rounded to a whole per cent.
+    const Child an = spawn({ATONLAB_BINARY, "analyze", db().string(), "--out", (dir_.path() / "rep").string(),
+                            "--bootstrap", "0"},
+                           dir_.path() / "an.out", dir_.path() / "an.err");
+    ASSERT_EQ(finish(an), 0) << file_bytes(an.err);
+    const std::string shown = fmt::format("presentation margin {:.0f} %", m.at("margin").get<double>() * 100.0);
+    EXPECT_NE(file_bytes(an.out).find(shown), std::string::npos) << shown << "\n" << file_bytes(an.out);
+    EXPECT_NE(file_bytes(dir_.path() / "rep" / "report.html").find("presentation margin"), std::string::npos);
+}
+
+TEST_F(runner, ASlowFrameIsWarnedAboutAndRefusedUnderStrictTiming) {
+    const fs::path protocol = kData / "screen_stall.toml";
+    // 12 ms added to each timed frame: it takes at least 12 of the 16.7 ms
+    // refresh, a margin of at most 28 %, on any machine (load only adds to it).
+    const Child c = start(protocol, {"--model-observer", "--inject-frame-cost-ms", "12"});
+    const int code = finish(c);
+    ASSERT_TRUE(code == 0 || code == 7) << code << "\n" << file_bytes(c.out) << file_bytes(c.err);
+    EXPECT_NE(file_bytes(c.err).find("warning: presentation margin"), std::string::npos) << file_bytes(c.err);
+    EXPECT_LE(stored_margin(db()).at("margin").get<double>(), 1.0 - 12.0 / 16.7);
+    // 40 ms: longer than a refresh. --strict-timing refuses before the study file is created.
+    fs::remove(db());
+    const Child strict = start(protocol, {"--model-observer", "--inject-frame-cost-ms", "40", "--strict-timing"}, "s");
+    ASSERT_EQ(finish(strict), 5) << file_bytes(strict.out) << file_bytes(strict.err);
+    EXPECT_NE(file_bytes(strict.err).find("under --strict-timing the session is not started"), std::string::npos)
+        << file_bytes(strict.err);
+    EXPECT_FALSE(fs::exists(db()));
 }
 
 TEST_F(runner, WithoutRepeatMissedTheStalledTrialIsMarkedAndCounted) {
@@ -408,7 +502,15 @@ TEST_F(runner, ADisplayAtAnotherRateThanTheProtocolsRefusesToStart) {
     const auto at = err.find("atonlab: monitor 0");
     ASSERT_NE(at, std::string::npos) << err;
     const std::string line = err.substr(at, err.find('\n', at) - at);
-    EXPECT_NE(line.find("written for 60 Hz"), std::string::npos) << line;
+    // The protocol's rate refuses it. On a loaded machine the software vsync's
+    // flips come late (its timer wakes late) and the measurement may refuse
+    // first, by its own rules (the rate against the display's 50 Hz, too few
+    // regular flips): a refusal all the same, before anything is written.
+    const bool by_protocol = line.find("written for 60 Hz") != std::string::npos;
+    const bool by_measurement = line.find("the measured refresh rate") != std::string::npos ||
+                                line.find("of the flip intervals in") != std::string::npos;
+    EXPECT_TRUE(by_protocol || by_measurement) << line;
+    if (!by_protocol) std::printf("loaded machine: refused by the measurement itself: %s\n", line.c_str());
     EXPECT_NE(line.find("not started"), std::string::npos) << line;
     EXPECT_FALSE(fs::exists(db())) << "the screen is refused before the study file is created";
 

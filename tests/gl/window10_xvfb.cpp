@@ -169,7 +169,9 @@ protected:
         // The X server copies the swapped frame into its screen asynchronously.
         Screen10 screen;
         std::size_t on_screen = 1;
-        for (int attempt = 0; attempt < 50 && on_screen != 0; ++attempt) {
+        // Up to 30 s (1500 × 20 ms; it is there within tens of ms on an idle
+        // machine): a loaded machine's X server may take long to get to it.
+        for (int attempt = 0; attempt < 1500 && on_screen != 0; ++attempt) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
             window_->poll_events();
             screen = read_screen(file);

@@ -1,5 +1,6 @@
 // The protocol keys of the full-screen runner (docs/protocol-file.md):
-// [timing] repeat_missed, refresh_hz, adaptation_skippable and [screens]
+// [timing] repeat_missed, max_missed_in_a_row, max_missed_fraction,
+// refresh_hz, adaptation_skippable and [screens]
 // text_cd_m2, cue_cd_m2, text_size_deg, fixation: their defaults, their
 // values, and one-sentence errors at the key's line for a wrong type or range.
 #include <gtest/gtest.h>
@@ -43,6 +44,8 @@ name = "c"
 TEST(ProtocolScreenKeys, Defaults) {
     const Protocol p = parse_protocol(protocol_with("", ""), "p.toml");
     EXPECT_FALSE(p.timing.repeat_missed);
+    EXPECT_EQ(p.timing.max_missed_in_a_row, 5);  // the defaults
+    EXPECT_EQ(p.timing.max_missed_fraction, 0.1);
     EXPECT_FALSE(p.timing.refresh_hz.has_value());
     EXPECT_FALSE(p.timing.adaptation_skippable);
     EXPECT_EQ(p.screens.text_cd_m2, 10.0);
@@ -53,11 +56,14 @@ TEST(ProtocolScreenKeys, Defaults) {
 
 TEST(ProtocolScreenKeys, ValuesAreRead) {
     const Protocol p =
-        parse_protocol(protocol_with("repeat_missed = true\nrefresh_hz = 119.88\nadaptation_skippable = true",
+        parse_protocol(protocol_with("repeat_missed = true\nrefresh_hz = 119.88\nadaptation_skippable = true\n"
+                                     "max_missed_in_a_row = 3\nmax_missed_fraction = 0.25",
                                      "text_cd_m2 = 25\ncue_cd_m2 = 0.2\ntext_size_deg = 0.8\nfixation = false"),
                        "p.toml");
     EXPECT_TRUE(p.timing.repeat_missed);
     EXPECT_EQ(p.timing.refresh_hz, 119.88);
+    EXPECT_EQ(p.timing.max_missed_in_a_row, 3);
+    EXPECT_EQ(p.timing.max_missed_fraction, 0.25);
     EXPECT_TRUE(p.timing.adaptation_skippable);
     EXPECT_EQ(p.screens.text_cd_m2, 25.0);
     EXPECT_EQ(p.screens.cue_cd_m2, 0.2);
@@ -85,6 +91,10 @@ TEST(ProtocolScreenKeys, WrongValuesAreOneSentenceAtTheirLine) {
     expect_error("refresh_hz = 0", "", "timing.refresh_hz", 12, "1 to 1000 Hz");
     expect_error("adaptation_skippable = 1", "", "timing.adaptation_skippable", 12, "expected true or false");
     expect_error("repeat_miss = true", "", "timing.repeat_miss", 12, "Did you mean 'repeat_missed'");
+    expect_error("max_missed_in_a_row = 0", "", "timing.max_missed_in_a_row", 12, "between 1 and");
+    expect_error("max_missed_in_a_row = 2.5", "", "timing.max_missed_in_a_row", 12, "expected an integer");
+    expect_error("max_missed_fraction = 0", "", "timing.max_missed_fraction", 12, "above 0 and at most 1");
+    expect_error("max_missed_fraction = 1.5", "", "timing.max_missed_fraction", 12, "above 0 and at most 1");
     expect_error("", "text_cd_m2 = -1", "screens.text_cd_m2", 15, "text_cd_m2");
     expect_error("", "cue_cd_m2 = 0", "screens.cue_cd_m2", 15, "cue_cd_m2");
     expect_error("", "text_size_deg = 20", "screens.text_size_deg", 15, "0.05 to 10 degrees");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
+#include "atonlab/store/json.h"
 #include "atonlab/store/schema.h"
 #include "atonlab/store/sha256.h"
 #include "atonlab/store/store.h"
@@ -313,6 +314,49 @@ TEST(Store, FinishResumeAndResumePoint) {
     ASSERT_EQ(all.size(), 1u);
     EXPECT_EQ(all[0].trial_count, 5);
     EXPECT_GE(*all[0].ended_at, all[0].started_at);  // ISO 8601 text orders like time
+}
+
+TEST(Store, StopSessionAppendsItsRecordAndAResumeKeepsTheHistory) {
+    TempDir dir;
+    Store s = Store::create_or_open(dir / "study.db");
+    const SessionId id = s.begin_session(make_start());
+    s.record_trial(id, make_trial(0));
+    EXPECT_FALSE(s.session(id).stop_json.has_value()) << "NULL until the runner stops it";
+
+    // Not a JSON object: refused, nothing written (the session still runs).
+    expect_store_error(StoreErrc::invalid_argument, [&] { s.stop_session(id, "[1, 2]"); });
+    expect_store_error(StoreErrc::invalid_argument, [&] { s.stop_session(id, "{\"reason\": "); });
+    EXPECT_EQ(s.session(id).status, SessionStatus::running);
+    EXPECT_FALSE(s.session(id).stop_json.has_value());
+
+    s.stop_session(id, R"({"reason":"missed_in_a_row","trials_stored":1})");
+    SessionRecord r = s.session(id);
+    EXPECT_EQ(r.status, SessionStatus::quit);
+    EXPECT_TRUE(r.ended_at.has_value());
+    ASSERT_TRUE(r.stop_json.has_value());
+    nlohmann::json stops = parse_json(*r.stop_json);
+    ASSERT_TRUE(stops.is_array());
+    ASSERT_EQ(stops.size(), 1u);
+    EXPECT_EQ(stops[0].at("reason"), "missed_in_a_row");
+    EXPECT_EQ(stops[0].at("trials_stored"), 1);
+    EXPECT_GE(stops[0].at("stopped_at").get<std::string>(), r.started_at);
+    // Only a running session can be stopped.
+    expect_store_error(StoreErrc::invalid_argument, [&] { s.stop_session(id, R"({"reason":"x"})"); });
+
+    // Resumed: the record stays; a second stop is appended after the first.
+    s.resume_session(id);
+    EXPECT_EQ(parse_json(*s.session(id).stop_json).size(), 1u);
+    s.record_trial(id, make_trial(1));
+    s.stop_session(id, R"({"reason":"missed_per_session","trials_stored":2})");
+    stops = parse_json(*s.session(id).stop_json);
+    ASSERT_EQ(stops.size(), 2u);
+    EXPECT_EQ(stops[0].at("reason"), "missed_in_a_row");
+    EXPECT_EQ(stops[1].at("reason"), "missed_per_session");
+    // ... and it is still there once the session completes.
+    s.resume_session(id);
+    s.finish_session(id, SessionStatus::completed);
+    EXPECT_EQ(parse_json(*s.session(id).stop_json).size(), 2u);
+    EXPECT_EQ(s.integrity_check(), "ok");
 }
 
 // --- A reader beside a writer ------------------------------------------------

@@ -17,7 +17,9 @@ struct ConditionSummary;  // session/summary.h
 
 /// `atonlab run` (docs/running.md). Exit status: 0 completed, 2 bad input, 3 no
 /// GL, 4 the study file failed (StoreError), 5 the display's timing was refused,
-/// 6 the observer ended the session (quit key, confirmed), 128 + N stopped by signal N.
+/// 6 the observer ended the session (quit key, confirmed), 7 the runner stopped it:
+/// presentations kept missing their refresh (session/missed_bound.h), 128 + N
+/// stopped by signal N.
 struct RunOptions {
     std::string protocol;
     /// Non-empty: the protocol's text, read instead of the file's (`atonlab
@@ -76,11 +78,17 @@ struct RunOptions {
     double sync_sd_max_ms = 1.0;              ///< the flip intervals' SD must be below this, ms
     double refresh_tolerance = 0.02;          ///< measured vs nominal refresh rate, relative
     std::string font;                         ///< TrueType font (default DejaVu Sans)
+    /// Refuse (exit status 5) a screen on which a prepared frame of the
+    /// protocol's heaviest condition cannot be shown within one refresh
+    /// (session/presentation_margin.h); without it such a screen is warned about.
+    bool strict_timing = false;
     bool trace = false;                       ///< print what each screen waits for (tests drive keys from it)
 
     // Test-only (docs/running.md "Testing").
     int inject_stall_frames = 0;                        ///< stall this many refreshes after a stimulus onset ...
     std::optional<std::int64_t> inject_stall_at_trial;  ///< ... of this trial (the store's trial_index)
+    bool inject_stall_every_trial = false;              ///< ... of every trial
+    double inject_frame_cost_ms = 0.0;  ///< the margin measurement's frames take this much longer (a sleep), ms
     std::optional<std::int64_t> capture_trial;          ///< capture each frame of this trial as shown ...
     std::string capture_dir;                            ///< ... into this folder
     std::string capture_screen_file;                    ///< ... copying this file (Xvfb -fbdir's screen) instead of

@@ -230,9 +230,6 @@ present::Screen SessionDisplay::background_screen(const p::Condition& c) {
     return sc;
 }
 
-std::shared_ptr<const s::EncodedImage> SessionDisplay::frame_picture(const p::ScheduledTrial& t, std::size_t f) {
-    return renderer_.codes(t.stimulus.frames[f], lights_of_frame(t.stimulus, f));
-}
 
 bool SessionDisplay::confirm_quit(const std::string& progress) {
     trace("pause");
@@ -328,20 +325,8 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
 
     const present::Screen bg = background_screen(c);
     std::vector<present::Screen> frames;
-    for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f) {
-        present::Screen sc;
-        sc.bits = bits_;
-        if (on_screen) {
-            const p::Frame& frame = t.stimulus.frames[f];
-            if (renderer_.animated(frame)) {
-                sc.animate = [this, frame](double at_s) { renderer_.encode(frame, at_s); };
-                sc.present = [this](int x, int y) { renderer_.present(x, y); };
-            } else {
-                sc.picture = frame_picture(t, f);
-            }
-        }
-        frames.push_back(std::move(sc));
-    }
+    for (std::size_t f = 0; f < t.stimulus.frames.size(); ++f)
+        frames.push_back(stimulus_screen(renderer_, t.stimulus, f, bits_, on_screen));
 
     present::Screen fix = bg;  // shown before the stimulus when n_iti > 0
     if (n_iti > 0 && on_screen && protocol_.screens.fixation) fix.overlays.push_back(fixation_overlay());
@@ -461,6 +446,21 @@ TrialShown SessionDisplay::present(const p::ScheduledTrial& t, const p::Conditio
     }
     out.response = observer_answer ? std::optional<p::Response>(observer_answer->response) : std::nullopt;
     return out;
+}
+
+present::Screen stimulus_screen(StimulusRenderer& renderer, const p::Stimulus& stimulus, std::size_t f, int bits,
+                                bool on_screen) {
+    present::Screen sc;
+    sc.bits = bits;
+    if (!on_screen) return sc;  // nothing is drawn headless: nothing to render
+    const p::Frame& frame = stimulus.frames[f];
+    if (renderer.animated(frame)) {
+        sc.animate = [&renderer, frame](double at_s) { renderer.encode(frame, at_s); };
+        sc.present = [&renderer](int x, int y) { renderer.present(x, y); };
+    } else {
+        sc.picture = renderer.codes(frame, lights_of_frame(stimulus, f));
+    }
+    return sc;
 }
 
 std::unique_ptr<present::Presenter> open_screen(const RunOptions& o, const p::Protocol& protocol,

@@ -121,7 +121,6 @@ public:
 
 private:
     present::Screen background_screen(const protocols::Condition& c);
-    std::shared_ptr<const stimuli::EncodedImage> frame_picture(const protocols::ScheduledTrial& t, std::size_t f);
     present::Overlay text_overlay(const std::string& text, present::Code3 ink, double y_fraction,
                                   double scale = 1.0) const;
     present::Overlay fixation_overlay() const;
@@ -140,6 +139,12 @@ private:
     double pixels_per_degree_ = 0.0;
     std::vector<SceneOverride> all_off_;  ///< every light dark and disc gone (StimulusRenderer::all_off)
 };
+
+/// Frame f of a stimulus as the screen shows it (`bits` per channel): its
+/// codes, rendered once; or, where a light has a rhythm, rendered at each
+/// flip's time (Screen::animate). Headless an empty screen (nothing is drawn).
+present::Screen stimulus_screen(StimulusRenderer& renderer, const protocols::Stimulus& stimulus, std::size_t f,
+                                int bits, bool on_screen);
 
 /// Opens the full-screen presenter for a session (RunOptions' on-screen
 /// options) and checks the screen fits the protocol: its size is the

@@ -39,9 +39,13 @@ std::string checked_observer_code(const RunOptions& o) {
         throw InputError(SourceLocation::command_line("--observer"),
                          "give the observer's code with --observer ID (or answer with --model-observer or --script "
                          "FILE).");
-    if (o.inject_stall_frames > 0 && !o.inject_stall_at_trial)
+    if (o.inject_stall_frames > 0 && !o.inject_stall_at_trial && !o.inject_stall_every_trial)
         throw InputError(SourceLocation::command_line("--inject-stall-frames"),
-                         "name the trial to stall with --inject-stall-at-trial N.");
+                         "name the trial to stall with --inject-stall-at-trial N (or stall every trial with "
+                         "--inject-stall-every-trial).");
+    if (o.inject_stall_every_trial && o.inject_stall_frames <= 0)
+        throw InputError(SourceLocation::command_line("--inject-stall-every-trial"),
+                         "give the stall's length with --inject-stall-frames N.");
     if (o.capture_trial && o.capture_dir.empty())
         throw InputError(SourceLocation::command_line("--capture-trial"), "give the folder with --capture-dir DIR.");
     const std::string code = !o.observer.empty() ? o.observer : o.model_observer ? std::string("model") : "script";

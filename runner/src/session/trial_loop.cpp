@@ -57,7 +57,8 @@ std::optional<p::Answer> observer_answer(const SessionParts& s, const p::Schedul
 TrialHooks hooks_for(const SessionParts& s, const p::ScheduledTrial& t, std::size_t row) {
     const RunOptions& o = s.options;
     TrialHooks hooks;
-    if (o.inject_stall_at_trial && static_cast<std::size_t>(*o.inject_stall_at_trial) == row)
+    if (o.inject_stall_every_trial ||
+        (o.inject_stall_at_trial && static_cast<std::size_t>(*o.inject_stall_at_trial) == row))
         hooks.stall_frames = o.inject_stall_frames;
     if (o.capture_trial && static_cast<std::size_t>(*o.capture_trial) == row) {
         hooks.before_frame_onset = [&s, &t, row](std::size_t f) {
@@ -82,6 +83,7 @@ TrialLoopResult run_trials(const SessionParts& s, p::Schedule& schedule, std::si
                 if (s.store.get_snapshot(s.session, c.name)) snapshotted.insert(c.name);
     }
     TrialLoopResult out;
+    out.missed.emplace(s.protocol.timing, schedule.max_trials(), s.presenter.period_s());
     out.rows = first_row;  // the next trial_index: every stored trial, counted or not
     const std::size_t runs = schedule.block_runs().size();
     bool first_trial_here = true;
@@ -146,6 +148,12 @@ TrialLoopResult run_trials(const SessionParts& s, p::Schedule& schedule, std::si
         previous_ended_trial = !counted || t.task != p::Task::Adjust || *shown.response == p::Response::Confirm;
         s.progress.trial(s.protocol, t, out.rows);
         if (o.after_trial) o.after_trial(out.rows, schedule.max_trials());
+        // A presentation shown again because it missed (repeat_missed; a
+        // timeout that missed too): counted towards the bound, which ends the run.
+        out.missed->add((repeat_missed || (shown.end == TrialEnd::timeout && shown.missed_deadline &&
+                                           t.task != p::Task::Adjust)),
+                        shown.dropped_frames);
+        if (out.missed->reached()) break;
     }
     s.progress.end_line();
     return out;

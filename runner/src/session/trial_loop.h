@@ -3,12 +3,14 @@
 // answered, given to the procedure and committed to the study file before the
 // next is shown.
 #include <cstddef>
+#include <optional>
 
 #include "atonlab/present/presenter.h"
 #include "atonlab/present/screen_presenter.h"
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/store/store.h"
+#include "session/missed_bound.h"
 #include "session/run_options.h"
 #include "session/progress.h"
 #include "session/session_observer.h"
@@ -36,10 +38,13 @@ struct TrialLoopResult {
     std::size_t rows = 0;        ///< the session's stored trials, counted or not
     double snapshot_s = 0.0;     ///< wall-clock s spent on condition snapshots
     double store_s = 0.0;        ///< wall-clock s spent committing trials
+    /// The missed presentations of this run; reached(): the run stopped at its bound.
+    std::optional<MissedBound> missed;
 };
 
 /// Shows the instructions, then runs trials until the schedule finishes, a
-/// signal arrives (stop_signals.h) or the observer quits. first_row: the
+/// signal arrives (stop_signals.h), the observer quits or the missed
+/// presentations reach their bound (missed_bound.h). first_row: the
 /// session's stored trials so far; previous_ended_trial: the next trial gets
 /// the inter-trial fixation (resume.h Replayed).
 TrialLoopResult run_trials(const SessionParts& parts, protocols::Schedule& schedule, std::size_t first_row,

@@ -136,6 +136,16 @@ struct SessionInfo {
     std::optional<bool> displayable;
     bool allowed_undisplayable = false;         ///< the session ran with --allow-undisplayable
     std::vector<std::string> undisplayable;     ///< the conditions that could not produce a match on its display
+    /// The runner's stops before the session's end (sessions.stop_json;
+    /// docs/running.md "Missed frames and timeouts"): how many, and the last
+    /// one's reason ("missed_in_a_row", "missed_per_session") and sentence;
+    /// 0 and empty when it never stopped (or for a CSV).
+    int stops = 0;
+    std::string stop_reason, stop_text;
+    /// The presentation margin before the first trial (on screen;
+    /// docs/running.md "Presentation margin"): the share of a refresh left once
+    /// a frame is shown. None headless, for a CSV, or before it was measured.
+    std::optional<double> presentation_margin;
     /// Every condition the session's protocol defines, in file order (so a
     /// condition without trials is still reported); empty for a CSV.
     std::vector<std::string> protocol_conditions;

@@ -78,6 +78,13 @@ struct PlayOptions {
     std::function<void(std::size_t step)> after_onset;
 };
 
+/// One showing of a screen, timed by Presenter::time_showing(), s.
+struct ShowTiming {
+    double upload_s = 0.0;  ///< prepare(): its picture's codes to the GPU, the overlays blended
+    double draw_s = 0.0;    ///< draw() (an animated picture rendered) and finish(): the GPU done
+    double show_s() const noexcept { return upload_s + draw_s; }
+};
+
 /// What play() did: one interval per step shown (every pass when looping),
 /// then the interval of the screen that followed them (its onset = the last
 /// step's offset).
@@ -119,6 +126,13 @@ public:
     std::optional<InputEvent> wait(const Screen* screen, double since_s, std::optional<double> deadline_s,
                                    const std::function<bool(const InputEvent&)>& accept);
 
+    /// How long showing `screen` takes, `times` times (docs/running.md,
+    /// "Presentation margin"): right after a flip, the screen is prepared as new
+    /// (its picture uploaded afresh), drawn as for its onset and finished (the
+    /// GPU's work done), then flipped. The flip's wait for the refresh is not
+    /// timed: it is the margin. extra_s: test-only, a sleep added to each draw.
+    std::vector<ShowTiming> time_showing(const Screen& screen, int times, double extra_s = 0.0);
+
     InputQueue& input() noexcept { return input_; }
     /// Checked between flips and while waiting: true ends play() and wait() early (a signal).
     void set_interrupt(std::function<bool()> interrupt) { interrupt_ = std::move(interrupt); }
@@ -129,6 +143,8 @@ protected:
     virtual std::unique_ptr<Prepared> prepare(const Screen& screen) = 0;
     /// Draws a prepared screen for the flip seen t_s after its step's onset.
     virtual void draw(const Prepared& screen, double t_s) = 0;
+    /// Waits until the GPU has done everything drawn so far (on screen glFinish).
+    virtual void finish() {}
     /// Presents what was drawn; returns when the flip was seen (s).
     virtual double flip() = 0;
     /// Test-only stall: lose `frames` refresh periods before the next flip.

@@ -80,6 +80,7 @@ public:
 protected:
     std::unique_ptr<Prepared> prepare(const Screen& screen) override;
     void draw(const Prepared& screen, double t_s) override;
+    void finish() override;
     double flip() override;
     void stall(int frames) override;
     void wait_events(double until_s) override;

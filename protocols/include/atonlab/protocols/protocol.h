@@ -190,6 +190,14 @@ struct Timing {
     /// A 2AFC or yes-no trial whose stimulus missed a refresh (a frame shown
     /// late) is stored as missed, not shown to the procedure, and shown again.
     bool repeat_missed = false;
+    /// With repeat_missed: a run of `atonlab run` stops (exit status 7,
+    /// docs/running.md "Missed frames and timeouts") at this many missed
+    /// presentations in a row ...
+    int max_missed_in_a_row = 5;
+    /// ... or when its missed presentations exceed this share of the
+    /// schedule's bound on trials (a schedule without a bound: only the
+    /// consecutive bound applies). (0, 1].
+    double max_missed_fraction = 0.1;
     /// The refresh rate the protocol's durations are meant for, Hz: the
     /// headless clock's rate (60 when absent); on screen the measured rate
     /// must agree with it.

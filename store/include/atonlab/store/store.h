@@ -117,6 +117,15 @@ public:
     /// then only read, as a simulated session (docs/simulate.md: a simulation
     /// folder holds a file per session). The next writer switches it back to WAL.
     void switch_to_rollback_journal();
+    /// Ends a running session as `quit` because the runner stopped it before
+    /// its end (not the observer: docs/running.md, "Missed frames and
+    /// timeouts"): stamps ended_at and appends `stop`, a JSON object, to the
+    /// session's stop_json array with a "stopped_at" time (UTC) added. One
+    /// transaction. The array keeps every stop of the session: resume_session()
+    /// leaves it as it is, so a session stopped, resumed and completed says
+    /// when and why it stopped on the way. Throws invalid_argument for a
+    /// session that is not running or a `stop` that is not a JSON object.
+    void stop_session(SessionId session, std::string_view stop);
     /// Reopens a session left running (its process died), crashed or quit, so
     /// record_trial may continue it; counts the resume. Returns the resume point.
     /// A completed session cannot be resumed.
