@@ -46,7 +46,7 @@ ProtocolSet parse_protocol_set(std::string_view text, std::string_view option) {
     if (!TomlValue::parse(s.value, &error))
         throw InputError(SourceLocation::command_line(std::string(option), s.key),
                          fmt::format("\"{}\" is not one TOML value ({}); a string needs quotes, e.g. "
-                                     "defaults.procedure.kind='\"quest\"'.",
+                                     "display.name='\"lab-1\"'.",
                                      s.value, error));
     return s;
 }
