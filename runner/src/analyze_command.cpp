@@ -438,6 +438,17 @@ bool is_bad_input(store::StoreErrc k) {
 
 }  // namespace
 
+bool make_output_folder(const std::string& out) {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec || !fs::is_directory(out)) {
+        std::fprintf(stderr, "atonlab: %s: the output folder cannot be created (%s).\n", out.c_str(),
+                     ec ? ec.message().c_str() : "a file of that name exists");
+        return false;
+    }
+    return true;
+}
+
 int run_analyze(const AnalyzeOptions& o) {
     if (o.studies.size() == 1 && fs::is_directory(o.studies.front())) {
         if (!an::is_simulation_folder(o.studies.front()))
@@ -482,13 +493,7 @@ int run_analyze(const AnalyzeOptions& o) {
     }
 
     const fs::path out_dir = o.out;
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (ec || !fs::is_directory(out_dir)) {
-        std::fprintf(stderr, "atonlab: %s: the output folder cannot be created (%s).\n", o.out.c_str(),
-                     ec ? ec.message().c_str() : "a file of that name exists");
-        return 2;
-    }
+    if (!make_output_folder(o.out)) return 2;
 
     for (const an::DamagedInput& x : data.damaged) {
         std::fprintf(stderr,

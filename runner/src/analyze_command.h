@@ -32,6 +32,9 @@ struct AnalyzeOptions {
 };
 
 void add_analyze_command(CLI::App& app, AnalyzeOptions& options);
+/// Creates `out` (the report folder) if absent; false, with one sentence on
+/// stderr, when it cannot be made (the caller exits 2).
+bool make_output_folder(const std::string& out);
 int run_analyze(const AnalyzeOptions& options);
 /// `atonlab analyze DIR` for a simulation folder (analyze_simulation.cpp).
 int run_analyze_simulation(const AnalyzeOptions& options);

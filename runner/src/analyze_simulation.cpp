@@ -88,13 +88,7 @@ int run_analyze_simulation(const AnalyzeOptions& o) {
     if (tty) std::fprintf(stderr, "\r\033[K");
 
     const fs::path out_dir = o.out;
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (ec || !fs::is_directory(out_dir)) {
-        std::fprintf(stderr, "atonlab: %s: the output folder cannot be created (%s).\n", o.out.c_str(),
-                     ec ? ec.message().c_str() : "a file of that name exists");
-        return 2;
-    }
+    if (!make_output_folder(o.out)) return 2;
     an::PlotOptions po;
     po.gnuplot = o.gnuplot;
     const an::PlotResult plots = an::make_simulation_figures(out_dir, results, po);
