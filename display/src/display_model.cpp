@@ -497,8 +497,9 @@ glm::ivec3 encode_pixel(const DisplayModel& display, glm::dvec3 relative_rgb, gl
                         const EncodeSettings& settings) {
     check_bits(settings.bits);
     const int max_code = (1 << settings.bits) - 1;
-    // Luminance wins over chroma (docs/tone-mapping.md "Adding light never darkens").
-    const glm::dvec3 shown = fit_to_gamut_keeping_luminance(relative_rgb, channel_weights(display));
+    // By default luminance wins over chroma (docs/tone-mapping.md "Adding light never darkens"
+    // and "Out of gamut: colour or luminance").
+    const glm::dvec3 shown = fit_to_gamut(relative_rgb, channel_weights(display), settings.out_of_gamut);
     glm::ivec3 code(0);
     for (int c = 0; c < 3; ++c) {
         const auto& ch = display.channels[static_cast<std::size_t>(c)];
@@ -556,6 +557,7 @@ GpuDisplayParams gpu_display_params(const DisplayModel& display, const EncodeSet
     p.bits = settings.bits;
     p.dither = static_cast<std::int32_t>(settings.dither);
     p.seed = settings.seed;
+    p.out_of_gamut = static_cast<std::uint32_t>(settings.out_of_gamut);
     return p;
 }
 

@@ -352,7 +352,7 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
                 // the pixel, so adding a red light to a grey pixel would darken it. Here
                 // luminance wins instead: the colour moves towards the grey of its own
                 // luminance until no channel exceeds 1 (docs/tone-mapping.md).
-                out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
+                if (s.out_of_gamut == OutOfGamut::keep_luminance) out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
             }
             break;
         }
@@ -360,7 +360,9 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     // clamp clips at the display's white: luminance first, then chroma (as for eq 4.30 above).
     // Clipping each channel instead would darken a pixel whose chroma turns towards a
     // saturated colour as light is added (a red light on a grey sky).
-    if (s.tone_operator == ToneOperator::clamp) out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
+    // Any other display.out_of_gamut leaves the fit to the encoder (ToneMapSettings::out_of_gamut).
+    if (s.tone_operator == ToneOperator::clamp && s.out_of_gamut == OutOfGamut::keep_luminance)
+        out = fit_to_gamut_keeping_luminance(out, xyz_row(1));
     return glm::max(out, glm::dvec3(0.0));
 }
 
@@ -379,7 +381,7 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     const double lda = display_adaptation_cd_m2(s);
     p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
-    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), 0.0f, 0.0f};
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(static_cast<double>(s.out_of_gamut)), 0.0f};
     p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
     const glm::dvec2 bxy = s.blueshift_xy;
     const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));

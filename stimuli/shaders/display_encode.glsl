@@ -37,7 +37,7 @@ struct DisplayParams {
     int bits;
     int dither;
     uint seed;
-    uint pad;
+    uint out_of_gamut;  // OutOfGamut (gamut.h): DISPLAY_KEEP_* below
 };
 
 layout(std430, binding = DISPLAY_LUT_BINDING) readonly buffer DisplayLutKnots { double display_lut[]; };
@@ -197,14 +197,88 @@ double display_drive_for(DisplayChannel c, double L) {
 }
 
 // ---------------------------------------------------------------------------
-// Twin of fit_to_gamut_keeping_luminance() (colour.cpp): NaN and negatives are black; a
-// colour with a channel above 1 moves towards the grey of its luminance (the display's
-// channel weights), one at or above white luminance is white.
-dvec3 display_fit_to_gamut(vec3 relative_rgb, DisplayParams p) {
-    dvec3 rgb;
-    for (int c = 0; c < 3; ++c) rgb[c] = relative_rgb[c] > 0.0 ? double(relative_rgb[c]) : 0.0LF;
-    dvec3 w = dvec3(p.channel[0].white_cd_m2, p.channel[1].white_cd_m2, p.channel[2].white_cd_m2);
-    w /= w.r + w.g + w.b;
+// display.out_of_gamut: the twin of fit_to_gamut() (display/src/gamut.cpp).
+
+const uint DISPLAY_KEEP_LUMINANCE = 0u;
+const uint DISPLAY_KEEP_SIGNAL_COLOUR = 1u;
+const uint DISPLAY_KEEP_CHROMATICITY = 2u;
+const uint DISPLAY_CLIP_CHANNELS = 3u;
+
+// SIGNAL_AREA, SIGNAL_SHOWN, SIGNAL_*_CORNERS, SIGNAL_RGB_TO_XYZ, SIGNAL_XYZ_TO_RGB:
+// generated from gamut.cpp's tables.
+#include "signal_colour_areas.glsl"
+
+double display_cross(dvec2 a, dvec2 b) { return a.x * b.y - a.y * b.x; }
+
+bool display_on_segment(dvec2 p, dvec2 a, dvec2 b) {
+    const double eps = 1e-12LF;
+    return abs(display_cross(b - a, p - a)) <= eps && p.x >= min(a.x, b.x) - eps && p.x <= max(a.x, b.x) + eps &&
+           p.y >= min(a.y, b.y) - eps && p.y <= max(a.y, b.y) + eps;
+}
+
+// inside_polygon(): the even-odd rule, the edge counting as inside.
+bool display_inside_polygon(dvec2 xy, dvec2 poly[8], int n) {
+    bool inside = false;
+    for (int i = 0, j = n - 1; i < n; j = i++) {
+        dvec2 a = poly[i], b = poly[j];
+        if (display_on_segment(xy, a, b)) return true;
+        if ((a.y > xy.y) != (b.y > xy.y) && xy.x < (b.x - a.x) * (xy.y - a.y) / (b.y - a.y) + a.x) inside = !inside;
+    }
+    return inside;
+}
+
+// nearest_point_of_polygon().
+dvec2 display_nearest_point(dvec2 xy, dvec2 poly[8], int n) {
+    if (n == 1) return poly[0];
+    if (display_inside_polygon(xy, poly, n)) return xy;
+    dvec2 best = poly[0];
+    double best_d = 1e300LF;
+    for (int i = 0; i < n; ++i) {
+        dvec2 a = poly[i], ab = poly[(i + 1) % n] - a;
+        double len2 = dot(ab, ab);
+        double t = len2 > 0.0LF ? clamp(dot(xy - a, ab) / len2, 0.0LF, 1.0LF) : 0.0LF;
+        dvec2 p = a + t * ab;
+        double d = length(p - xy);
+        if (d < best_d) {
+            best_d = d;
+            best = p;
+        }
+    }
+    return best;
+}
+
+dvec2[8] display_polygon_corners(bool shown, int colour, out int n) {
+    n = shown ? SIGNAL_SHOWN_CORNERS[colour] : SIGNAL_AREA_CORNERS[colour];
+    dvec2 poly[8];
+    for (int i = 0; i < 8; ++i) poly[i] = shown ? SIGNAL_SHOWN[8 * colour + i] : SIGNAL_AREA[8 * colour + i];
+    return poly;
+}
+
+// nearest_signal_colour(): 0 white, 1 red, 2 green, 3 yellow. White inside white's area or
+// near the display's white; else the coloured area nearest in hue angle, within a limit.
+int display_nearest_signal_colour(dvec2 xy) {
+    int n;
+    dvec2 white_area[8] = display_polygon_corners(false, 0, n);
+    if (display_inside_polygon(xy, white_area, n)) return 0;
+    dvec2 v = xy - SIGNAL_WHITE;
+    double s = length(v);
+    if (!(s >= SIGNAL_MIN_SATURATION)) return 0;
+    dvec2 u = v / s;
+    int best = 0;
+    double best_cos = SIGNAL_MAX_ANGLE_COS;
+    for (int c = 1; c < 4; ++c) {
+        dvec2 first = SIGNAL_SPAN_FIRST[c], last = SIGNAL_SPAN_LAST[c];
+        bool inside = display_cross(first, u) >= 0.0LF && display_cross(u, last) >= 0.0LF;
+        double k = inside ? 1.0LF : max(dot(u, first), dot(u, last));
+        if (k > best_cos) {
+            best_cos = k;
+            best = c;
+        }
+    }
+    return best;
+}
+
+dvec3 display_keep_luminance(dvec3 rgb, dvec3 w) {
     double y = dot(w, rgb);
     if (!(y < 1.0LF)) return dvec3(1.0LF);
     double m = max(rgb.r, max(rgb.g, rgb.b));
@@ -213,8 +287,38 @@ dvec3 display_fit_to_gamut(vec3 relative_rgb, DisplayParams p) {
     return dvec3(y) + t * (rgb - dvec3(y));
 }
 
+// Twin of fit_to_gamut(): NaN and negatives are black; a colour with no channel above 1
+// is shown as it is; otherwise p.out_of_gamut decides.
+dvec3 display_fit_to_gamut(vec3 relative_rgb, DisplayParams p) {
+    dvec3 rgb;
+    for (int c = 0; c < 3; ++c) rgb[c] = relative_rgb[c] > 0.0 ? double(relative_rgb[c]) : 0.0LF;
+    dvec3 w = dvec3(p.channel[0].white_cd_m2, p.channel[1].white_cd_m2, p.channel[2].white_cd_m2);
+    w /= w.r + w.g + w.b;
+    double m = max(rgb.r, max(rgb.g, rgb.b));
+    if (m <= 1.0LF) return rgb;
+    if (p.out_of_gamut == DISPLAY_CLIP_CHANNELS) return min(rgb, dvec3(1.0LF));
+    if (p.out_of_gamut == DISPLAY_KEEP_CHROMATICITY)
+        return isinf(m) ? dvec3(rgb.r == m ? 1.0LF : 0.0LF, rgb.g == m ? 1.0LF : 0.0LF, rgb.b == m ? 1.0LF : 0.0LF)
+                        : rgb / m;
+    if (p.out_of_gamut == DISPLAY_KEEP_SIGNAL_COLOUR && !isinf(m)) {
+        dvec3 xyz = SIGNAL_RGB_TO_XYZ * rgb;
+        dvec2 xy = xyz.xy / (xyz.x + xyz.y + xyz.z);
+        int colour = display_nearest_signal_colour(xy);
+        if (colour != 0) {
+            int n;
+            dvec2 poly[8] = display_polygon_corners(true, colour, n);
+            dvec2 t = display_nearest_point(xy, poly, n);
+            double k = 1.0LF / t.y;  // xyY_to_xyz at Y = 1
+            dvec3 full = max(SIGNAL_XYZ_TO_RGB * dvec3(k * t.x, 1.0LF, k * (1.0LF - t.x - t.y)), dvec3(0.0LF));
+            full /= max(full.r, max(full.g, full.b));
+            return full * min(1.0LF, dot(w, rgb) / dot(w, full));
+        }
+    }
+    return display_keep_luminance(rgb, w);
+}
+
 // The encoder: relative_rgb is linear Rec.709 relative to the display's white
-// (1 = full drive), brought into the gamut keeping its luminance (display_fit_to_gamut).
+// (1 = full drive), brought into the gamut by p.out_of_gamut (display_fit_to_gamut).
 uvec3 encode_pixel(vec3 relative_rgb, ivec2 pixel, uint frame, DisplayParams p) {
     double max_code = double((1 << p.bits) - 1);
     dvec3 shown = display_fit_to_gamut(relative_rgb, p);

@@ -38,7 +38,7 @@ struct ToneMapParams {
     uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift (BLUE_*), w: white_cd_m2 given 0/1
     vec4 curve;          // x: 1/L_white² (empirical), y: Reinhard key, z: 1/L_white² (Reinhard), w: Kakimoto g
     vec4 display;        // x: Kakimoto k, y: white_cd_m2, z: L_dmax (cd/m²), w: L_da (cd/m²)
-    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), zw: 0
+    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), z: display.out_of_gamut (0 = keep-luminance), w: 0
     vec4 blue_rgb;       // xyz: blueshift RGB at Y = 1 (eq 4.29); w: blueshift y
     vec4 blue_per_sum;   // xyz: blueshift RGB per unit X+Y+Z (eq 4.28 path)
     vec4 rgb_to_x;       // rows of the Rec.709 RGB -> XYZ matrix
@@ -165,10 +165,11 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
         outc = ld * ((cone / y_w) * c + rod * p.blue_rgb.xyz);
         if (p.mode.y == HUE_RGB) {
             // eq 4.30 with luminance kept instead of the division (tonemap.cpp).
-            outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);
+            if (p.tvi.z == 0.0) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);
         }
     }
-    if (p.mode.x == TONE_CLAMP) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);  // luminance first (tonemap.cpp)
+    // Luminance first (tonemap.cpp); another display.out_of_gamut leaves the fit to the encoder.
+    if (p.mode.x == TONE_CLAMP && p.tvi.z == 0.0) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);
     return max(outc, vec3(0.0));
 }
 

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "atonlab/display/display_encodings.h"
+#include "atonlab/display/gamut.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/gl/objects.h"
 #include "gl_enums.h"
@@ -35,6 +36,11 @@ std::string_view shader_source(std::string_view name) {
     // Made from a registry rather than written: the GPU's dispatch over the display encodings.
     if (name == "display_encodings.glsl") {
         static const std::string generated = display::display_encodings_glsl();
+        return generated;
+    }
+    // Made from gamut.cpp's tables: the signal-colour areas of display.out_of_gamut.
+    if (name == "signal_colour_areas.glsl") {
+        static const std::string generated = display::signal_colour_areas_glsl();
         return generated;
     }
     for (std::size_t i = 0; i < detail::embedded_shaders_count; ++i)

@@ -56,7 +56,7 @@ inline constexpr std::string_view kSections[] = {"display", "camera", "environme
                                            "disc"};
 inline constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",     "viewing_distance_m",
                                              "peak_cd_m2", "black_cd_m2", "transfer",    "calibration",
-                                             "bits",       "dither",      "dither_seed"};
+                                             "bits",       "dither",      "dither_seed", "out_of_gamut"};
 inline constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 inline constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
                                                  "sea_reflectance"};

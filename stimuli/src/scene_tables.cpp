@@ -231,9 +231,18 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
         if (auto d = s.boolean("dither")) out.encode.dither = *d ? Dither::spatiotemporal : Dither::none;
         if (auto seed = s.integer("dither_seed", 0, std::numeric_limits<int>::max()))
             out.encode.seed = static_cast<std::uint32_t>(*seed);
+        if (auto g = s.string("out_of_gamut")) {
+            auto v = out_of_gamut_from_name(*g);
+            if (!v)
+                s.fail(s.get("out_of_gamut"), "out_of_gamut",
+                       fmt::format("unknown out_of_gamut \"{}\"; it must be one of {}.", text::echo(*g),
+                                   join(out_of_gamut_names(), "\"")));
+            out.encode.out_of_gamut = *v;
+        }
     }
     ToneMapSettings& tm = out.tonemap;
     tm.display_peak_cd_m2 = out.display.peak_cd_m2;
+    tm.out_of_gamut = out.encode.out_of_gamut;  // one key for both (ToneMapSettings::out_of_gamut)
     const toml::table* t = sub_table(root, "tonemap", "[tonemap]");
     if (t == nullptr) return;
     Section s(doc, *t, "tonemap", "the [tonemap] table");

@@ -131,5 +131,29 @@ TEST_F(GpuEncode, MatchesTheCpuReferenceForEveryTransferKind) {
     }
 }
 
+// display.out_of_gamut on the GPU (display_encode.glsl) against fit_to_gamut() (gamut.cpp):
+// every choice, on inputs mostly out of gamut (up to 6× full drive), on a nominal and a
+// measured (GOG) display.
+TEST_F(GpuEncode, EveryOutOfGamutChoiceMatchesTheCpuReference) {
+    const auto ssbo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}});
+    std::vector<float> inputs = make_inputs();
+    for (std::size_t i = 0; i < inputs.size(); ++i)
+        if (i % 4 != 3 && std::isfinite(inputs[i])) inputs[i] *= 5.0f;
+    const std::vector<DisplayModel> displays = every_kind();
+    for (const auto& name : out_of_gamut_names()) {
+        for (const DisplayModel& display : {displays[0], displays[1]}) {
+            EncodeSettings settings{8, Dither::spatiotemporal, 77};
+            settings.out_of_gamut = *out_of_gamut_from_name(name);
+            const Agreement a = run_case(ssbo, false, display, settings, inputs);
+            const double fraction = static_cast<double>(a.identical) / static_cast<double>(a.total);
+            std::printf("out_of_gamut %-18s %-5s: %ld/%ld codes identical (%.5f %%), max diff %d\n",
+                        std::string(name).c_str(), display.name.c_str(), a.identical, a.total, 100.0 * fraction,
+                        a.max_diff);
+            EXPECT_GE(fraction, 0.999) << name << " " << display.name;
+            EXPECT_LE(a.max_diff, 1) << name << " " << display.name;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace atonlab::test

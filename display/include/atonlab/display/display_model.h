@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/gamut.h"
 
 namespace atonlab::display {
 
@@ -121,14 +122,17 @@ struct EncodeSettings {
     int bits = 8;  ///< frame buffer bits per channel, 1..16 (8 or 10 in practice)
     Dither dither = Dither::spatiotemporal;
     std::uint32_t seed = 0;  ///< decorrelates the pattern between runs and channels
+    /// display.out_of_gamut: what a colour the display cannot show gives up (gamut.h).
+    OutOfGamut out_of_gamut = OutOfGamut::keep_luminance;
 };
 
 /// Encodes one pixel. relative_rgb is linear Rec.709 relative to the display's
 /// white: channel c should emit relative_rgb[c] · channel c's L(1). A colour the
-/// display cannot show first gives up chroma and keeps its luminance
-/// (fit_to_gamut_keeping_luminance with channel_weights(display)): NaN and negative
-/// channels are black, a colour with a channel above 1 moves towards the grey of
-/// its luminance, and one at or above white luminance is white. Each channel's
+/// display cannot show is brought into the gamut by settings.out_of_gamut
+/// (fit_to_gamut with channel_weights(display)); under the default, keep_luminance,
+/// it gives up chroma and keeps its luminance: NaN and negative channels are black,
+/// a colour with a channel above 1 moves towards the grey of its luminance, and one
+/// at or above white luminance is white. Each channel's
 /// target is then clipped to [L(0), L(1)], inverted through its transfer function
 /// and quantised to `bits` with the dither offset. Codes are always in
 /// [0, 2^bits − 1]. Throws InputError for bits outside 1..16.
@@ -174,7 +178,7 @@ struct GpuDisplayParams {
     std::int32_t bits;
     std::int32_t dither;  ///< Dither as an int
     std::uint32_t seed;
-    std::uint32_t pad;
+    std::uint32_t out_of_gamut;  ///< OutOfGamut as a uint
 };
 static_assert(sizeof(GpuDisplayParams) == 256);
 

@@ -27,6 +27,8 @@
 
 #include <span>
 
+#include "atonlab/display/gamut.h"
+
 namespace atonlab::display {
 
 // ---------------------------------------------------------------------------
@@ -127,6 +129,12 @@ struct ToneMapSettings {
     glm::dvec2 blueshift_xy{0.3, 0.3};
 
     HuePreservation hue_preservation = HuePreservation::xyY;
+
+    /// display.out_of_gamut (gamut.h), set with the encoder's. Under keep_luminance the rgb
+    /// hue mode and the clamp operator bring their output into the gamut here, keeping
+    /// luminance (as always); under any other choice they leave it to the encoder, which
+    /// applies the choice, so that the two never disagree.
+    OutOfGamut out_of_gamut = OutOfGamut::keep_luminance;
 };
 
 /// Throws InputError naming the key ("tonemap.white_relative", ...) in its SourceLocation
@@ -230,7 +238,7 @@ struct ToneMapGpuParams {
         mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
     std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
     std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), 0, 0
+    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), OutOfGamut as a float, 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)

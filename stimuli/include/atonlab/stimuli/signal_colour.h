@@ -15,22 +15,15 @@
 #include <vector>
 
 #include "atonlab/display/display_model.h"
+#include "atonlab/display/gamut.h"
 
 namespace atonlab::stimuli {
 
-/// The chromaticity area (CIE 1931 xy, corners in order) of a navigation light
-/// of colour "white", "green", "red" or "yellow" (COLREGs 1972 Annex I §7);
-/// nullopt for any other name (blue has no area there).
-std::optional<std::vector<glm::dvec2>> signal_colour_area(std::string_view colour);
-
-/// Whether xy lies inside (or on the edge of) a simple polygon, convex or not.
-bool inside_polygon(glm::dvec2 xy, const std::vector<glm::dvec2>& polygon);
-
-/// Whether two simple polygons overlap (share any point).
-bool polygons_overlap(const std::vector<glm::dvec2>& a, const std::vector<glm::dvec2>& b);
-
-/// The Rec.709 gamut triangle in xy (red, green, blue primaries).
-std::vector<glm::dvec2> rec709_gamut_xy();
+// The areas and their geometry live with the display's gamut choice (display/gamut.h).
+using display::inside_polygon;
+using display::polygons_overlap;
+using display::rec709_gamut_xy;
+using display::signal_colour_area;
 
 /// CIE 1976 u′v′ of an XYZ (u′ = 4X/(X+15Y+3Z), v′ = 9Y/(X+15Y+3Z)); (0, 0) for black.
 glm::dvec2 uv_prime(glm::dvec3 xyz);
