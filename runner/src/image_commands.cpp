@@ -7,6 +7,7 @@
 #include "image_commands.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -103,6 +104,10 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--dither", o.dither, "on (default: the pipeline's spatio-temporal dither) or off (round)");
     cmd->add_option("--blueshift", o.blueshift, "Scotopic blueshift (K2012 eq 4.27-4.29): on (default) or off");
     cmd->add_option("--hue-preservation", o.hue_preservation, "none, xyY (default) or rgb");
+    cmd->add_option("--out-of-gamut", o.out_of_gamut,
+                    fmt::format("What a colour the display cannot show gives up (display.out_of_gamut): {}; "
+                                "clip-channels is pfstools' (default: the scene's, else keep-luminance)",
+                                fmt::join(display::out_of_gamut_names(), ", ")));
     cmd->add_option("--key", o.key, "reinhard: the key a (default 0.18)");
     cmd->add_option(
         "--reinhard-white", o.reinhard_white,
@@ -159,6 +164,15 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
                              fmt::format("must be none, xyY or rgb, not '{}'", *o.hue_preservation));
         tm.hue_preservation = *h;
     }
+    if (o.out_of_gamut) {
+        const auto g = display::out_of_gamut_from_name(*o.out_of_gamut);
+        if (!g)
+            throw InputError(option("--out-of-gamut"), fmt::format("must be {}, not '{}'",
+                                                                   fmt::join(display::out_of_gamut_names(), ", "),
+                                                                   *o.out_of_gamut));
+        out.encode.out_of_gamut = *g;
+    }
+    tm.out_of_gamut = out.encode.out_of_gamut;  // one choice for both (ToneMapSettings::out_of_gamut)
     if (o.key) tm.reinhard_key = positive(o.key, "--key", "the key");
     bool white_is_max = false;
     if (o.reinhard_white) {
@@ -228,9 +242,11 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
             : std::string(),
         display::hue_preservation_name(tm.hue_preservation), tm.blueshift ? "on" : "off");
     result.settings += fmt::format(
-        "  display={} peak_cd_m2={:g} black_cd_m2={:g} bits=8 dither={}; {} pixels above display white (clipped)\n",
+        "  display={} peak_cd_m2={:g} black_cd_m2={:g} bits=8 dither={} out_of_gamut={}; {} pixels above display "
+        "white (clipped)\n",
         out.display.name, out.display.peak_cd_m2, out.display.black_cd_m2,
-        out.encode.dither == display::Dither::none ? "off" : "on", clipped);
+        out.encode.dither == display::Dither::none ? "off" : "on", display::out_of_gamut_name(out.encode.out_of_gamut),
+        clipped);
     return result;
 }
 

@@ -30,6 +30,7 @@ struct TonemapOptions {
     std::optional<std::string> dither;     ///< on or off
     std::optional<std::string> blueshift;  ///< on or off
     std::optional<std::string> hue_preservation;
+    std::optional<std::string> out_of_gamut;  ///< display.out_of_gamut (gamut.h)
     std::optional<double> key;                  ///< reinhard's key
     std::optional<std::string> reinhard_white;  ///< a number or "max"
     std::optional<double> white_cd_m2;          ///< linear, clamp

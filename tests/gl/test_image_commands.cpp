@@ -2,7 +2,8 @@
 // (docs/tone-mapping.md "HDR images in and out"):
 //  - tonemap --operator reinhard against pfstools' pfstmo_reinhard02 (Debian
 //    pfstools) with the parameters matched as documented: mean |Δcode| <= 0.05,
-//    max <= 1;
+//    max <= 1; with --out-of-gamut clip-channels the same holds on every pixel,
+//    out-of-gamut ones included (pfsout clips each channel);
 //  - glare keeps Σ L·Ω within 1e-3 once the reported edge cut is added back.
 // GL only for the rendering (exit status 3 without GL 4.5: skipped).
 #include <gtest/gtest.h>
@@ -153,6 +154,63 @@ TEST(ImageCommands, TonemapReinhardMatchesPfstmoReinhard02) {
     std::printf("against pfsoutppm --srgb (8-bit, truncated): %zu of %zu codes one above, %zu otherwise different\n",
                 one_above, codes.size(), other);
     EXPECT_EQ(other, 0u);
+    fs::remove_all(dir);
+}
+
+// display.out_of_gamut = "clip-channels" is what pfsout does to a colour above full drive: each
+// channel clipped at 1. With it, `atonlab tonemap` reproduces pfstmo_reinhard02 on every pixel,
+// the coloured cores that pfstmo leaves out of gamut included (docs/tone-mapping.md "Out of
+// gamut: colour or luminance"); under the default (keep-luminance) those cores differ by up to
+// 254 codes.
+TEST(ImageCommands, TonemapClipChannelsMatchesPfstmoReinhard02OutOfGamut) {
+    if (shell("command -v pfstmo_reinhard02 > /dev/null && command -v pfsoutpfm > /dev/null") != 0)
+        ATONLAB_SKIP_MISSING_TOOL() << "pfstmo_reinhard02 or pfsoutpfm is not installed (Debian packages pfstmo, pfstools; "
+                                        "scripts/setup.sh installs them)";
+    const fs::path dir = scratch("reinhard-clip");
+    const fs::path exr = dir / "four.exr";
+    if (!render(exr)) ATONLAB_SKIP_NO_GPU() << "no OpenGL 4.5 context";
+    const std::string common = " --operator reinhard --key 0.18 --reinhard-white max --epsilon-cd-m2 1e-5 --blueshift off"
+                               " --hue-preservation none --display srgb --black-cd-m2 0 --dither off";
+    for (const char* choice : {"clip-channels", "keep-luminance"})
+        ASSERT_EQ(shell(std::string(ATONLAB_BINARY) + " tonemap " + exr.string() + " -o " + (dir / choice).string() +
+                        ".png" + common + " --out-of-gamut " + choice + " > /dev/null"),
+                  0);
+    ASSERT_EQ(shell("pfsin " + exr.string() + " | pfstmo_reinhard02 --key 0.18 | pfsoutpfm " + (dir / "pfs.pfm").string()),
+              0);
+    int pw = 0, ph = 0;
+    const std::vector<float> pfs = read_pfm_rgb(dir / "pfs.pfm", pw, ph);
+    for (const std::string choice : {"clip-channels", "keep-luminance"}) {
+        int w = 0, h = 0;
+        const std::vector<float> ours = read_png_rgb(dir / (choice + ".png"), w, h);
+        ASSERT_EQ(w, pw);
+        ASSERT_EQ(h, ph);
+        double sum_in = 0, sum_out = 0;
+        int worst_in = 0, worst_out = 0;
+        std::size_t n_in = 0, n_out = 0;
+        for (std::size_t px = 0; px * 3 < pfs.size(); ++px) {
+            const bool outside = pfs[px * 3] > 1.0f || pfs[px * 3 + 1] > 1.0f || pfs[px * 3 + 2] > 1.0f;
+            for (std::size_t i = px * 3; i < px * 3 + 3; ++i) {
+                const int d = std::abs(static_cast<int>(std::lround(ours[i] * 255.0)) - srgb_code(pfs[i]));
+                (outside ? sum_out : sum_in) += d;
+                (outside ? worst_out : worst_in) = std::max(outside ? worst_out : worst_in, d);
+                ++(outside ? n_out : n_in);
+            }
+        }
+        std::printf("tonemap --out-of-gamut %s vs pfstmo_reinhard02: in gamut mean |dcode| %.4f max %d (%zu values); "
+                    "out of gamut mean %.2f max %d (%zu values, %.2f %% of the pixels)\n",
+                    choice.c_str(), sum_in / static_cast<double>(n_in), worst_in, n_in,
+                    n_out ? sum_out / static_cast<double>(n_out) : 0.0, worst_out, n_out,
+                    100.0 * static_cast<double>(n_out) / static_cast<double>(n_in + n_out));
+        ASSERT_GT(n_out, 0u) << "the frame should hold pixels pfstmo leaves out of gamut";
+        EXPECT_LE(sum_in / static_cast<double>(n_in), 0.05) << choice;
+        EXPECT_LE(worst_in, 1) << choice;
+        if (choice == "clip-channels") {
+            EXPECT_LE(sum_out / static_cast<double>(n_out), 0.05);
+            EXPECT_LE(worst_out, 1);
+        } else {
+            EXPECT_GT(worst_out, 50) << "keep-luminance should differ from pfsout's clipping out of gamut";
+        }
+    }
     fs::remove_all(dir);
 }
 
