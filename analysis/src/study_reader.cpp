@@ -288,6 +288,13 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
             if (!store::boolean_at(c, "/displayable").value_or(true))
                 info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
         if (const auto m = store::number_at(j, "/presentation/margin")) info.presentation_margin = *m;
+        info.out_of_gamut = store::string_at(j, "/display/out_of_gamut");
+        if (info.out_of_gamut && *info.out_of_gamut != "keep-luminance")
+            d.notes.push_back(fmt::format(
+                "{} session {} showed colours its display cannot show by display.out_of_gamut = \"{}\", not "
+                "keep-luminance: its out-of-gamut lights gave up luminance (docs/tone-mapping.md \"Out of gamut: "
+                "colour or luminance\")",
+                file, s.id.value, *info.out_of_gamut));
         if (info.displayable == false)
             d.notes.push_back(fmt::format(
                 "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "

@@ -25,7 +25,8 @@ inline constexpr std::string_view kRootKeys[] = {"protocol", "display",  "timing
                                                  "screens",  "defaults", "block",  "observer"};
 inline constexpr std::string_view kProtocolKeys[] = {"name", "description", "scene", "seed", "adaptation_s"};
 inline constexpr std::string_view kDisplayKeys[] = {"width_px",           "height_px", "width_m",
-                                             "viewing_distance_m", "name",      "max_calibration_age_days"};
+                                             "viewing_distance_m", "name",      "max_calibration_age_days",
+                                             "max_out_of_gamut_loss"};
 inline constexpr std::string_view kTimingKeys[] = {"stimulus_s",          "inter_stimulus_s", "inter_trial_s",
                                             "response_timeout_s",  "repeat_missed",    "refresh_hz",
                                             "adaptation_skippable", "max_missed_in_a_row", "max_missed_fraction"};

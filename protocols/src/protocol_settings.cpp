@@ -88,6 +88,10 @@ void read_display(const Document& doc, const Section& root, Protocol& p) {
         s.greater_than("max_calibration_age_days", *days, 0.0);
         p.display.max_calibration_age_days = *days;
     }
+    if (auto share = s.number("max_out_of_gamut_loss")) {
+        s.within("max_out_of_gamut_loss", *share, 0.0, 1.0);
+        p.display.max_out_of_gamut_loss = *share;
+    }
     for (auto&& [k, v] : *t) p.display.lines[std::string(k.str())] = Document::line_of(&v);
 }
 

@@ -78,6 +78,9 @@ void add_check_command(CLI::App& app, CheckOptions& o) {
     cmd->add_option("--db", o.db,
                     "Study file whose latest calibration of the protocol's display.name encodes the frames, as "
                     "`atonlab run --db` would (read only)");
+    cmd->add_flag("--strict", o.strict,
+                  "Refuse (exit 2) also where a judged light is clipped at the display's white at a level where the "
+                  "match may lie (otherwise a warning)");
 }
 
 Displayability check_protocol(const CheckOptions& o, const std::function<void()>& make_context) {
@@ -110,6 +113,12 @@ int run_check(const CheckOptions& o) {
         return 4;
     }
     std::printf("%s", displayability_table(d).c_str());
+    const std::string warnings = displayability_warnings(d, o.protocol);
+    if (!warnings.empty()) std::fprintf(stderr, "%s\n", warnings.c_str());
+    if (o.strict && !warnings.empty() && d.displayable()) {
+        std::fprintf(stderr, "atonlab: --strict: the warnings above refuse the protocol\n");
+        return 2;
+    }
     if (d.displayable()) {
         std::printf("every condition can produce a match on this display\n");
         return 0;

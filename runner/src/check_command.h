@@ -16,6 +16,7 @@ struct CheckOptions {
     std::string protocol;
     std::vector<std::string> sets;  ///< --set display.KEY=VALUE
     std::string db;                 ///< --db: the study file whose calibration encodes the frames
+    bool strict = false;            ///< --strict: a warning (a light clipped at white) refuses too
 };
 
 void add_check_command(CLI::App& app, CheckOptions& options);

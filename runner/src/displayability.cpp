@@ -8,6 +8,9 @@
 #include <cmath>
 #include <memory>
 
+#include "atonlab/display/gamut.h"
+#include "atonlab/display/tonemap.h"
+#include "atonlab/stimuli/tonemap.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/store/json.h"
 
@@ -16,6 +19,59 @@ namespace atonlab::runner {
 namespace p = atonlab::protocols;
 
 namespace {
+
+/// The light a judged light's window loses to the display's white and to
+/// display.out_of_gamut (ShownLight::white_loss_share, gamut_loss_share): the
+/// tone mapper's CPU reference on the frame's HDR image at the frame's
+/// adaptation, each window pixel's target luminance Y (relative to white: the
+/// tone curve's L_d) against min(1, Y) (what keep-luminance shows) and against
+/// what the choice shows, summed as Σ ΔL · Ω_px over the observer's window.
+void gamut_losses(const stimuli::ImageRGBA32F& hdr, const stimuli::Scene& sc, double adaptation_cd_m2,
+                  const LightWindow& w, double radius_deg, ShownLight& s) {
+    const display::DisplayModel& dm = sc.output.display;
+    const glm::dvec3 weights = display::channel_weights(dm);
+    double white_cd_m2 = 0.0;
+    for (int c = 0; c < 3; ++c) white_cd_m2 += dm.channels[static_cast<std::size_t>(c)].max_cd_m2();
+    display::ToneMapSettings no_hue = sc.output.tonemap;
+    no_hue.hue_preservation = display::HuePreservation::none;
+    no_hue.out_of_gamut = display::OutOfGamut::clip_channels;  // no fit in the tone mapper either
+    p::DisplayedImage to_white = w.image, to_choice = w.image;
+    to_white.background_cd_m2.clear();
+    to_choice.background_cd_m2.clear();
+    const int x0 = static_cast<int>(std::lround(w.frame_px.x - w.light_px.x));
+    const int y0 = static_cast<int>(std::lround(w.frame_px.y - w.light_px.y));
+    for (int j = 0; j < w.image.height; ++j)
+        for (int i = 0; i < w.image.width; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j) * w.image.width + i;
+            to_white.luminance_cd_m2[k] = to_choice.luminance_cd_m2[k] = 0.0f;
+            const int x = x0 + i, y = y0 + j;
+            if (x < 0 || y < 0 || x >= hdr.width || y >= hdr.height) continue;
+            const float* px = hdr.pixel(x, y);
+            const glm::dvec3 rgb(px[0], px[1], px[2]);
+            const glm::dvec3 rel = display::tonemap_pixel(rgb, adaptation_cd_m2, sc.output.tonemap);
+            // The tone curve's L_d: without hue preservation (eq 4.29) the output's luminance is
+            // L_d itself; eq 4.28 (xyY) caps it at 1 before the display sees it.
+            const double asked = glm::dot(weights, display::tonemap_pixel(rgb, adaptation_cd_m2, no_hue));
+            const double kept = std::min(1.0, asked);  // keep-luminance (gamut.h)
+            const double shown = glm::dot(weights, display::fit_to_gamut(rel, weights, sc.output.encode.out_of_gamut));
+            to_white.luminance_cd_m2[k] = static_cast<float>((asked - kept) * white_cd_m2);
+            to_choice.luminance_cd_m2[k] = static_cast<float>(std::max(0.0, kept - shown) * white_cd_m2);
+        }
+    const double white_lux = p::window_illuminance_lux(to_white, w.light_px, radius_deg);
+    const double choice_lux = p::window_illuminance_lux(to_choice, w.light_px, radius_deg);
+    const double asked_lux = std::max(0.0, s.added_lux) + white_lux + choice_lux;
+    if (asked_lux > 0.0) {
+        s.white_loss_share = white_lux / asked_lux;
+        s.gamut_loss_share = choice_lux / asked_lux;
+    }
+}
+
+/// The tone mapper's adaptation for a frame rendered afresh (StimulusRenderer::encode_scene):
+/// the eye's level, or with dynamic adaptation the frame's own log-average (K2012 eq 4.15).
+double frame_adaptation_cd_m2(const stimuli::Scene& sc, const stimuli::ImageRGBA32F& hdr) {
+    if (sc.output.adaptation.mode == stimuli::AdaptationMode::fixed) return sc.adaptation_cd_m2;
+    return stimuli::log_average_luminance(hdr, sc.output.adaptation.epsilon_cd_m2);
+}
 
 /// Every judged light of the condition's stimulus at `level` (the test first
 /// in 2AFC: the order does not change what each light looks like).
@@ -27,11 +83,14 @@ LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, con
     LevelEnd end;
     end.level = level;
     std::vector<std::shared_ptr<const FrameViews>> frames(stim.frames.size());
+    std::vector<stimuli::ImageRGBA32F> hdrs(stim.frames.size());
     std::vector<std::size_t> seen(stim.frames.size(), 0);
     for (std::size_t f = 0; f < stim.frames.size(); ++f) {
         std::vector<std::string> lights;
         for (const p::StimulusView& v : stim.views)
             if (v.frame == f) lights.push_back(v.light);
+        double deg_per_px = 0.0;
+        hdrs[f] = renderer.hdr(stim.frames[f], lights, deg_per_px);  // renders and caches the views
         frames[f] = renderer.views(stim.frames[f], lights);
     }
     for (const p::StimulusView& v : stim.views) {
@@ -48,6 +107,10 @@ LevelEnd render_end(StimulusRenderer& renderer, const p::Protocol& protocol, con
         // Σ (L − L_off) · Ω over its window.
         s.added_lux = p::increment_illuminance_lux(w.image, w.light_px, renderer.window_radius_deg());
         s.resolution_lux = w.code_step_cd_m2 * w.image.pixel_sr(w.brightest_px.x, w.brightest_px.y);
+        const auto sc = renderer.scene(stim.frames[v.frame].overrides);
+        end.out_of_gamut = std::string(display::out_of_gamut_name(sc->output.encode.out_of_gamut));
+        gamut_losses(hdrs[v.frame], *sc, frame_adaptation_cd_m2(*sc, hdrs[v.frame]), w, renderer.window_radius_deg(),
+                     s);
         end.lights.push_back(std::move(s));
     }
     return end;
@@ -175,10 +238,45 @@ void judge(const p::Condition& c, ConditionDisplayability& cd, int white) {
     }
 }
 
+/// R5 and W1 of displayability.h for one condition (after judge(): W1 uses its equal level).
+void judge_losses(const p::Condition& c, ConditionDisplayability& cd, int white, double max_loss) {
+    const bool matching = c.task != p::Task::YesNo;
+    // Where the match may lie: for the other stimulus every level (it is judged against at
+    // each); for the level stimulus the end nearer the estimated equal level (both without one).
+    const double mid = 0.5 * (cd.low.level + cd.high.level);
+    for (const LevelEnd* end : {&cd.low, &cd.high}) {
+        const bool high = end == &cd.high;
+        const bool near_match = !cd.equal_level || (high ? *cd.equal_level >= mid : *cd.equal_level <= mid);
+        const std::string& choice = end->out_of_gamut;
+        const bool keep_luminance = choice == display::out_of_gamut_name(display::OutOfGamut::keep_luminance);
+        for (const ShownLight& s : end->lights) {
+            const std::string at = fmt::format("at {} ({:.4g})", bound_name(c, high), end->level);
+            if (matching && !keep_luminance && s.gamut_loss_share > max_loss)
+                cd.problems.push_back(fmt::format(
+                    "{} the {} gives up {:.1f} % of its light within the observer's window to display.out_of_gamut = "
+                    "\"{}\" (more than display.max_out_of_gamut_loss, {:.3g} %): a brightness match would judge a "
+                    "colour that lost its luminance; use keep-luminance for brightness, or lower its intensity",
+                    at, role_text(s), 100.0 * s.gamut_loss_share, choice, 100.0 * max_loss));
+            // The other stimulus is the same at both ends: said once, at the top.
+            const bool where = s.role != c.level_on ? high : near_match;
+            if (s.white_loss_share > 0.01 && where)
+                cd.warnings.push_back(fmt::format(
+                    "{} the {} is clipped at the display's white (code {}) and shows {:.1f} % less light within the "
+                    "observer's window than its intensity asks for: a match near this level may lie; lower the "
+                    "intensity, or show the lights on an HDR display or larger pixels",
+                    at, role_text(s), white, 100.0 * s.white_loss_share));
+        }
+    }
+}
+
 std::string light_cell(const ShownLight& s, int white) {
-    return fmt::format("{} {:+.2e} lx ({:>7.3g} steps of {:.1e} lx) peak {:>4}{} bg {},{},{} {:.2e} cd/m²",
+    // The shares lost (ShownLight), only where there are any: a light shown whole reads as before.
+    const std::string lost =
+        (s.white_loss_share >= 0.005 ? fmt::format(" -{:.0f}% at white", 100.0 * s.white_loss_share) : "") +
+        (s.gamut_loss_share >= 0.005 ? fmt::format(" -{:.0f}% to gamut", 100.0 * s.gamut_loss_share) : "");
+    return fmt::format("{} {:+.2e} lx ({:>7.3g} steps of {:.1e} lx) peak {:>4}{}{} bg {},{},{} {:.2e} cd/m²",
                        p::to_string(s.role), s.added_lux, s.resolution_lux > 0 ? s.added_lux / s.resolution_lux : 0.0,
-                       s.resolution_lux, s.peak_code, s.peak_code >= white && s.clipped ? " WHITE" : "",
+                       s.resolution_lux, s.peak_code, s.peak_code >= white && s.clipped ? " WHITE" : "", lost,
                        s.background_code.r, s.background_code.g, s.background_code.b, s.background_cd_m2);
 }
 
@@ -198,6 +296,8 @@ Displayability check_displayability(StimulusRenderer& renderer, const p::Protoco
     // Degrees per pixel at the centre (a flat screen; the same pinhole as the camera's).
     d.window_radius_deg = renderer.window_radius_deg();
     d.deg_per_px = 2.0 * std::atan(0.5 * d.width_m / d.width_px / d.viewing_distance_m) * 180.0 / M_PI;
+    d.out_of_gamut = std::string(display::out_of_gamut_name(renderer.scene({})->output.encode.out_of_gamut));
+    d.max_out_of_gamut_loss = protocol.display.max_out_of_gamut_loss;
     for (const p::Block& b : protocol.blocks)
         for (const p::Condition& c : b.conditions) {
             const auto [lo, hi] = c.procedure.level_range();
@@ -209,6 +309,7 @@ Displayability check_displayability(StimulusRenderer& renderer, const p::Protoco
             // The codes' depth (white = 2^bits − 1), as every window of the frames knows it.
             d.bits = static_cast<int>(std::lround(std::log2(static_cast<double>(cd.high.white_code) + 1.0)));
             judge(c, cd, (1 << d.bits) - 1);
+            judge_losses(c, cd, (1 << d.bits) - 1, d.max_out_of_gamut_loss);
             d.conditions.push_back(std::move(cd));
         }
     return d;
@@ -222,6 +323,9 @@ std::string displayability_table(const Displayability& d) {
         "through the display model), that in code steps at its brightest pixel (one step's light, lx), its peak "
         "code, and the background there with the judged lights off (codes R,G,B; cd/m²):\n",
         d.width_px, d.height_px, d.width_m, d.viewing_distance_m, d.deg_per_px, d.bits, white, d.window_radius_deg);
+    if (d.out_of_gamut != display::out_of_gamut_name(display::OutOfGamut::keep_luminance))
+        t += fmt::format("  colours the display cannot show: display.out_of_gamut = \"{}\" (not keep-luminance)\n",
+                         d.out_of_gamut);
     for (const ConditionDisplayability& c : d.conditions) {
         for (const LevelEnd* end : {&c.low, &c.high}) {
             std::string row =
@@ -249,6 +353,15 @@ std::string displayability_refusal(const Displayability& d, const std::string& p
     return out;
 }
 
+std::string displayability_warnings(const Displayability& d, const std::string& protocol_file) {
+    std::string out;
+    for (const ConditionDisplayability& c : d.conditions)
+        for (const std::string& w : c.warnings)
+            out += fmt::format("{}atonlab: warning: {}:{}: condition \"{}\": {}.", out.empty() ? "" : "\n",
+                               protocol_file, c.line, c.name, w);
+    return out;
+}
+
 std::string displayability_json(const Displayability& d, bool allowed, const std::string& presentation_json) {
     using Json = nlohmann::ordered_json;
     Json conditions = Json::array();
@@ -265,12 +378,16 @@ std::string displayability_json(const Displayability& d, bool allowed, const std
                     {"peak_code", s.peak_code},
                     {"clipped", s.clipped},
                     {"background_code", Json::array({s.background_code.r, s.background_code.g, s.background_code.b})},
-                    {"background_cd_m2", s.background_cd_m2}});
-            ends.push_back(Json{{"level", end->level}, {"lights", std::move(lights)}});
+                    {"background_cd_m2", s.background_cd_m2},
+                    {"white_loss_share", s.white_loss_share},
+                    {"gamut_loss_share", s.gamut_loss_share}});
+            ends.push_back(
+                Json{{"level", end->level}, {"out_of_gamut", end->out_of_gamut}, {"lights", std::move(lights)}});
         }
         conditions.push_back(Json{{"name", c.name},
                                   {"displayable", c.displayable()},
                                   {"problems", c.problems},
+                                  {"warnings", c.warnings},
                                   {"equal_level", c.equal_level ? Json(*c.equal_level) : Json(nullptr)},
                                   {"ends", std::move(ends)}});
     }
@@ -281,7 +398,8 @@ std::string displayability_json(const Displayability& d, bool allowed, const std
                    {"viewing_distance_m", d.viewing_distance_m},
                    {"deg_per_px", d.deg_per_px},
                    {"bits", d.bits},
-                   {"white_code", (1 << d.bits) - 1}}},
+                   {"white_code", (1 << d.bits) - 1},
+                   {"out_of_gamut", d.out_of_gamut}}},
                  {"window_radius_deg", d.window_radius_deg},
                  {"displayable", d.displayable()},
                  {"allowed_undisplayable", allowed},

@@ -30,6 +30,10 @@
 //      two would be equal, interpolated between the ends: log10 of the light
 //      linear in the level on a log10 level scale, the light itself on a
 //      linear one).
+//  R5  (2AFC and adjust) under a display.out_of_gamut other than
+//      keep-luminance, a judged light at either end loses more than the
+//      protocol's display.max_out_of_gamut_loss (5 %) of its window's light to
+//      the choice: a brightness match on a colour that gave up luminance.
 // `atonlab run` refuses such a protocol (exit 2, before the study file is
 // created) unless --allow-undisplayable; `atonlab check` prints the same table
 // and exits 0 or 2.
@@ -61,6 +65,14 @@ struct ShownLight {
     /// The display's resolution there: one code step of the channels it
     /// raises at that pixel, over the lights-off codes, times Ω_px, lx.
     double resolution_lux = 0.0;
+    /// Of the light the tone mapper asks the window to show (Σ over the window of
+    /// the pixels' target luminance, the CPU reference on the frame's HDR image,
+    /// minus the lights-off frame's, times Ω_px), the share the display's white
+    /// cuts (a target above white, shown at white: issue 44's clipping) ...
+    double white_loss_share = 0.0;
+    /// ... and the share display.out_of_gamut takes beyond that (0 under
+    /// keep-luminance): the luminance a colour gives up to keep its colour.
+    double gamut_loss_share = 0.0;
 };
 
 /// A condition's stimulus at one end of its level range.
@@ -68,6 +80,7 @@ struct LevelEnd {
     double level = 0.0;  ///< in the procedure's units
     std::vector<ShownLight> lights;
     int white_code = 255;  ///< the display's white, 2^bits − 1
+    std::string out_of_gamut = "keep-luminance";  ///< its scene's display.out_of_gamut
 };
 
 struct ConditionDisplayability {
@@ -78,9 +91,13 @@ struct ConditionDisplayability {
     /// light as the other, interpolated between the ends (R4); nullopt where
     /// the ends do not give one (a light adds none, or the same at both ends).
     std::optional<double> equal_level;
-    /// Why the condition cannot produce a match on this display (R1-R4, with
+    /// Why the condition cannot produce a match on this display (R1-R5, with
     /// what to change), one clause each; empty when it can.
     std::vector<std::string> problems;
+    /// W1: a judged light clipped at the display's white loses more than 1 % of
+    /// its light there (the share named): the match may lie. `atonlab check`
+    /// prints them as warnings and, under --strict, refuses.
+    std::vector<std::string> warnings;
     bool displayable() const noexcept { return problems.empty(); }
 };
 
@@ -90,6 +107,10 @@ struct Displayability {
     double deg_per_px = 0.0;         ///< at the screen's centre
     double window_radius_deg = 0.5;  ///< the observer's window the light is summed over, degrees
     int bits = 8;                    ///< bits per channel of the codes
+    /// display.out_of_gamut of the scene (docs/tone-mapping.md "Out of gamut: colour or luminance").
+    std::string out_of_gamut = "keep-luminance";
+    /// R5's limit: the protocol's display.max_out_of_gamut_loss.
+    double max_out_of_gamut_loss = 0.05;
     std::vector<ConditionDisplayability> conditions;
     bool displayable() const noexcept;
 };
@@ -114,6 +135,10 @@ std::string displayability_table(const Displayability& d);
 /// One sentence per undisplayable condition (file:line: what is not
 /// displayable and what to change), newline-separated; "" when all are.
 std::string displayability_refusal(const Displayability& d, const std::string& protocol_file);
+
+/// One line per warning (W1), "atonlab: warning: file:line: condition "NAME": ...",
+/// newline-separated; "" when there are none.
+std::string displayability_warnings(const Displayability& d, const std::string& protocol_file);
 
 /// The JSON stored with the session (sessions.displayability_json; docs/store.md).
 /// `allowed`: the session ran with --allow-undisplayable.

@@ -337,6 +337,7 @@ TEST(Displayability, RunRefusesBeforeAnyTrialAndAllowRecordsTheFlag) {
         EXPECT_EQ(store::string_at(j, "/conditions/0/name"), "too-dim");
         EXPECT_EQ(store::number_at(j, "/display/width_px"), 320.0);
         EXPECT_EQ(store::number_at(j, "/display/white_code"), 255.0);
+        EXPECT_EQ(store::string_at(j, "/display/out_of_gamut"), "keep-luminance");  // the scene's default
         // The test light is the first of a 2AFC stimulus; at 1e-7 cd it adds nothing.
         EXPECT_EQ(store::string_at(j, "/conditions/0/ends/1/lights/0/role"), "test");
         EXPECT_EQ(store::number_at(j, "/conditions/0/ends/1/lights/0/added_lux").value_or(99.0), 0.0);
@@ -405,6 +406,68 @@ TEST(Displayability, CheckCommandExitsTwoOrZeroAndWritesNothing) {
     for (const auto& e : fs::directory_iterator(dir.path()))
         EXPECT_TRUE(e.path().extension() == ".out" || e.path().extension() == ".err" || e.path() == brighter)
             << e.path();
+}
+
+// Issue 44 §5 and issue 43 §3: a red 0.3 cd test light at 500 m over 0.001 cd/m² (320 × 180 px):
+// its core asks the tone mapper for about twice the display's white (empirical operator, white
+// 2: lr = key · L / L_wa ≈ 5), so keep-luminance shows it at white and loses about half of its
+// light there. `check` warns of it with the share lost and refuses it under --strict. With
+// display.out_of_gamut = "keep-signal-colour" the core is shown in red at 0.2126 of white: it
+// gives up most of the luminance left, more than display.max_out_of_gamut_loss (5 %), and a
+// brightness-matching condition is refused (R5) unless the protocol allows that share.
+TEST(Displayability, AClippedOrOutOfGamutLightIsWarnedOfAndRefusedAsStated) {
+    TempDir dir;
+    const std::vector<std::pair<std::string, std::string>> red = {
+        {"max_level = -2.0", "max_level = 0.0"},
+        {kMinLevel, "min_level = -2.0"},
+        {"start = -3.0", "start = -1.0"},
+        {"\"light.test.intensity_cd=1e-7\"]", "\"light.test.intensity_cd=0.3\", 'light.test.colour=\"red\"']"}};
+    const fs::path clipped = variant(dir.path(), "clipped.toml", kUndisplayable, red);
+    const Result loose = atonlab({"check", clipped.string()}, dir.path(), "loose");
+    if (loose.code == 3) ATONLAB_SKIP_NO_GPU() << "no GL 4.5 context: " << loose.err;
+    EXPECT_EQ(loose.code, 0) << loose.out << loose.err;
+    EXPECT_TRUE(contains(loose.err, "atonlab: warning: " + clipped.string())) << loose.err;
+    EXPECT_TRUE(contains(loose.err, "the test light \"test\" is clipped at the display's white (code 255) and shows"))
+        << loose.err;
+    EXPECT_TRUE(contains(loose.out, "% at white")) << loose.out;
+    const Result strict = atonlab({"check", clipped.string(), "--strict"}, dir.path(), "strict");
+    EXPECT_EQ(strict.code, 2) << strict.err;
+    EXPECT_TRUE(contains(strict.err, "--strict")) << strict.err;
+    if (!test::gl_context()) ATONLAB_SKIP_NO_GPU() << test::gl_unavailable_reason();
+
+    // The share lost, from the API: about half of the test light's window light (Y ≈ 2 at its core).
+    const Displayability d = check(clipped, 320, 180, 0.1);
+    ASSERT_EQ(d.conditions.size(), 1u);
+    const runner::ShownLight& test = d.conditions[0].high.lights[0];
+    std::printf("red 0.3 cd: adds %.3g lx, %.1f %% lost at white, %.1f %% to the gamut choice\n", test.added_lux,
+                100.0 * test.white_loss_share, 100.0 * test.gamut_loss_share);
+    EXPECT_GT(test.white_loss_share, 0.2);
+    EXPECT_LT(test.white_loss_share, 0.8);
+    EXPECT_LT(test.gamut_loss_share, 1e-9);  // keep-luminance takes nothing beyond the white
+    EXPECT_EQ(d.out_of_gamut, "keep-luminance");
+
+    // keep-signal-colour: the red core keeps its colour and gives up luminance; R5 refuses.
+    std::vector<std::pair<std::string, std::string>> signal = red;
+    signal.emplace_back("set = ['tonemap.operator=\"empirical\"']",
+                        "set = ['tonemap.operator=\"empirical\"', 'display.out_of_gamut=\"keep-signal-colour\"']");
+    const fs::path coloured = variant(dir.path(), "coloured.toml", kUndisplayable, signal);
+    const Displayability k = check(coloured, 320, 180, 0.1);
+    ASSERT_EQ(k.conditions.size(), 1u);
+    const runner::ShownLight& kt = k.conditions[0].high.lights[0];
+    std::printf("keep-signal-colour: %.1f %% lost at white, %.1f %% to the gamut choice\n",
+                100.0 * kt.white_loss_share, 100.0 * kt.gamut_loss_share);
+    EXPECT_GT(kt.gamut_loss_share, 0.05);
+    EXPECT_EQ(k.conditions[0].high.out_of_gamut, "keep-signal-colour");
+    EXPECT_FALSE(k.conditions[0].displayable());
+    bool named = false;
+    for (const std::string& problem : k.conditions[0].problems)
+        named = named || contains(problem, "display.out_of_gamut = \"keep-signal-colour\"");
+    EXPECT_TRUE(named) << runner::displayability_refusal(k, coloured.string());
+    // A protocol that allows the share: no R5.
+    signal.emplace_back("viewing_distance_m = 0.9", "viewing_distance_m = 0.9\nmax_out_of_gamut_loss = 1.0");
+    const Displayability allowed = check(variant(dir.path(), "allowed.toml", kUndisplayable, signal), 320, 180, 0.1);
+    for (const std::string& problem : allowed.conditions.at(0).problems)
+        EXPECT_FALSE(contains(problem, "display.out_of_gamut")) << problem;
 }
 
 }  // namespace

@@ -135,6 +135,8 @@ struct SessionInfo {
     /// "Displayability"): none for a session from before it (or a CSV).
     std::optional<bool> displayable;
     bool allowed_undisplayable = false;         ///< the session ran with --allow-undisplayable
+    /// display.out_of_gamut as displayability_json stored it; nullopt in files from before it was stored.
+    std::optional<std::string> out_of_gamut;
     std::vector<std::string> undisplayable;     ///< the conditions that could not produce a match on its display
     /// The runner's stops before the session's end (sessions.stop_json;
     /// docs/running.md "Missed frames and timeouts"): how many, and the last

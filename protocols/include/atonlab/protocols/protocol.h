@@ -175,6 +175,10 @@ struct Display {
     std::string name;
     /// `atonlab run` warns when the calibration is older than this, days (> 0).
     std::optional<double> max_calibration_age_days;
+    /// `atonlab check` and `run` refuse a brightness-matching condition whose judged
+    /// light gives up more than this share of its window's light to the scene's
+    /// display.out_of_gamut (any choice but keep-luminance; docs/running.md), 0..1.
+    double max_out_of_gamut_loss = 0.05;
     /// The line of each key in the protocol file ("viewing_distance_m" -> 9),
     /// so that a limit the scene derives from them (a glare billboard too wide
     /// for the display) names the protocol's lines; a key without a line was
