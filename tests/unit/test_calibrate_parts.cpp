@@ -408,6 +408,11 @@ TEST(CalibratePolicy, ProtocolDisplayNameAndMaximumAge) {
     EXPECT_EQ(error_key("\n\nname = \"\"\n"), "display.name");
     EXPECT_EQ(error_key("\n\nmax_calibration_age_days = 0\n"), "display.max_calibration_age_days");
     EXPECT_EQ(error_key("\n\nmax_calibration_age_days = \"30\"\n"), "display.max_calibration_age_days");
+    // display.max_out_of_gamut_loss: R5's share (docs/running.md), 5 % unless given, 0 … 1.
+    EXPECT_EQ(plain.display.max_out_of_gamut_loss, 0.05);
+    EXPECT_EQ(protocols::parse_protocol(with_keys("max_out_of_gamut_loss = 0.2\n"), "p.toml").display.max_out_of_gamut_loss,
+              0.2);
+    EXPECT_EQ(error_key("\n\nmax_out_of_gamut_loss = 1.5\n"), "display.max_out_of_gamut_loss");
 }
 
 // --- The view's keys ---------------------------------------------------------------------

@@ -415,6 +415,19 @@ TEST(SceneFileErrors, UnknownChoicesSaySo) {
     expect_error_at(bogus, 7, "eye.glare", "unknown glare model");
 }
 
+// display.out_of_gamut (docs/tone-mapping.md "Out of gamut: colour or luminance"): keep-luminance
+// by default; the one key sets the encoder's and the tone mapper's choice; a wrong name says which.
+TEST(SceneFile, OutOfGamutIsReadForTheEncoderAndTheToneMapper) {
+    const Scene plain = parse_scene(kMinimal, kFile);
+    EXPECT_EQ(plain.output.encode.out_of_gamut, OutOfGamut::keep_luminance);
+    EXPECT_EQ(plain.output.tonemap.out_of_gamut, OutOfGamut::keep_luminance);
+    const Scene coloured = parse_scene(std::string(kMinimal) + "out_of_gamut = \"keep-signal-colour\"\n", kFile);
+    EXPECT_EQ(coloured.output.encode.out_of_gamut, OutOfGamut::keep_signal_colour);
+    EXPECT_EQ(coloured.output.tonemap.out_of_gamut, OutOfGamut::keep_signal_colour);
+    expect_error_at(std::string(kMinimal) + "out_of_gamut = \"keep-colour\"\n", 6, "display.out_of_gamut",
+                    "\"keep-luminance\", \"keep-signal-colour\", \"keep-chromaticity\", \"clip-channels\"");
+}
+
 TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
     const std::string text = std::string(kMinimal) +
                              "[eye]\nglare = \"spencer\"\npupil_mm = 5.5\n[glare]\nwindow = \"epanechnikov\"\n"
