@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
         scene.adaptation_cd_m2 = 0.03;
         scene.output.adaptation.mode = st::AdaptationMode::dynamic;
         scene.output.ldr_glare = ldr;
+        // A navigator must name the buoy's colour: a core brighter than the display shows in red
+        // stays red and gives up luminance (docs/tone-mapping.md "Out of gamut: colour or
+        // luminance"). The tone mapper and the encoder take the one choice together.
+        scene.output.encode.out_of_gamut = d::OutOfGamut::keep_signal_colour;
+        scene.output.tonemap.out_of_gamut = d::OutOfGamut::keep_signal_colour;
         scene.glare.model = st::GlareModel::wave_optics;
         scene.glare.psf_size = 256;
         scene.glare.eye.gratings.enabled = false;  // resolved only from N = 512
