@@ -288,7 +288,11 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
             if (!store::boolean_at(c, "/displayable").value_or(true))
                 info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
         if (const auto m = store::number_at(j, "/presentation/margin")) info.presentation_margin = *m;
+        // The scene's choice, or a condition's own (a `set` of display.out_of_gamut) where it differs.
         info.out_of_gamut = store::string_at(j, "/display/out_of_gamut");
+        for (const nlohmann::json& c : store::array_at(j, "/conditions"))
+            for (const nlohmann::json& e : store::array_at(c, "/ends"))
+                if (const auto g = store::string_at(e, "/out_of_gamut"); g && *g != "keep-luminance") info.out_of_gamut = g;
         if (info.out_of_gamut && *info.out_of_gamut != "keep-luminance")
             d.notes.push_back(fmt::format(
                 "{} session {} showed colours its display cannot show by display.out_of_gamut = \"{}\", not "

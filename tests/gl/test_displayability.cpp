@@ -465,9 +465,29 @@ TEST(Displayability, AClippedOrOutOfGamutLightIsWarnedOfAndRefusedAsStated) {
     EXPECT_TRUE(named) << runner::displayability_refusal(k, coloured.string());
     // A protocol that allows the share: no R5.
     signal.emplace_back("viewing_distance_m = 0.9", "viewing_distance_m = 0.9\nmax_out_of_gamut_loss = 1.0");
-    const Displayability allowed = check(variant(dir.path(), "allowed.toml", kUndisplayable, signal), 320, 180, 0.1);
+    const fs::path allowed_file = variant(dir.path(), "allowed.toml", kUndisplayable, signal);
+    const Displayability allowed = check(allowed_file, 320, 180, 0.1);
     for (const std::string& problem : allowed.conditions.at(0).problems)
         EXPECT_FALSE(contains(problem, "display.out_of_gamut")) << problem;
+    // The study file stores the choice, and the report names it.
+    const fs::path db = dir / "study.db";
+    const Result ran = atonlab({"run", allowed_file.string(), "--db", db.string(), "--headless", "--model-observer",
+                                "--no-true-pse", "--allow-undisplayable"},
+                               dir.path(), "ran");
+    ASSERT_EQ(ran.code, 0) << ran.err;
+    {
+        const store::Store study = store::Store::open_read_only(db);
+        const nlohmann::json j = store::parse_json(*study.sessions().at(0).displayability_json);
+        EXPECT_EQ(store::string_at(j, "/conditions/0/ends/1/out_of_gamut"), "keep-signal-colour");
+        EXPECT_GT(store::number_at(j, "/conditions/0/ends/1/lights/0/gamut_loss_share").value_or(0.0), 0.05);
+    }
+    const Result analyzed =
+        atonlab({"analyze", db.string(), "--out", (dir / "report").string(), "--bootstrap", "20"}, dir.path(), "an");
+    EXPECT_TRUE(analyzed.code == 0 || analyzed.code == 5) << analyzed.err;
+    // The report's notes (HTML-escaped quotes).
+    const std::string html = file_bytes(dir / "report/report.html");
+    EXPECT_TRUE(contains(html, "display.out_of_gamut = &quot;keep-signal-colour&quot;, not keep-luminance"))
+        << analyzed.out;
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 // The areas are those of the International Regulations for Preventing Collisions at Sea
 // (COLREGs 1972, Annex I §7, "Colour specification of lights"), as corners in CIE 1931 xy:
 // the CIE areas for signal lights (CIE S 004/E-2001), narrowed for ships. IALA
-// Recommendation E-200-1 (2008) specifies the same four colours for marine aids to
-// navigation within the same CIE areas; COLREGs' corners are the ones at hand here.
+// Recommendation E-200-1 gives its own areas for marine aids to navigation, after the
+// CIE's; they were not at hand, so COLREGs' corners serve both here.
 #include <array>
 #include <cstdint>
 #include <optional>
