@@ -45,6 +45,10 @@ std::optional<TomlValue> TomlValue::parse(std::string_view text, std::string* er
     return TomlValue(std::move(doc));
 }
 
+std::string TomlValue::quoted(std::string_view text) {
+    return toml_quoted(text);
+}
+
 std::optional<TomlValue> TomlValue::string(std::string_view text, std::string* error, std::string_view source) {
     return parse(toml_quoted(text), error, source);
 }

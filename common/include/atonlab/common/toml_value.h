@@ -32,6 +32,11 @@ public:
     static std::optional<TomlValue> string(std::string_view text, std::string* error = nullptr,
                                            std::string_view source = {});
 
+    /// `text` as the TOML text of a basic string: quoted, quotes and
+    /// backslashes escaped, control characters written \uXXXX. What string()
+    /// parses; also the value text of an override's stored form ("key=\"red\"").
+    static std::string quoted(std::string_view text);
+
     /// A value made in code, not read from text (a Python keyword's value):
     /// its nodes have no source.
     static TomlValue of(bool v);
