@@ -312,22 +312,21 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     const text::FileText read = text::read_text_file(csv_file, kMaxCsvBytes);
     if (!read.opened) throw csv_error(file, 0, "", "cannot be opened for reading (does it exist?)");
     if (!read.ok()) throw csv_error(file, 0, "", fmt::format("cannot be read: {}", read.error));
-    std::istringstream in(read.text);
-    int line = 0;
-    std::string error;
-    auto header = detail::read_csv_record(in, line, error);
-    if (!header) throw csv_error(file, 1, "", error.empty() ? "is empty: it needs a header row" : error);
+    CsvReader reader(read.text, file);
+    const auto header_record = reader.next();
+    if (!header_record) throw csv_error(file, 1, "", "is empty: it needs a header row");
+    const std::vector<std::string> header_fields = header_record->texts();
+    const auto* header = &header_fields;
     std::map<std::string, std::size_t> index;
-    for (std::size_t i = 0; i < header->fields.size(); ++i) {
-        std::string name = RowReader::trim(header->fields[i]);
-        if (i == 0 && name.rfind("\xEF\xBB\xBF", 0) == 0) name.erase(0, 3);  // a UTF-8 byte-order mark
+    for (std::size_t i = 0; i < header->size(); ++i) {
+        const std::string name = RowReader::trim((*header)[i]);
         if (name.empty()) throw csv_error(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
         if (!index.emplace(name, i).second) throw csv_error(file, 1, name, "appears twice in the header");
     }
     for (const std::string& col : required_csv_columns()) {
         if (!index.count(col)) {
             std::string have;
-            for (const std::string& f : header->fields) have += (have.empty() ? "" : ", ") + f;
+            for (const std::string& f : *header) have += (have.empty() ? "" : ", ") + f;
             throw csv_error(file, 1, col,
                              fmt::format("the header has no column '{}', which is required (required: observer, "
                                          "condition, level, response; the header has: {})",
@@ -353,22 +352,20 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
     }
     std::map<std::string, std::int64_t> next_index;  // per session, when trial_index is not given
     while (true) {
-        auto rec = detail::read_csv_record(in, line, error);
-        if (!rec) {
-            if (!error.empty()) throw csv_error(file, line, "", error);
-            break;
-        }
-        if (rec->fields.size() == 1 && RowReader::trim(rec->fields[0]).empty()) continue;  // a blank line
-        if (rec->fields.size() != header->fields.size())
+        const auto rec = reader.next();
+        if (!rec) break;
+        const std::vector<std::string> fields = rec->texts();
+        if (fields.size() == 1 && RowReader::trim(fields[0]).empty()) continue;  // a blank line
+        if (fields.size() != header->size())
             throw csv_error(file, rec->line, "",
-                             fmt::format("the row has {} fields where the header has {}", rec->fields.size(),
-                                         header->fields.size()));
-        const RowReader row(file, rec->line, index, rec->fields);
+                             fmt::format("the row has {} fields where the header has {}", fields.size(),
+                                         header->size()));
+        const RowReader row(file, rec->line, index, fields);
         Trial t = trial_from_row(row, file);
         // "KEY[0]", "KEY[1]", ...: one array setting (write_trials_csv writes a position so).
         std::map<std::string, std::map<std::size_t, std::string>> arrays;
         for (const auto& [name, i] : setting_columns) {
-            const std::string v = RowReader::trim(rec->fields[i]);
+            const std::string v = RowReader::trim(fields[i]);
             if (v.empty()) continue;
             const auto open = name.rfind('[');
             std::size_t element = 0;
@@ -431,7 +428,7 @@ std::string setting_field(const std::string& toml_value) {
     const SettingValue v = setting_value(toml_value);
     if (v.number) return detail::number_text(*v.number);
     if (v.boolean) return *v.boolean ? "true" : "false";
-    return detail::csv_field(v.text);
+    return csv_field(v.text);
 }
 
 }  // namespace
@@ -453,15 +450,14 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
     for (const std::string& k : setting_keys) {
         const auto e = elements.find(k);
         if (e == elements.end()) {
-            out << ',' << detail::csv_field(k);
+            out << ',' << csv_field(k);
             continue;
         }
-        for (std::size_t i = 0; i < e->second; ++i) out << ',' << detail::csv_field(fmt::format("{}[{}]", k, i));
+        for (std::size_t i = 0; i < e->second; ++i) out << ',' << csv_field(fmt::format("{}[{}]", k, i));
     }
     out << '\n';
     auto num = [](const std::optional<double>& v) { return v ? detail::number_text(*v) : std::string(); };
     auto flag = [](const std::optional<bool>& v) { return v ? std::string(*v ? "1" : "0") : std::string(); };
-    using detail::csv_field;
     for (const Trial& t : data.trials) {
         const std::vector<std::string> f{csv_field(t.session),
                                          csv_field(t.observer),

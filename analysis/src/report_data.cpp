@@ -172,7 +172,7 @@ std::string setting_csv(const std::string& toml_value) {
     const SettingValue v = setting_value(toml_value);
     if (v.number) return detail::number_text(*v.number);
     if (v.boolean) return *v.boolean ? "true" : "false";
-    return detail::csv_field(v.text);
+    return csv_field(v.text);
 }
 
 /// The same as a JSON value.
@@ -411,9 +411,8 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
     // The fixed columns, then one per factor of the design (StudyResults::factor_columns).
     std::vector<std::string> cols = fits_csv_columns();
     cols.insert(cols.end(), r.factor_columns.begin(), r.factor_columns.end());
-    for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + detail::csv_field(cols[i]);
+    for (std::size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + csv_field(cols[i]);
     out += "\n";
-    using detail::csv_field;
     for (const GroupResult& g : r.groups) {
         const ConditionInfo* c = r.condition(g.condition);
         if (!c) continue;

@@ -27,11 +27,11 @@ std::string value_text(const toml::node& n) {
     return {};
 }
 
-/// An override's TOML value text, parsed; a value that is not TOML is a
-/// string, as the scene loader takes it (docs/scene-file.md "Overrides with --set").
-std::string override_value(const std::string& toml_value) {
-    if (const auto v = TomlValue::parse(toml_value)) return value_text(v->node());
-    return toml_value;
+/// An override's value as a report writes it: its typed value (a value that
+/// is not TOML is a string, as the scene loader takes it; docs/scene-file.md
+/// "Overrides with --set"), else the text as written.
+std::string override_value(const SceneOverride& o) {
+    return o.typed() ? value_text(o.typed()->node()) : o.value;
 }
 
 constexpr std::string_view kColourKeys[] = {"colour", "xy", "spd"};
@@ -78,8 +78,7 @@ std::optional<SceneLights> SceneLights::parse(std::string_view scene_text, std::
     return out;
 }
 
-std::optional<LightLook> SceneLights::look(std::string_view name,
-                                           const std::vector<std::pair<std::string, std::string>>& overrides) const {
+std::optional<LightLook> SceneLights::look(std::string_view name, const std::vector<SceneOverride>& overrides) const {
     // The light or disc itself, or the base of "NAME/LETTER" (an alternating light's colour).
     std::string letter;
     const auto find = [&](std::string_view n) -> std::pair<const std::vector<Entry>*, std::size_t> {
@@ -98,21 +97,16 @@ std::optional<LightLook> SceneLights::look(std::string_view name,
     }
     const std::string array = list == &lights_ ? "light" : "disc";
     Entry e = (*list)[index];
-    // The overrides that address this element: ARRAY.NAME.KEY (NAME may hold
-    // dots; KEY never does) or ARRAY[INDEX].KEY, applied in order.
-    for (const auto& [key, value] : overrides) {
-        const auto last_dot = key.rfind('.');
-        if (last_dot == std::string::npos) continue;
-        const std::string element = key.substr(0, last_dot);
-        const std::string leaf = key.substr(last_dot + 1);
-        const bool by_name = element == array + "." + (*list)[index].name;
-        const bool by_index = element == fmt::format("{}[{}]", array, index);
-        if (!by_name && !by_index) continue;
+    // The overrides that address this element (ARRAY.NAME.KEY or ARRAY[INDEX].KEY), applied in order.
+    for (const SceneOverride& o : overrides) {
+        const std::optional<ElementAddress> a = element_address(o.key, array);
+        if (!a || (a->index ? *a->index != index : a->name != (*list)[index].name)) continue;
+        const std::string& leaf = a->key;
         if (std::find(std::begin(kColourKeys), std::end(kColourKeys), leaf) != std::end(kColourKeys)) {
             e.colour_key = leaf;  // the others of the group are removed (scene_reader.h exclusive_groups)
-            e.colour_value = override_value(value);
+            e.colour_value = override_value(o);
         } else if (leaf == "rhythm" && !e.disc) {
-            e.rhythm = override_value(value);
+            e.rhythm = override_value(o);
         }
     }
     LightLook out;

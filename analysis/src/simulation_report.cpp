@@ -29,7 +29,7 @@ std::string cell(const std::optional<double>& v) {
 
 std::string row_of(const std::vector<std::string>& fields) {
     std::string out;
-    for (std::size_t i = 0; i < fields.size(); ++i) out += (i ? "," : "") + detail::csv_field(fields[i]);
+    for (std::size_t i = 0; i < fields.size(); ++i) out += (i ? "," : "") + csv_field(fields[i]);
     return out + "\n";
 }
 

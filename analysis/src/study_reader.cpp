@@ -13,6 +13,8 @@
 #include <sstream>
 
 #include "atonlab/analysis/dataset.h"
+#include "atonlab/common/input_error.h"
+#include "atonlab/common/scene_override.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
 #include "csv.h"
@@ -42,39 +44,39 @@ void read_stops(const std::string& text, std::int64_t id, const std::string& fil
                                   info.stops, store::number_at(last, "/trials_stored").value_or(0), info.stop_text));
 }
 
-/// A TOML value as the protocol wrote it in an override: a number, or a quoted
-/// string (the protocol loader accepts nothing else for the keys read here).
-std::optional<double> toml_number(std::string_view v) {
-    double x = 0.0;
-    const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-    if (ec != std::errc() || ptr != v.data() + v.size() || !std::isfinite(x)) return std::nullopt;
-    return x;
+/// An override's value as a number: its typed value's, when it is a finite number.
+std::optional<double> number_of(const SceneOverride& o) {
+    if (o.typed() == nullptr) return std::nullopt;
+    const toml::node& n = o.typed()->node();
+    if (!n.is_integer() && !n.is_floating_point()) return std::nullopt;
+    const double x = *n.value<double>();
+    return std::isfinite(x) ? std::optional<double>(x) : std::nullopt;
 }
 
-std::string toml_string(std::string_view v) {
-    if (v.size() >= 2 && (v.front() == '"' || v.front() == '\'') && v.back() == v.front())
-        return std::string(v.substr(1, v.size() - 2));
-    return std::string(v);
+/// An override's value as text: a string's contents, any other value as written.
+std::string text_of(const SceneOverride& o) {
+    if (o.typed() != nullptr && o.typed()->node().is_string()) return *o.typed()->node().value<std::string>();
+    return o.value;
 }
 
 struct Frame {
-    std::string role;                                            ///< "test", "reference", "both"
-    std::vector<std::pair<std::string, std::string>> overrides;  ///< (key, TOML value), in order
+    std::string role;                      ///< "test", "reference", "both"
+    std::vector<SceneOverride> overrides;  ///< as stored, read by SceneOverride::parse, in order
 
-    /// The last value written to `key` (later overrides win).
-    std::optional<std::string> value(std::string_view key) const {
-        std::optional<std::string> v;
-        for (const auto& [k, val] : overrides)
-            if (k == key) v = val;
+    /// The last override of `key` (later overrides win).
+    const SceneOverride* value(std::string_view key) const {
+        const SceneOverride* v = nullptr;
+        for (const SceneOverride& o : overrides)
+            if (o.key == key) v = &o;
         return v;
     }
 };
 
 /// The glare model a frame's overrides give a light: its own
 /// (light.NAME.glare), else the eye's (eye.glare); nullopt: the scene's.
-std::optional<std::string> glare_of(const Frame& frame, const std::string& light) {
+const SceneOverride* glare_of(const Frame& frame, const std::string& light) {
     if (!light.empty())
-        if (auto v = frame.value("light." + light + ".glare")) return v;
+        if (const SceneOverride* v = frame.value("light." + light + ".glare")) return v;
     return frame.value("eye.glare");
 }
 
@@ -97,10 +99,13 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
         Frame frame;
         frame.role = store::string_at(f, "/role").value_or("both");
         for (const nlohmann::json& o : store::array_at(f, "/overrides")) {
+            // The one reader of "key=value" (common/scene_override.h): the value typed once.
             const std::string text = o.is_string() ? o.get<std::string>() : std::string();
-            const auto eq = text.find('=');
-            if (eq == std::string::npos) continue;
-            frame.overrides.emplace_back(text.substr(0, eq), text.substr(eq + 1));
+            try {
+                frame.overrides.push_back(SceneOverride::parse(text));
+            } catch (const InputError&) {
+                continue;  // not "key=value": the runner stores none such
+            }
         }
         frames.push_back(std::move(frame));
     }
@@ -135,18 +140,18 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
     }
     if (!test && !frames.empty()) test = &frames.front();
     if (test) {
-        if (const auto v = test->value("eye.adaptation_cd_m2")) t.adaptation_cd_m2 = toml_number(*v);
-        if (const auto v = test->value("tonemap.operator")) t.tone_operator = toml_string(*v);
-        if (const auto v = glare_of(*test, test_light)) t.glare_test = toml_string(*v);
+        if (const auto v = test->value("eye.adaptation_cd_m2")) t.adaptation_cd_m2 = number_of(*v);
+        if (const auto v = test->value("tonemap.operator")) t.tone_operator = text_of(*v);
+        if (const auto v = glare_of(*test, test_light)) t.glare_test = text_of(*v);
         if (!test_light.empty()) {
             if (const auto v = test->value("light." + test_light + ".intensity_cd")) {
-                const auto cd = toml_number(*v);
+                const auto cd = number_of(*v);
                 if (cd && *cd > 0.0) t.test_intensity_cd = cd;
             }
         }
     }
     if (reference) {
-        if (const auto v = glare_of(*reference, reference_light)) t.glare_reference = toml_string(*v);
+        if (const auto v = glare_of(*reference, reference_light)) t.glare_reference = text_of(*v);
     }
     if (test_glare) t.glare_test = *test_glare;
     if (reference_glare) t.glare_reference = *reference_glare;
@@ -164,15 +169,18 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
     // The other overrides, as factor columns (Trial::settings).
     std::set<std::string> keys;
     for (const Frame& f : frames)
-        for (const auto& kv : f.overrides) keys.insert(kv.first);
+        for (const SceneOverride& o : f.overrides) keys.insert(o.key);
     const std::set<std::string> covered{t.level_key, "eye.adaptation_cd_m2", "tonemap.operator", "eye.glare",
                                         test_light.empty() ? std::string() : "light." + test_light + ".intensity_cd",
                                         test_light.empty() ? std::string() : "light." + test_light + ".glare",
                                         reference_light.empty() ? std::string() : "light." + reference_light + ".glare"};
     for (const std::string& key : keys) {
         if (covered.count(key)) continue;
-        const std::optional<std::string> tv = test ? test->value(key) : std::nullopt;
-        const std::optional<std::string> rv = reference ? reference->value(key) : std::nullopt;
+        // The values as written (the factor columns' text).
+        const SceneOverride* to = test ? test->value(key) : nullptr;
+        const SceneOverride* ro = reference ? reference->value(key) : nullptr;
+        const std::optional<std::string> tv = to ? std::optional<std::string>(to->value) : std::nullopt;
+        const std::optional<std::string> rv = ro ? std::optional<std::string>(ro->value) : std::nullopt;
         if (tv == rv) {
             if (tv) t.settings[key] = *tv;
             continue;

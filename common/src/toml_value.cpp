@@ -45,8 +45,39 @@ std::optional<TomlValue> TomlValue::parse(std::string_view text, std::string* er
     return TomlValue(std::move(doc));
 }
 
+std::string TomlValue::quoted(std::string_view text) {
+    return toml_quoted(text);
+}
+
 std::optional<TomlValue> TomlValue::string(std::string_view text, std::string* error, std::string_view source) {
     return parse(toml_quoted(text), error, source);
+}
+
+namespace {
+
+template <class T>
+std::shared_ptr<const toml::table> holding(T v) {
+    auto doc = std::make_shared<toml::table>();
+    doc->insert("v", std::move(v));
+    return doc;
+}
+
+}  // namespace
+
+TomlValue TomlValue::of(bool v) {
+    return TomlValue(holding(v));
+}
+
+TomlValue TomlValue::of(std::int64_t v) {
+    return TomlValue(holding(v));
+}
+
+TomlValue TomlValue::of(double v) {
+    return TomlValue(holding(v));
+}
+
+TomlValue TomlValue::of(std::string_view v) {
+    return TomlValue(holding(std::string(v)));
 }
 
 }  // namespace atonlab

@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 
+#include "atonlab/common/csv.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/display/readings_text.h"
@@ -33,13 +34,6 @@ const char* channel_name(Channel c) {
 }
 
 namespace {
-
-std::string_view trim(std::string_view s) {
-    const auto b = s.find_first_not_of(" \t\r");
-    if (b == std::string_view::npos) return {};
-    const auto e = s.find_last_not_of(" \t\r");
-    return s.substr(b, e - b + 1);
-}
 
 std::string read_text(const std::filesystem::path& path) {
     text::FileText read = text::read_text_file(path);  // only up to a limit (/dev/zero is refused)
@@ -118,26 +112,18 @@ struct CsvHeader {
     int header_line = 0;
 };
 
-/// A CSV line's comma-separated fields, trimmed, with their 1-based columns.
-std::vector<std::pair<std::string_view, int>> csv_fields(std::string_view line) {
-    std::vector<std::pair<std::string_view, int>> fields;
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t comma = line.find(',', start);
-        const std::string_view raw =
-            line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
-        const auto lead = raw.find_first_not_of(" \t");
-        const int column = static_cast<int>(start + (lead == std::string_view::npos ? 0 : lead)) + 1;
-        fields.emplace_back(trim(raw), column);
-        if (comma == std::string_view::npos) break;
-        start = comma + 1;
-    }
+/// A record's fields (common/csv.h: RFC 4180, trimmed, '#' comments), each with its 1-based column.
+using CsvFields = std::vector<std::pair<std::string, int>>;
+
+CsvFields csv_fields(const CsvRecord& rec) {
+    CsvFields fields;
+    for (const CsvField& f : rec.fields) fields.emplace_back(f.text, f.column);
     return fields;
 }
 
 /// The header (the first non-comment line, number line_no): which column holds what, and the drive scale.
-CsvHeader parse_csv_header(const std::vector<std::pair<std::string_view, int>>& fields, int line_no,
-                           const std::string& file_name, const CalibrationFileOptions& options) {
+CsvHeader parse_csv_header(const CsvFields& fields, int line_no, const std::string& file_name,
+                           const CalibrationFileOptions& options) {
     CsvHeader h;
     h.header_line = line_no;
     h.n_columns = fields.size();
@@ -201,15 +187,12 @@ CsvHeader parse_csv_header(const std::vector<std::pair<std::string_view, int>>& 
 std::vector<Measurement> parse_calibration_csv(std::string_view text, const std::string& file_name,
                                                const CalibrationFileOptions& options) {
     std::vector<Measurement> out;
-    const auto lines = split_lines(text);
     std::optional<CsvHeader> header;  // once the header line is read
-    for (std::size_t li = 0; li < lines.size(); ++li) {
-        const int line_no = static_cast<int>(li) + 1;
-        std::string_view line = lines[li];
-        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-        if (trim(line).empty()) continue;
-
-        const auto fields = csv_fields(line);
+    CsvReader reader(text, file_name, CsvOptions{.trim = true, .comments = true});
+    while (const auto rec = reader.next()) {
+        if (rec->blank()) continue;  // an empty or comment line
+        const int line_no = rec->line;
+        const CsvFields fields = csv_fields(*rec);
         if (!header) {
             header = parse_csv_header(fields, line_no, file_name, options);
             continue;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/common/csv.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_text.h"
 #include "atonlab/common/toml_value.h"
@@ -19,60 +20,23 @@ namespace atonlab::protocols::detail {
 
 namespace {
 
-std::string_view trim_blanks(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-    return s;
+/// A CSV cell as a value: the TOML value it is (a number, true / false, an
+/// array), else the text as a string (toml_value.h: the one reading of a value's text).
+TomlValue cell_value(const std::string& cell, const std::string& file) {
+    if (auto v = TomlValue::parse(cell, nullptr, file)) return *v;
+    if (auto v = TomlValue::string(cell, nullptr, file)) return *v;
+    return TomlValue::of(std::string_view(cell));
 }
 
-std::string toml_string(std::string_view text) {
-    std::string q = "\"";
-    for (const char ch : text) {
-        if (ch == '"' || ch == '\\') q += '\\';
-        q += ch;
-    }
-    return q + "\"";
+/// The cell as an override's value text ("key=VALUE", the stored form of a
+/// `set` line): the cell when it is one TOML value, else it quoted as a TOML string.
+std::string override_text(const std::string& key, const std::string& cell) {
+    return key + "=" + (TomlValue::parse(cell) ? cell : TomlValue::quoted(cell));
 }
 
-/// A CSV cell as TOML: the text itself when it is one TOML value (a number,
-/// true / false, an array), else a TOML string of it.
-std::string toml_value(const std::string& cell, bool always_string) {
-    if (!always_string && TomlValue::parse(cell)) return cell;
-    return toml_string(cell);
-}
-
-/// One CSV line split into fields (RFC 4180 quoting; a field may not span lines).
-std::optional<std::vector<std::string>> csv_fields(std::string_view line, std::string& error) {
-    std::vector<std::string> out;
-    std::string field;
-    bool quoted = false, was_quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char ch = line[i];
-        if (quoted) {
-            if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                field += '"';
-                ++i;
-            } else if (ch == '"') {
-                quoted = false;
-            } else {
-                field += ch;
-            }
-        } else if (ch == '"' && field.empty() && !was_quoted) {
-            quoted = was_quoted = true;
-        } else if (ch == ',') {
-            out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
-            field.clear();
-            was_quoted = false;
-        } else {
-            field += ch;
-        }
-    }
-    if (quoted) {
-        error = "a quoted field is not closed on its line (a field may not span lines).";
-        return std::nullopt;
-    }
-    out.push_back(was_quoted ? field : std::string(trim_blanks(field)));
-    return out;
+/// t[key] = a copy of the value's node.
+void insert_value(toml::table& t, std::string_view key, const TomlValue& v) {
+    v.node().visit([&](const auto& node) { t.insert_or_assign(key, node); });
 }
 
 /// The CSV text stored after "#@conditions_file NAME" in the protocol text, if any.
@@ -158,45 +122,35 @@ void expand_conditions_file(Document& doc, std::string_view protocol_text, toml:
                       fmt::format("cannot read the conditions file \"{}\": {}.", csv.string(), read.error));
         }
     }
-    std::vector<std::string> lines;
-    for (std::size_t at = 0; at <= read.text.size();) {
-        const std::size_t end = std::min(read.text.find('\n', at), read.text.size());
-        lines.push_back(read.text.substr(at, end - at));
-        at = end + 1;
-    }
-    if (!lines.empty() && lines.front().rfind("\xEF\xBB\xBF", 0) == 0) lines.front().erase(0, 3);
-    std::string error;
-    const auto header = csv_fields(lines.empty() ? std::string_view() : std::string_view(lines.front()), error);
-    if (!header || header->empty() || (header->size() == 1 && header->front().empty()))
-        throw InputError(SourceLocation{file, 1, 0, ""},
-                         error.empty() ? "the conditions file has no header row." : error);
-    const std::vector<Kind> kinds = column_kinds(file, *header);
-    // One TOML line per CSV line: row N of the file is line N of the text.
-    std::string toml_text = "\n";
-    std::vector<std::pair<std::string, Document::CsvRow>> rows;
+    // One reader of CSV (common/csv.h): RFC 4180, blanks around a cell trimmed.
+    CsvReader reader(read.text, file, CsvOptions{.trim = true});
+    const auto header_record = reader.next();
+    const std::vector<std::string> header = header_record ? header_record->texts() : std::vector<std::string>();
+    if (header.empty() || (header.size() == 1 && header.front().empty()))
+        throw InputError(SourceLocation{file, 1, 0, ""}, "the conditions file has no header row.");
+    const std::vector<Kind> kinds = column_kinds(file, header);
+    // Each row's condition, built as a table from its cells' values (no TOML text is made of them).
+    std::vector<std::pair<toml::table, Document::CsvRow>> rows;
     const std::string block_name = bt.get("name") && bt.get("name")->is_string()
                                        ? *bt.get("name")->value<std::string>()
                                        : fmt::format("block{}", bi);
-    for (std::size_t li = 1; li < lines.size(); ++li) {
-        const int line = static_cast<int>(li) + 1;
-        if (trim_blanks(lines[li]).empty()) {
-            toml_text += "\n";
-            continue;
-        }
-        const auto cells = csv_fields(lines[li], error);
-        if (!cells) throw InputError(SourceLocation{file, line, 0, ""}, error);
-        if (cells->size() != header->size())
-            throw InputError(SourceLocation{file, line, 0, ""},
-                fmt::format("the row has {} fields where the header has {}.", cells->size(), header->size()));
+    while (const auto record = reader.next()) {
+        if (record->blank()) continue;
+        const int line = record->line;
+        const std::vector<CsvField>& cells = record->fields;
+        if (cells.size() != header.size())
+            throw InputError(
+                SourceLocation{file, line, 0, ""},
+                fmt::format("the row has {} fields where the header has {}.", cells.size(), header.size()));
         Document::CsvRow row;
         row.file = file;
         row.line = line;
-        std::string fields, procedure;
-        std::vector<std::string> set, test_set, reference_set;
+        toml::table condition, procedure;
+        toml::array set, test_set, reference_set;
         bool take = true;
-        for (std::size_t c = 0; c < cells->size(); ++c) {
-            const std::string& cell = (*cells)[c];
-            const std::string& h = (*header)[c];
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            const std::string& cell = cells[c].text;
+            const std::string& h = header[c];
             const int col = static_cast<int>(c) + 1;
             if (cell.empty()) continue;  // not given for this row
             row.columns.emplace_back(h, col);
@@ -206,53 +160,34 @@ void expand_conditions_file(Document& doc, std::string_view protocol_text, toml:
                     break;
                 case Kind::name:
                 case Kind::string_key:
-                    fields += fmt::format("{} = {}, ", h, toml_string(cell));
+                    condition.insert_or_assign(h, cell);
                     break;
                 case Kind::other_key:
-                    fields += fmt::format("{} = {}, ", h, toml_value(cell, false));
+                    insert_value(condition, h, cell_value(cell, file));
                     break;
                 case Kind::procedure:
-                    procedure += fmt::format("{}{} = {}", procedure.empty() ? "" : ", ", h.substr(10),
-                                             toml_value(cell, false));
+                    insert_value(procedure, std::string_view(h).substr(10), cell_value(cell, file));
                     break;
                 case Kind::set:
-                    set.push_back(toml_string(h + "=" + toml_value(cell, false)));
+                    set.push_back(override_text(h, cell));
                     row.set.push_back(col);
                     break;
                 case Kind::test_set:
-                    test_set.push_back(toml_string(h.substr(5) + "=" + toml_value(cell, false)));
+                    test_set.push_back(override_text(h.substr(5), cell));
                     row.test_set.push_back(col);
                     break;
                 case Kind::reference_set:
-                    reference_set.push_back(toml_string(h.substr(10) + "=" + toml_value(cell, false)));
+                    reference_set.push_back(override_text(h.substr(10), cell));
                     row.reference_set.push_back(col);
                     break;
             }
         }
-        if (!take) {
-            toml_text += "\n";
-            continue;
-        }
-        auto list = [](const std::vector<std::string>& v) {
-            std::string out = "[";
-            for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + v[i];
-            return out + "]";
-        };
-        if (!set.empty()) fields += "set = " + list(set) + ", ";
-        if (!test_set.empty()) fields += "test_set = " + list(test_set) + ", ";
-        if (!reference_set.empty()) fields += "reference_set = " + list(reference_set) + ", ";
-        if (!procedure.empty()) fields += "procedure = { " + procedure + " }, ";
-        if (fields.size() >= 2) fields.resize(fields.size() - 2);
-        const std::string row_key = fmt::format("row{}", line);
-        toml_text += fmt::format("{} = {{ {} }}\n", row_key, fields);
-        rows.emplace_back(row_key, std::move(row));
-    }
-    toml::table parsed;
-    try {
-        parsed = toml::parse(toml_text, file);
-    } catch (const toml::parse_error& e) {
-        throw InputError(SourceLocation{file, static_cast<int>(e.source().begin.line), 0, ""},
-            fmt::format("a cell is not a TOML value: {}.", strip_period(std::string(e.description()))));
+        if (!take) continue;
+        if (!set.empty()) condition.insert_or_assign("set", std::move(set));
+        if (!test_set.empty()) condition.insert_or_assign("test_set", std::move(test_set));
+        if (!reference_set.empty()) condition.insert_or_assign("reference_set", std::move(reference_set));
+        if (!procedure.empty()) condition.insert_or_assign("procedure", std::move(procedure));
+        rows.emplace_back(std::move(condition), std::move(row));
     }
     if (rows.empty())
         doc.fail(&f, key,
@@ -266,11 +201,9 @@ void expand_conditions_file(Document& doc, std::string_view protocol_text, toml:
     if (!conds->is_array_of_tables() && !(conds->is_array() && conds->as_array()->empty()))
         return;  // reported where the block's conditions are read
     toml::array& carr = *conds->as_array();
-    for (auto& [row_key, row] : rows) {
-        toml::node* t = parsed.get(row_key);
-        if (t == nullptr || !t->is_table()) continue;
+    for (auto& [condition, row] : rows) {
         doc.add_csv_row(fmt::format("block[{}].condition[{}]", bi, carr.size()), std::move(row));
-        carr.push_back(std::move(*t->as_table()));
+        carr.push_back(std::move(condition));
     }
 }
 

@@ -6,17 +6,12 @@
 #include <algorithm>
 #include <cstdlib>
 
+#include "atonlab/common/scene_override.h"
 #include "atonlab/common/toml_text.h"
 
 namespace atonlab::protocols::detail {
 
 namespace {
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-    return s;
-}
 
 /// A dotted scene key: at least two non-empty parts, no spaces or '='.
 bool is_scene_key(std::string_view k) {
@@ -84,8 +79,9 @@ std::string Document::scene_key(const toml::node* n, const std::string& key, con
 
 Override Document::scene_override(const toml::node* n, const std::string& key, const std::string& context) const {
     const std::string text = string(n, key, context);
-    const auto eq = text.find('=');
-    if (eq == std::string::npos)
+    // The one reader of "key=value" (common/scene_override.h).
+    const std::optional<KeyValue> kv = read_key_value(text);
+    if (!kv)
         fail(n, key,
              context + fmt::format("expected \"section.key=value\" with a TOML value, e.g. 'eye.glare=\"none\"', "
                                    "got \"{}\".",
@@ -96,8 +92,7 @@ Override Document::scene_override(const toml::node* n, const std::string& key, c
     std::string no_message;
     relocate(origin, no_message);
     // The value is parsed here, once (SceneOverride's constructor).
-    Override o(std::string(trim(std::string_view(text).substr(0, eq))),
-               std::string(trim(std::string_view(text).substr(eq + 1))), std::move(origin));
+    Override o(kv->key, kv->text, std::move(origin));
     if (!is_scene_key(o.key))
         fail(n, key,
              context + fmt::format("\"{}\" is not a scene key: write section.key as in the scene file, e.g. "

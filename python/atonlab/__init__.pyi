@@ -69,9 +69,10 @@ def tonemap(hdr: npt.ArrayLike, *, operator: Optional[str] = None, adaptation_cd
 
 def glare(hdr: npt.ArrayLike, deg_per_px: float, *, model: Optional[str] = None,
           adaptation_cd_m2: Optional[float] = None, pupil_mm: Optional[float] = None,
-          radius_deg: Optional[float] = None, bloom_sigma_deg: Optional[float] = None, window: Optional[str] = None,
-          psf_size: Optional[int] = None, scene: Optional[str] = None) -> npt.NDArray[np.float32]:
-    """H×W×3 cd/m² with a glare model's glare added, as `atonlab glare`."""
+          radius_deg: Optional[float] = None, window: Optional[str] = None,
+          psf_size: Optional[int] = None, scene: Optional[str] = None,
+          **settings: Union[bool, int, float, str]) -> npt.NDArray[np.float32]:
+    """H×W×3 cd/m² with a glare model's glare added, as `atonlab glare`; settings: the models' own (bloom_sigma_deg=…)."""
 
 def psf(*, pupil_mm: Optional[float] = None, adaptation_cd_m2: Optional[float] = None,
         eye_preset: Optional[str] = None, clear: bool = False, spd: str = "d65", size: int = 512, samples: int = 30,

@@ -7,12 +7,15 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/common/toml_value.h"
+#include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/image_io.h"
 #include "bindings.h"
 #include "psf_command.h"
@@ -81,11 +84,30 @@ py::array tonemap(const py::array& hdr, const std::optional<std::string>& tone_o
     return out;
 }
 
+/// glare()'s docstring: its models and their settings from the registry (glare_models/glare_model.h).
+std::string glare_docstring() {
+    std::string models, keys;
+    for (const stimuli::GlareModelType* m : stimuli::glare_models()) {
+        if (!m->on_images()) continue;
+        models += fmt::format("{}{}", models.empty() ? "" : ", ", m->name());
+        for (const stimuli::GlareSetting& s : m->settings())
+            keys += fmt::format("\n  {} ({}, {}; default {}): {}", s.key, m->name(), s.unit, s.default_text, s.doc);
+    }
+    return fmt::format(
+        "Adds the eye's glare to an H×W×3 (or ×4) scene-referred array (cd/m²) as `atonlab glare` does: the image "
+        "convolved with a glare model's PSF, energy conserved. deg_per_px: degrees of visual angle per pixel; "
+        "model: {} (default spencer); adaptation_cd_m2 (cd/m²): the pupil (K2012 eq 3.15) and Spencer's vision "
+        "class (default: the image's log-average); pupil_mm, radius_deg, window (silverman, epanechnikov, none), "
+        "psf_size; scene: take [glare] from a scene file. Returns H×W×3 float32 cd/m². The GIL is released. Any "
+        "other keyword is a model's own setting, as the scene file's key of that name:{}",
+        models, keys);
+}
+
 py::array glare(const py::array& hdr, double deg_per_px, const std::optional<std::string>& model,
                 const std::optional<double>& adaptation_cd_m2, const std::optional<double>& pupil_mm,
-                const std::optional<double>& radius_deg, const std::optional<double>& bloom_sigma_deg,
-                const std::optional<std::string>& window, const std::optional<int>& psf_size,
-                const std::optional<std::string>& scene) {
+                const std::optional<double>& radius_deg, const std::optional<std::string>& window,
+                const std::optional<int>& psf_size, const std::optional<std::string>& scene,
+                const py::kwargs& settings) {
     runner::GlareImageOptions o;
     o.input = "hdr";
     o.scene = scene.value_or("");
@@ -94,7 +116,20 @@ py::array glare(const py::array& hdr, double deg_per_px, const std::optional<std
     o.adaptation_cd_m2 = adaptation_cd_m2;
     o.pupil_mm = pupil_mm;
     o.radius_deg = radius_deg;
-    o.bloom_sigma_deg = bloom_sigma_deg;
+    // Each other keyword is a model's own setting (bloom_sigma_deg=0.1), as its model declares it.
+    for (const auto& [k, v] : settings) {
+        const std::string key = py::str(k);
+        if (py::isinstance<py::bool_>(v))
+            o.settings.insert_or_assign(key, TomlValue::of(v.cast<bool>()));
+        else if (py::isinstance<py::int_>(v))
+            o.settings.insert_or_assign(key, TomlValue::of(v.cast<std::int64_t>()));
+        else if (py::isinstance<py::float_>(v))
+            o.settings.insert_or_assign(key, TomlValue::of(v.cast<double>()));
+        else if (py::isinstance<py::str>(v))
+            o.settings.insert_or_assign(key, TomlValue::of(v.cast<std::string>()));
+        else
+            throw py::type_error(fmt::format("glare(): {} takes a bool, a number or a string", key));
+    }
     o.window = window;
     o.psf_size = psf_size;
     stimuli::ExrImage in;
@@ -359,16 +394,11 @@ void bind_images(py::module_& m) {
           "(default) or pq, with peak_cd_m2 (100) and black_cd_m2 (0.1); dither, blueshift: bools; "
           "hue_preservation: none, xyY, rgb; key, reinhard_white (a number or \"max\"): reinhard; white_cd_m2: "
           "linear and clamp; scene: take [display] and [tonemap] from a scene file. The GIL is released.");
+    static const std::string glare_doc = glare_docstring();
     m.def("glare", &glare, py::arg("hdr"), py::arg("deg_per_px"), py::kw_only(), py::arg("model") = py::none(),
           py::arg("adaptation_cd_m2") = py::none(), py::arg("pupil_mm") = py::none(),
-          py::arg("radius_deg") = py::none(), py::arg("bloom_sigma_deg") = py::none(), py::arg("window") = py::none(),
-          py::arg("psf_size") = py::none(), py::arg("scene") = py::none(),
-          "Adds the eye's glare to an H×W×3 (or ×4) scene-referred array (cd/m²) as `atonlab glare` does: the image "
-          "convolved with a glare model's PSF, energy conserved. deg_per_px: degrees of visual angle per pixel; "
-          "model: wave-optics, gaussian-bloom, spencer (default) or cie; adaptation_cd_m2 (cd/m²): the pupil "
-          "(K2012 eq 3.15) and Spencer's vision class (default: the image's log-average); pupil_mm, radius_deg, "
-          "bloom_sigma_deg, window (silverman, epanechnikov, none), psf_size; scene: take [glare] from a scene "
-          "file. Returns H×W×3 float32 cd/m². The GIL is released.");
+          py::arg("radius_deg") = py::none(), py::arg("window") = py::none(), py::arg("psf_size") = py::none(),
+          py::arg("scene") = py::none(), glare_doc.c_str());
     m.def("read_exr", &read_exr, py::arg("path"),
           "Reads an EXR: (H×W×3 float32 array, metadata dict) with the header's units, degreesPerPixel, "
           "adaptationLuminance (cd/m²) and string attributes, as atonlab writes them.");

@@ -16,6 +16,7 @@
 
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/read_file.h"
+#include "atonlab/common/scene_override.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -34,21 +35,22 @@ namespace {
 
 /// `--set display.KEY=VALUE`: the protocol's [display] for this check.
 void apply_display_set(p::Display& display, const std::string& set) {
-    const SourceLocation where = SourceLocation::command_line("--set", set);
-    const auto eq = set.find('=');
-    if (eq == std::string::npos)
-        throw InputError(where, "a --set is KEY=VALUE, e.g. display.width_px=3840.");
-    const std::string key = set.substr(0, eq);
-    const std::string value = set.substr(eq + 1);
+    // The one reader of "key=value" (common/scene_override.h): the value typed once.
+    if (set.find('=') == std::string::npos)
+        throw InputError(SourceLocation::command_line("--set", set),
+                         "a --set is KEY=VALUE, e.g. display.width_px=3840.");
+    const SceneOverride o = SceneOverride::parse(set);
+    const std::string& key = o.key;
+    const std::string& value = o.value;
     if (key != "display.width_px" && key != "display.height_px" && key != "display.width_m" &&
         key != "display.viewing_distance_m")
         throw InputError(SourceLocation::command_line("--set", key),
                          "check sets only the display: display.width_px, display.height_px, display.width_m or "
                          "display.viewing_distance_m.");
     display.lines.erase(key.substr(std::string_view("display.").size()));  // its errors name --set, not the file
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-    if (ec != std::errc() || end != value.data() + value.size() || !std::isfinite(v) || !(v > 0))
+    const toml::node* n = o.typed() ? &o.typed()->node() : nullptr;
+    const double v = n && (n->is_integer() || n->is_floating_point()) ? *n->value<double>() : 0.0;
+    if (!std::isfinite(v) || !(v > 0))
         throw InputError(SourceLocation::command_line("--set", key),
                          fmt::format("\"{}\" is not a positive number.", text::echo(value)));
     const bool whole = v == std::floor(v) && v <= 65536;

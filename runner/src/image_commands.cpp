@@ -23,6 +23,7 @@
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/glare_kernel.h"
+#include "atonlab/stimuli/glare_models/glare_setting.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/image_glare.h"
 #include "atonlab/stimuli/image_io.h"
@@ -296,11 +297,31 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     cmd->add_option("--radius-deg", o.radius_deg,
                     fmt::format("The kernel's radius (degrees; default per model, {} {})", name(stimuli::GlareModel::cie),
                                 stimuli::glare_model_type(stimuli::GlareModel::cie).default_radius_deg({}, 0.0)));
-    cmd->add_option("--bloom-sigma-deg", o.bloom_sigma_deg,
-                    name(stimuli::GlareModel::gaussian_bloom) + ": the standard deviation (degrees)");
     cmd->add_option("--window", o.window, "The kernel's radial window: silverman (default), epanechnikov or none");
     cmd->add_option("--psf-size", o.psf_size,
                     name(stimuli::GlareModel::wave_optics) + ": the PSF size N (a power of two; default 512)");
+    // Each model's own settings, as the model declares them (glare_models/glare_setting.h):
+    // --bloom-sigma-deg for bloom_sigma_deg, read and checked as the scene file's key.
+    for (const stimuli::GlareModelType* m : stimuli::glare_models()) {
+        if (!m->on_images()) continue;
+        for (const stimuli::GlareSetting& s : m->settings()) {
+            const std::string key(s.key);
+            cmd->add_option_function<std::string>(
+                   stimuli::glare_setting_option(key),
+                   [&o, key](const std::string& text) {
+                       // The one reading of an option's text as a value (toml_value.h): TOML, else a string.
+                       auto v = TomlValue::parse(text);
+                       if (!v) v = TomlValue::string(text);
+                       if (!v)
+                           throw InputError(option(stimuli::glare_setting_option(key).c_str()),
+                                            fmt::format("'{}' is not a value", text));
+                       o.settings.insert_or_assign(key, *v);
+                   },
+                   fmt::format("{}: {} ({}; default {}, e.g. {})", m->name(), s.doc, s.unit, s.default_text,
+                               s.example))
+                ->type_name(std::string(s.type));
+        }
+    }
 }
 
 ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli::ExrImage()>& read_input) {
@@ -324,7 +345,6 @@ ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli:
                                                         stimuli::glare_model_name(gs.model)));
     if (o.pupil_mm) gs.pupil_mm = positive(o.pupil_mm, "--pupil-mm", "the pupil diameter");
     if (o.radius_deg) gs.radius_deg = positive(o.radius_deg, "--radius-deg", "the radius");
-    if (o.bloom_sigma_deg) gs.bloom_sigma_deg = positive(o.bloom_sigma_deg, "--bloom-sigma-deg", "the sigma");
     if (o.window) {
         try {
             gs.window = stimuli::glare_window_from_name(*o.window);
@@ -348,12 +368,15 @@ ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli:
 
     stimuli::GlareKernel kernel;
     try {
+        stimuli::apply_glare_settings(o.settings, gs,
+                                      gs.pupil_mm.value_or(stimuli::pupil_diameter_mm_from_adaptation(adaptation)));
         kernel = stimuli::image_glare_kernel(gs, adaptation, dpp);
     } catch (const InputError& e) {
         // The library names the scene key; on the command line it is an option.
         const std::string key = e.where() ? e.where()->key : std::string();
+        // A model's own setting: its option (glare_setting_option).
+        if (o.settings.contains(key)) throw InputError(option(stimuli::glare_setting_option(key).c_str()), e.message());
         const char* name = key == "radius_deg"                                        ? "--radius-deg"
-                           : key == "bloom_sigma_deg"                                 ? "--bloom-sigma-deg"
                            : key == "size" || key == "psf_size"                       ? "--psf-size"
                            : key == "pixels_per_degree" || key == "degrees_per_pixel" ? "--deg-per-px"
                            : !o.scene.empty()                                         ? o.scene.c_str()

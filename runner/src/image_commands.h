@@ -4,10 +4,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "atonlab/common/toml_value.h"
 #include "atonlab/stimuli/image_io.h"
 
 namespace CLI {
@@ -65,7 +67,9 @@ struct GlareImageOptions {
     std::optional<double> adaptation_cd_m2;
     std::optional<double> pupil_mm;
     std::optional<double> radius_deg;
-    std::optional<double> bloom_sigma_deg;
+    /// The models' own settings by key (--bloom-sigma-deg for bloom_sigma_deg;
+    /// each model declares them, glare_models/glare_setting.h).
+    std::map<std::string, TomlValue, std::less<>> settings;
     std::optional<std::string> window;
     std::optional<int> psf_size;
 };

@@ -312,10 +312,10 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
     const ComputePlacement where = veil_placement(scene, P.width_px, P.height_px);
     veil_report.placement = where;
     veil_report.applied = true;
-    veil_report.observer = scene.glare.cie;
+    veil_report.observer = cie_observer(scene.glare);
     if (where == ComputePlacement::gpu) {
         veil_report.outside_frame =
-            gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure, P.focal_px, scene.glare.cie);
+            gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure, P.focal_px, cie_observer(scene.glare));
         // The veil's passes took storage bindings 0-7 and texture unit 0: give
         // the frame's back (the LDR path draws its billboards after the veil,
         // reading `draws` at binding 3).
@@ -327,7 +327,7 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
     // Into buffers kept from frame to frame (Texture2D::download_floats).
     std::vector<float>& light = veil_light;
     glare_only.download_floats(light);
-    veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, scene.glare.cie);
+    veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, cie_observer(scene.glare));
     if (ldr) {
         glare_only.upload(light.data());
     } else {

@@ -62,13 +62,6 @@ double cached_pupil_mm(double pupil_mm, double tolerance_mm) {
     return std::max(1.0, std::round(pupil_mm / tolerance_mm)) * tolerance_mm;
 }
 
-SpencerVision spencer_vision_for(const Scene& scene) {
-    if (scene.glare.spencer_vision) return *scene.glare.spencer_vision;
-    if (scene.adaptation_cd_m2 >= 3.0) return SpencerVision::photopic;
-    if (scene.adaptation_cd_m2 <= 0.001) return SpencerVision::scotopic;
-    return SpencerVision::mesopic;
-}
-
 double glare_billboard_radius_deg(const GlareSettings& glare) {
     if (glare_path(glare.model) != GlarePath::billboard) return 0.0;  // none; cie: the whole frame
     return default_glare_radius_deg(glare, glare_psf_degrees_per_texel(glare));
@@ -324,20 +317,6 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
         return cached_pupil_mm(glare_model_type(model).kernel_pupil_mm(gs, pupil, time_s),
                                gs.pupil_tolerance_mm.value_or(0.0));
     };
-    const EyeModel& e = gs.eye;
-    std::string common;
-    auto add = [&common](const auto&... values) { ((common += fmt::format("{}|", values)), ...); };
-    add(gs.psf_size, gs.spectral_samples, spectral_path_name(gs.spectral_path), gs.spectral_anchors,
-        glare_window_name(gs.window), gs.radius_deg.value_or(-1), gs.bloom_sigma_deg);
-    add(gs.aperture_image, gs.aperture_width_mm, gs.aperture_with_pupil, ppd);
-    add(e.hippus.enabled, e.hippus.amplitude, e.hippus.max_pupil_mm);
-    add(e.gratings.enabled, e.gratings.count, e.gratings.inner_radius_mm, e.gratings.width_um, e.gratings.opacity,
-        e.gratings.angle_jitter);
-    for (const Particles* p : {&e.lens_particles, &e.vitreous_particles})
-        add(p->enabled, p->count, p->diameter_um, p->diameter_spread, p->opacity, p->spread_radius_mm);
-    add(e.eyelashes.enabled, e.eyelashes.count, e.eyelashes.width_um, e.eyelashes.reach_mm, e.eyelashes.max_tilt_deg);
-    add(e.eyelid.enabled, e.eyelid.edge_mm, e.defocus_diopters, static_cast<int>(e.scale), e.plane_width_mm,
-        e.halo_radius_deg.value_or(-1), e.seed, e.supersampling);
 
     // The largest projected radius each group needs (lights in front whose glare can reach the image).
     std::vector<double> need(m.order.size(), 0.0);
@@ -360,9 +339,9 @@ double GlareStage::prepare(const Scene& scene, const CameraProjection& P, double
         const double pupil_now = pupil_for(g.model);
         // What of the scene the model's kernel reads (Spencer's vision class; the
         // wave-optics eye's kernel does not change where the adaptation crosses
-        // 0.001 cd/m², so a dusk-to-night sweep keeps its cached kernels).
-        const std::string key = fmt::format("{}|{}|{}|{}", glare_model_name(g.model), common, g.spd,
-                                            glare_model_type(g.model).kernel_scene_key(scene));
+        // 0.001 cd/m², so a dusk-to-night sweep keeps its cached kernels), and
+        // every setting the model declares (glare_kernel_key).
+        const std::string key = glare_kernel_key(scene, g.model, g.spd);
         m.update_kernel(g, scene, ppd, time_s, pupil_now, key);
         // Layers only where a light covers more than a pixel; radius rounded up
         // to a power of two so a light approaching does not rebuild every frame.

@@ -126,27 +126,20 @@ std::pair<toml::table*, std::string> element_for_override(const Document& doc, t
     if (node == nullptr || !node->is_array() || node->as_array()->empty())
         override_error(o, fmt::format("the scene has no [[{}]] tables to override.", array));
     toml::array& elements = *node->as_array();
-    const std::string& k = o.key;
-    const auto last_dot = k.rfind('.');
-    if (last_dot == std::string::npos || last_dot == k.size() - 1) override_error(o, written);
-    key = k.substr(last_dot + 1);
+    // The addressing is common/'s (element_address), which the analysis reads trials' lights with too.
+    const std::optional<ElementAddress> address = element_address(o.key, array);
+    if (!address) override_error(o, written);
+    key = address->key;
 
     std::size_t index = 0;
-    const std::size_t skip = array.size() + 1;  // "light[" or "light."
-    if (k.starts_with(array + "[")) {
-        const auto close = k.find(']');
-        const std::string digits = k.substr(skip, close == std::string::npos ? 0 : close - skip);
-        if (close == std::string::npos || close + 1 != last_dot || digits.empty() ||
-            !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
-            digits.size() > 6)
-            override_error(o, written);
-        index = static_cast<std::size_t>(std::stoul(digits));
+    if (address->index) {
+        index = *address->index;
         if (index >= elements.size())
             override_error(o, fmt::format("there is no {0}[{1}]: the scene has {2} {0}{3} ({0}[0] to {0}[{4}]).",
                                               array, index, elements.size(), elements.size() == 1 ? "" : "s",
                                               elements.size() - 1));
     } else {
-        const std::string name = k.substr(skip, last_dot - skip);
+        const std::string& name = address->name;
         std::vector<std::string> known;
         bool found = false;
         for (std::size_t i = 0; i < elements.size(); ++i) {

@@ -93,23 +93,24 @@ Environment read_environment(const Document& doc, const Section& root) {
 
 namespace {
 
-std::vector<std::string_view> with_models_keys(KeyList own,
-                                               std::span<const std::string_view> (GlareModelType::*keys)() const) {
+// A table's own keys and the settings the models declare in it (glare_setting.h).
+std::vector<std::string_view> with_models_keys(KeyList own, GlareTable table) {
     std::vector<std::string_view> all(own.begin(), own.end());
     for (const GlareModelType* m : glare_models())
-        for (std::string_view k : (m->*keys)()) all.push_back(k);
+        for (const GlareSetting& s : m->settings())
+            if (s.table == table) all.push_back(s.key);
     return all;
 }
 
 }  // namespace
 
 KeyList eye_keys() {
-    static const std::vector<std::string_view> keys = with_models_keys(kEyeOwnKeys, &GlareModelType::eye_keys);
+    static const std::vector<std::string_view> keys = with_models_keys(kEyeOwnKeys, GlareTable::eye);
     return keys;
 }
 
 KeyList glare_keys() {
-    static const std::vector<std::string_view> keys = with_models_keys(kSharedGlareKeys, &GlareModelType::glare_keys);
+    static const std::vector<std::string_view> keys = with_models_keys(kSharedGlareKeys, GlareTable::glare);
     return keys;
 }
 

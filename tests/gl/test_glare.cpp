@@ -106,7 +106,7 @@ Scene black_scene(GlareModel model) {
     s.glare.eye = small_eye();
     s.glare.psf_size = 256;
     s.glare.pupil_mm = 6.0;
-    s.glare.bloom_sigma_deg = 0.2;
+    s.glare.values["bloom_sigma_deg"] = 0.2;
     s.glare.radius_deg = 1.0;
     return s;
 }
@@ -454,7 +454,7 @@ TEST_F(GlareFrames, ApertureImageGivesItsDiffractionPattern) {
     std::filesystem::create_directories(dir);
     write_png_rgb8(dir / "bar.png", w, w, rgb);
     Scene scene = black_scene(GlareModel::aperture);
-    scene.glare.aperture_image = (dir / "bar.png").string();
+    scene.glare.values["aperture_image"] = (dir / "bar.png").string();
     scene.lights = {light_at({0.0, 0.0, -500.0})};
     EXPECT_NEAR(energy(scene) / (100.0 / 250000.0), 1.0, 0.01);
     ASSERT_NE(renderer->glare().psf(0), nullptr);
@@ -466,7 +466,7 @@ TEST_F(GlareFrames, ApertureImageGivesItsDiffractionPattern) {
         along_y += p.at(p.n / 2, p.n / 2 + k).g;
     }
     EXPECT_GT(along_y, 2 * along_x);
-    scene.glare.aperture_image = (dir / "missing.png").string();
+    scene.glare.values["aperture_image"] = (dir / "missing.png").string();
     EXPECT_NE(input_error_of([&] { renderer->render(scene, 0.0); }).find("aperture_image"), std::string::npos);
 }
 

@@ -46,7 +46,7 @@ Scene grid_scene(GlareModel model) {
     s.adaptation_cd_m2 = 0.01;
     s.output.encode.dither = Dither::none;
     s.glare.model = model;
-    s.glare.bloom_sigma_deg = 0.3;
+    s.glare.values["bloom_sigma_deg"] = 0.3;
     s.glare.radius_deg = 1.0;
     s.glare.psf_size = 128;
     s.glare.pupil_mm = 5.0;

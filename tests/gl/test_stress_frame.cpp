@@ -244,7 +244,7 @@ TEST_F(StressGlare, ExtremeLightsWithEveryCheapModelAndPupil) {
             scene.glare.eye.halo_radius_deg.reset();
             scene.glare.eye.defocus_diopters = 0.5;
             scene.glare.radius_deg = 0.5;
-            scene.glare.bloom_sigma_deg = 0.1;
+            scene.glare.values["bloom_sigma_deg"] = 0.1;
             const glm::dvec3 c = scene.camera.position_m;
             scene.lights = {light_at(c, 1e7, 0.1),                          // at the camera
                             light_at(c - forward(scene) * 10.0, 1e7, 0.1),  // behind
@@ -286,7 +286,7 @@ TEST_F(StressHalfFloatTarget, ExtremeLightsNeverOverflowTheRgba16fTarget) {
             scene.adaptation_cd_m2 = adaptation;
             scene.glare.model = model;
             scene.glare.radius_deg = 0.5;
-            scene.glare.bloom_sigma_deg = 0.1;
+            scene.glare.values["bloom_sigma_deg"] = 0.1;
             const glm::dvec3 c = scene.camera.position_m;
             for (int k = 0; k < 4; ++k)
                 scene.lights.push_back(light_at(c + forward(scene) * 0.1 + right(scene) * (1e-5 * k), 1e7, 1e-3));

@@ -207,7 +207,7 @@ Scene night_scene(ComputePlacement placement) {
     s.environment.luminance_cd_m2 = 0.001;  // a night sky
     s.adaptation_cd_m2 = 0.01;
     s.glare.model = GlareModel::cie;
-    s.glare.cie = {40, 0.5};
+    s.glare.values["cie_age_years"] = 40.0;
     s.glare.placement = placement;
     Light red, green;
     red.position_m = {-40.0, 2.0, -1000.0};
@@ -272,7 +272,7 @@ TEST_F(VeilGpu, TheLdrPathWithABloomLightDrawnAfterTheVeilIsTheSameFrameOnTheGpu
         Scene s = night_scene(placement);
         s.output.ldr_glare = true;
         s.lights[1].glare = GlareModel::gaussian_bloom;  // the green light: a billboard
-        s.glare.bloom_sigma_deg = 0.3;
+        s.glare.values["bloom_sigma_deg"] = 0.3;
         return s;
     };
     FrameRenderer gpu_renderer, cpu_renderer;

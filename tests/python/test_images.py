@@ -58,6 +58,9 @@ def test_tonemap_equals_the_command_line(exr, tmp_path, settings):
     {},
     {"model": "gaussian-bloom", "bloom_sigma_deg": 0.1},
     {"model": "spencer", "adaptation_cd_m2": 0.03, "window": "none", "radius_deg": 0.5},
+    # Models' own settings, from their declarations: a keyword here, an option there.
+    {"model": "spencer", "spencer_vision": "photopic"},
+    {"model": "cie", "cie_age_years": 60},
 ])
 def test_glare_equals_the_command_line(exr, tmp_path, settings):
     out = atonlab.glare(hdr_image(), DEG_PER_PX, **settings)
@@ -70,6 +73,21 @@ def test_glare_equals_the_command_line(exr, tmp_path, settings):
     assert out.shape == (60, 90, 3) and out.dtype == np.float32
     assert np.array_equal(out, ref)
     assert not out.flags.owndata and out.base is not None  # the library's buffer, not copied
+
+
+def test_glare_takes_and_documents_each_models_declared_settings():
+    # The docstring lists the settings from the models' declarations (glare_models/glare_setting.h).
+    for key in ("bloom_sigma_deg", "spencer_vision", "cie_age_years", "eye_preset"):
+        assert key in atonlab.glare.__doc__
+    # A setting is checked as the scene file checks it, and a key no model declares is refused.
+    with pytest.raises(Exception, match="bloom_sigma_deg must be greater than 0"):
+        atonlab.glare(hdr_image(), DEG_PER_PX, model="gaussian-bloom", bloom_sigma_deg=-1.0)
+    with pytest.raises(Exception, match="no glare model has a setting 'bloom_sigma'"):
+        atonlab.glare(hdr_image(), DEG_PER_PX, model="gaussian-bloom", bloom_sigma=0.1)
+    # Two values of a setting give two images.
+    a = atonlab.glare(hdr_image(), DEG_PER_PX, model="spencer", spencer_vision="photopic")
+    b = atonlab.glare(hdr_image(), DEG_PER_PX, model="spencer", spencer_vision="scotopic")
+    assert not np.array_equal(a, b)
 
 
 def test_glare_conserves_energy():

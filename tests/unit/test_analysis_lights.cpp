@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "../../analysis/src/csv.h"
+#include "atonlab/common/csv.h"
 #include "../store/store_test_support.h"
 #include "analysis_test_data.h"
 #include "atonlab/analysis/dataset.h"
@@ -30,7 +31,7 @@ namespace fs = std::filesystem;
 using store::test_support::file_bytes;
 using store::test_support::TempDir;
 namespace td = test_data;
-using Overrides = std::vector<std::pair<std::string, std::string>>;
+using Overrides = std::vector<SceneOverride>;  // as a trial stores them
 
 // --- The scene reader ---------------------------------------------------------
 
@@ -166,20 +167,19 @@ Analysed analyse(const TempDir& dir, const std::string& protocol, const std::str
     return a;
 }
 
-/// A CSV's column `name` as text, row by row (RFC 4180, read by analysis's own reader).
+/// A CSV's column `name` as text, row by row (RFC 4180, read by common/csv.h's reader).
 std::vector<std::string> column(const std::string& csv, const std::string& name) {
-    std::istringstream in(csv);
-    int line = 0;
-    std::string error;
-    const auto header = detail::read_csv_record(in, line, error);
-    EXPECT_TRUE(header) << error;
+    CsvReader reader(csv, "trials.csv");
+    const auto header = reader.next();
+    EXPECT_TRUE(header);
     if (!header) return {};
-    const auto at = std::find(header->fields.begin(), header->fields.end(), name);
-    EXPECT_NE(at, header->fields.end()) << "no column " << name;
-    const auto i = static_cast<std::size_t>(at - header->fields.begin());
+    const std::vector<std::string> names = header->texts();
+    const auto at = std::find(names.begin(), names.end(), name);
+    EXPECT_NE(at, names.end()) << "no column " << name;
+    const auto i = static_cast<std::size_t>(at - names.begin());
     std::vector<std::string> out;
-    while (const auto rec = detail::read_csv_record(in, line, error))
-        out.push_back(i < rec->fields.size() ? rec->fields[i] : std::string());
+    while (const auto rec = reader.next())
+        out.push_back(i < rec->fields.size() ? rec->fields[i].text : std::string());
     return out;
 }
 

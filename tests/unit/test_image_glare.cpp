@@ -114,7 +114,7 @@ TEST(ImageGlare, GaussianBloomSpreadsAPointByItsVariance) {
     // Gaussian's variance by quadrature here.
     GlareSettings g;
     g.model = GlareModel::gaussian_bloom;
-    g.bloom_sigma_deg = 0.25;
+    g.values["bloom_sigma_deg"] = 0.25;
     g.window = GlareWindow::none;
     const double dpp = 0.02;
     const GlareKernel k = image_glare_kernel(g, 1.0, dpp);

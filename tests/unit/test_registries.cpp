@@ -2,6 +2,7 @@
 // display encoding"): each one's names are unique and read back through every
 // reader, and no name is spelled in a string literal outside its registry's
 // files, so that adding one touches only the files the doc names.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -214,32 +215,35 @@ TEST(Registries, EveryGlareModelReadsBackFromASceneAndFromSet) {
     }
 }
 
-/// Whether a table row of `doc` names `key` in its first cell ("| `hippus`, `hippus_amplitude` | …").
-bool has_row(const std::string& doc, std::string_view key) {
+/// The table row of `doc` whose first cell is `key` ("| `bloom_sigma_deg` | …"); "" when none.
+std::string row_of(const std::string& doc, std::string_view key) {
     std::istringstream lines(doc);
-    for (std::string line; std::getline(lines, line);) {
-        if (!line.starts_with("| `")) continue;
-        const std::string first = line.substr(0, line.find(" |", 2));
-        if (first.find("`" + std::string(key) + "`") != std::string::npos) return true;
-    }
-    return false;
+    const std::string start = "| `" + std::string(key) + "` |";
+    for (std::string line; std::getline(lines, line);)
+        if (line.starts_with(start)) return line;
+    return {};
 }
 
-TEST(Registries, EveryGlareModelsKeysAreReadAndDocumented) {
-    // Each model's own keys are keys of the scene file (--set takes them) and rows of docs/scene-file.md.
+TEST(Registries, EveryGlareModelsSettingsAreReadAndDocumentedAsDeclared) {
+    // Each model's declared settings (glare_setting.h) are keys of the scene file (--set takes them), and
+    // docs/scene-file.md's row of each is its declaration: type, unit, default and meaning.
     const std::string doc = read_text(fs::path(ATONLAB_SOURCE_DIR) / "docs/scene-file.md");
+    std::set<std::string_view> keys;
     for (const GlareModelType* m : glare_models()) {
-        for (const auto& [table, keys] : {std::pair{"glare", m->glare_keys()}, std::pair{"eye", m->eye_keys()}})
-            for (std::string_view key : keys) {
-                EXPECT_TRUE(has_row(doc, key)) << m->name() << ": " << key << " has no row in docs/scene-file.md";
-                try {
-                    // A key the reader does not know is refused as unknown; a known one may only be refused for its value.
-                    (void)parse_scene(kScene, "registry.toml",
-                                      {atonlab::SceneOverride::parse(std::string(table) + "." + std::string(key) + "=1")});
-                } catch (const atonlab::InputError& e) {
-                    EXPECT_EQ(std::string(e.what()).find("unknown key"), std::string::npos) << m->name() << ": " << e.what();
-                }
+        for (const GlareSetting& s : m->settings()) {
+            EXPECT_TRUE(keys.insert(s.key).second) << s.key << " is declared twice";
+            const std::string row = fmt::format("| `{}` | {} | {} | {} | {} |", s.key, s.type, s.unit, s.default_text,
+                                                s.doc);
+            EXPECT_EQ(row_of(doc, s.key), row) << m->name() << ": docs/scene-file.md's row of " << s.key
+                                               << " is not its declaration";
+            try {
+                // A key the reader does not know is refused as unknown; a known one may only be refused for its value.
+                (void)parse_scene(kScene, "registry.toml",
+                                  {atonlab::SceneOverride::parse(fmt::format("{}.{}=1", glare_table_name(s.table), s.key))});
+            } catch (const atonlab::InputError& e) {
+                EXPECT_EQ(std::string(e.what()).find("unknown key"), std::string::npos) << m->name() << ": " << e.what();
             }
+        }
     }
     // The `glare` rows of [eye] and [[light]] name every model.
     std::istringstream lines(doc);

@@ -20,6 +20,7 @@
 #include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
+#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
 
 using atonlab::InputError;
@@ -438,7 +439,7 @@ TEST(SceneFileGlare, ModelsPupilAndTableAreRead) {
     EXPECT_EQ(scene.glare.window, GlareWindow::epanechnikov);
     EXPECT_EQ(scene.glare.psf_size, 256);
     EXPECT_EQ(scene.glare.radius_deg, 2.5);
-    EXPECT_EQ(scene.glare.spencer_vision, SpencerVision::mesopic);
+    EXPECT_EQ(spencer_vision_for(scene), SpencerVision::mesopic);
     EXPECT_EQ(scene.glare.placement, ComputePlacement::automatic);  // not given
     for (auto [name, want] : {std::pair{"gpu", ComputePlacement::gpu}, std::pair{"cpu", ComputePlacement::cpu},
                               std::pair{"automatic", ComputePlacement::automatic}})
@@ -493,14 +494,14 @@ TEST(SceneFileGlare, CieModelAndObserverAreRead) {
         std::string(kMinimal) + "[eye]\nglare = \"cie\"\ncie_age_years = 62\ncie_pigmentation = 1.0\n";
     const Scene scene = parse_scene(text, "cie.toml");
     EXPECT_EQ(scene.glare.model, GlareModel::cie);
-    EXPECT_EQ(scene.glare.cie.age_years, 62.0);
-    EXPECT_EQ(scene.glare.cie.pigmentation, 1.0);
+    EXPECT_EQ(cie_observer(scene.glare).age_years, 62.0);
+    EXPECT_EQ(cie_observer(scene.glare).pigmentation, 1.0);
     // Defaults: the CIE's 25-year-old, brown eyes (p = 0.5); and --set reaches both keys.
     const Scene plain = parse_scene(std::string(kMinimal), "cie.toml");
-    EXPECT_EQ(plain.glare.cie.age_years, 25.0);
-    EXPECT_EQ(plain.glare.cie.pigmentation, 0.5);
+    EXPECT_EQ(cie_observer(plain.glare).age_years, 25.0);
+    EXPECT_EQ(cie_observer(plain.glare).pigmentation, 0.5);
     const Scene set = parse_scene(text, "cie.toml", sets({"eye.cie_age_years=40", "eye.glare=\"cie\""}));
-    EXPECT_EQ(set.glare.cie.age_years, 40.0);
+    EXPECT_EQ(cie_observer(set.glare).age_years, 40.0);
 }
 
 TEST(SceneFileGlare, SpectralPathIsRead) {

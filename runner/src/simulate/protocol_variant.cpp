@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/common/scene_override.h"
 #include "atonlab/common/toml_value.h"
 
 namespace atonlab::runner {
@@ -28,26 +29,26 @@ std::vector<std::string> split_path(const std::string& key) {
 }  // namespace
 
 ProtocolSet parse_protocol_set(std::string_view text, std::string_view option) {
-    const std::size_t eq = text.find('=');
-    if (eq == std::string_view::npos || eq == 0)
+    // The one reader of "key=value" (common/scene_override.h).
+    const std::optional<KeyValue> kv = read_key_value(text);
+    if (!kv || kv->key.empty())
         throw InputError(SourceLocation::command_line(std::string(option), std::string(text)),
                          fmt::format("a protocol key to set is KEY=VALUE (e.g. defaults.procedure.max_trials=40), "
                                      "not \"{}\".",
                                      text));
     ProtocolSet s;
-    s.key = std::string(text.substr(0, eq));
-    s.value = std::string(text.substr(eq + 1));
+    s.key = kv->key;
+    s.value = kv->text;
     if (s.key.find('.') == std::string::npos) s.key = "defaults.procedure." + s.key;
     for (const std::string& part : split_path(s.key))
         if (part.empty())
             throw InputError(SourceLocation::command_line(std::string(option), s.key),
                              fmt::format("the key \"{}\" has an empty part.", s.key));
-    std::string error;
-    if (!TomlValue::parse(s.value, &error))
+    if (!kv->not_toml.empty())
         throw InputError(SourceLocation::command_line(std::string(option), s.key),
                          fmt::format("\"{}\" is not one TOML value ({}); a string needs quotes, e.g. "
                                      "display.name='\"lab-1\"'.",
-                                     s.value, error));
+                                     s.value, kv->not_toml));
     return s;
 }
 

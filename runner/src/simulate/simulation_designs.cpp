@@ -10,6 +10,7 @@
 #include "atonlab/common/atomic_file.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/read_file.h"
+#include "atonlab/common/scene_override.h"
 #include "atonlab/common/toml_value.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "displayability.h"
@@ -44,15 +45,15 @@ std::vector<std::vector<ProtocolSet>> combinations(const std::vector<std::string
 /// `--observer KEY=VALUE` over the protocol's [observer] table.
 void apply_observer_options(p::SimulatedObserverParams& params, const std::vector<std::string>& options) {
     for (const std::string& text : options) {
-        const std::size_t eq = text.find('=');
-        const std::string key = text.substr(0, eq);
+        // The one reader of "key=value" (common/scene_override.h).
+        const std::optional<KeyValue> kv = read_key_value(text);
+        const std::string key = kv ? kv->key : text;
         const SourceLocation where = SourceLocation::command_line("--observer", key);
-        if (eq == std::string::npos || eq == 0)
+        if (!kv || kv->key.empty())
             throw InputError(where, fmt::format("--observer takes KEY=VALUE (e.g. eta=0.2), not \"{}\".", text));
-        const std::optional<TomlValue> v = TomlValue::parse(text.substr(eq + 1));
+        const std::optional<TomlValue>& v = kv->value;
         if (!v || !(v->node().is_floating_point() || v->node().is_integer()))
-            throw InputError(where, fmt::format("the observer's {} takes a number, not \"{}\".", key,
-                                                text.substr(eq + 1)));
+            throw InputError(where, fmt::format("the observer's {} takes a number, not \"{}\".", key, kv->text));
         set_observer_key(params, key, v->node().value<double>().value_or(0.0), where);
     }
 }

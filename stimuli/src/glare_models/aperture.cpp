@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <string>
 
 #include "atonlab/common/toml_reader.h"
 #include "atonlab/display/colour.h"
@@ -22,12 +23,49 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr std::string_view kKeys[] = {"aperture_image", "aperture_width_mm", "aperture_with_pupil"};
+constexpr std::string_view kImage = "aperture_image", kWidth = "aperture_width_mm", kWithPupil = "aperture_with_pupil";
+
+const GlareSetting kSettings[] = {
+    // No default: the model is unavailable without an image (available()).
+    {.key = kImage,
+     .type = "string",
+     .unit = "path",
+     .default_text = "—",
+     .doc = "`aperture`: PNG (sRGB-decoded) or EXR; transmittance = luminance, white = clear; relative to the scene "
+            "file",
+     .example = "\"aperture.png\""},
+    {.key = kWidth,
+     .type = "number",
+     .unit = "mm",
+     .default_text = "18",
+     .doc = "`aperture`: the plane side the image spans; the PSF texel is λ0/width rad",
+     .example = "12",
+     .default_value = 18.0,
+     .check =
+         [](const GlareSettingValue& v) {
+             const double w = std::get<double>(v);
+             return w > 0
+                        ? std::string()
+                        : fmt::format("aperture_width_mm must be greater than 0, got {}.", toml_reader::number_text(w));
+         }},
+    {.key = kWithPupil,
+     .type = "bool",
+     .unit = "—",
+     .default_text = "false",
+     .doc = "`aperture`: also clip by the pupil disc",
+     .example = "true",
+     .default_value = false},
+};
+
+std::string image_of(const GlareSettings& g) {
+    const auto it = g.values.find(kImage);
+    return it == g.values.end() ? std::string() : std::get<std::string>(it->second);
+}
 
 // The obstacle image as a pupil-plane field at λ0: transmittance = the image's
 // linear luminance, resampled bilinearly over the plane (image row 0 at the top).
 ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_mm) {
-    const std::filesystem::path path = g.aperture_image;
+    const std::filesystem::path path = image_of(g);
     int w = 0, h = 0;
     std::vector<double> lum;
     try {
@@ -56,7 +94,8 @@ ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_
         throw InputError(SourceLocation{"", 0, 0, "aperture_image"},
                          fmt::format("the aperture image {} must be at least 2×2 pixels.", path.string()));
     ComplexImage<double> field(n);
-    const double texel_mm = g.aperture_width_mm / n;
+    const double texel_mm = glare_number(g, kWidth) / n;
+    const bool with_pupil = glare_flag(g, kWithPupil);
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             // Plane texel centre → image coordinates (the image spans the whole plane).
@@ -68,7 +107,7 @@ ComplexImage<double> aperture_field(const GlareSettings& g, int n, double pupil_
             auto L = [&](int x, int y) { return std::clamp(lum[static_cast<std::size_t>(y) * w + x], 0.0, 1.0); };
             double t =
                 (1 - ty) * ((1 - tx) * L(x0, y0) + tx * L(x1, y0)) + ty * ((1 - tx) * L(x0, y1) + tx * L(x1, y1));
-            if (g.aperture_with_pupil) {
+            if (with_pupil) {
                 const double x = (i + 0.5 - n / 2.0) * texel_mm, y = (j + 0.5 - n / 2.0) * texel_mm;
                 if (std::hypot(x, y) > 0.5 * pupil_mm) t = 0;
             }
@@ -83,26 +122,24 @@ public:
     std::string_view summary() const override {
         return "the FFT of an obstacle image in the pupil plane (aperture_image; Kakimoto et al. 2005)";
     }
-    std::span<const std::string_view> glare_keys() const override { return kKeys; }
+    std::span<const GlareSetting> settings() const override { return kSettings; }
     void read_glare_keys(const toml_reader::Document& doc, const toml_reader::Section& s, GlareSettings& g,
-                         double) const override {
-        if (auto img = s.string("aperture_image")) {
+                         double pupil_mm) const override {
+        GlareModelType::read_glare_keys(doc, s, g, pupil_mm);
+        if (auto it = g.values.find(kImage); it != g.values.end()) {
             // Relative to the scene file, like every path in it.
-            std::filesystem::path p(*img);
+            std::filesystem::path p(std::get<std::string>(it->second));
             if (p.is_relative() && !doc.file().empty()) p = std::filesystem::path(doc.file()).parent_path() / p;
             if (!std::filesystem::is_regular_file(p))
-                s.fail(s.get("aperture_image"), "aperture_image",
+                s.fail(s.get(kImage), std::string(kImage),
                        fmt::format("the aperture image {} does not exist or is not a file.", p.string()));
-            g.aperture_image = p.string();
+            it->second = p.string();
         }
-        g.aperture_width_mm = s.number_or("aperture_width_mm", g.aperture_width_mm);
-        s.greater_than("aperture_width_mm", g.aperture_width_mm, 0.0);
-        g.aperture_with_pupil = s.boolean("aperture_with_pupil").value_or(g.aperture_with_pupil);
     }
-    bool available(const GlareSettings& g) const override { return !g.aperture_image.empty(); }
+    bool available(const GlareSettings& g) const override { return !image_of(g).empty(); }
     /// λ0 over the aperture's width (the FFT's angular texel, K2012 eq 4.9 at λ0).
     double psf_degrees_per_texel(const GlareSettings& g) const override {
-        return kReferenceWavelengthNm * 1e-6 / g.aperture_width_mm * 180.0 / std::numbers::pi;
+        return kReferenceWavelengthNm * 1e-6 / glare_number(g, kWidth) * 180.0 / std::numbers::pi;
     }
     double default_radius_deg(const GlareSettings& g, double dpt) const override {
         return fft_glare_radius_deg(g, dpt);

@@ -3,6 +3,8 @@
 // cie_pigmentation ([eye]). Not a billboard: the frame renderer convolves the
 // direct images of its lights with the veil; `atonlab glare` convolves an
 // image with it as a radial kernel.
+#include <fmt/format.h>
+
 #include <string>
 
 #include "atonlab/common/input_error.h"
@@ -15,7 +17,41 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr std::string_view kEyeKeys[] = {"cie_age_years", "cie_pigmentation"};
+constexpr std::string_view kAge = "cie_age_years", kPigmentation = "cie_pigmentation";
+
+const GlareSetting kSettings[] = {
+    {.key = kAge,
+     .table = GlareTable::eye,
+     .type = "number",
+     .unit = "years",
+     .default_text = "25",
+     .doc = "`cie`: the observer's age A, 0 … 100",
+     .example = "60",
+     .default_value = 25.0,
+     .check =
+         [](const GlareSettingValue& v) {
+             const double a = std::get<double>(v);
+             return a >= 0 && a <= 100
+                        ? std::string()
+                        : fmt::format("cie_age_years must be between 0 and 100, got {}.", toml_reader::number_text(a));
+         }},
+    {.key = kPigmentation,
+     .table = GlareTable::eye,
+     .type = "number",
+     .unit = "—",
+     .default_text = "0.5",
+     .doc = "`cie`: ocular pigmentation p, 0 … 1.2 (0 very dark, 0.5 brown, 1.0 light blue-green, 1.2 very light "
+            "blue eyes)",
+     .example = "1",
+     .default_value = 0.5,
+     .check =
+         [](const GlareSettingValue& v) {
+             const double p = std::get<double>(v);
+             return p >= 0 && p <= 1.2 ? std::string()
+                                       : fmt::format("cie_pigmentation must be between 0 and 1.2, got {}.",
+                                                     toml_reader::number_text(p));
+         }},
+};
 constexpr double kDefaultImageRadiusDeg = 20.0;  // `atonlab glare`'s kernel (docs/tone-mapping.md)
 
 class CieVeil final : public GlareModelType {
@@ -26,21 +62,14 @@ public:
                "Berg)";
     }
     GlarePath path() const override { return GlarePath::veil; }
-    std::span<const std::string_view> eye_keys() const override { return kEyeKeys; }
+    std::span<const GlareSetting> settings() const override { return kSettings; }
     void read_eye_keys(const toml_reader::Section& s, GlareSettings& glare) const override {
-        if (auto a = s.number("cie_age_years")) {
-            s.within("cie_age_years", *a, 0.0, 100.0);
-            glare.cie.age_years = *a;
-        }
-        if (auto p = s.number("cie_pigmentation")) {
-            s.within("cie_pigmentation", *p, 0.0, 1.2);
-            glare.cie.pigmentation = *p;
-        }
+        GlareModelType::read_eye_keys(s, glare);
         try {
-            (void)cie_glare_spread(glare.cie);
+            (void)cie_glare_spread(cie_observer(glare));
         } catch (const InputError& err) {
             // Only a combination of the two can fail here: name the one the file gives (the age first).
-            const std::string key = s.get("cie_age_years") ? "cie_age_years" : "cie_pigmentation";
+            const std::string key(s.get(kAge) ? kAge : kPigmentation);
             s.fail(s.get(key), key, err.message());
         }
     }
@@ -48,13 +77,17 @@ public:
     double default_radius_deg(const GlareSettings&, double) const override { return kDefaultImageRadiusDeg; }
 
     GlareKernel image_kernel(const GlareKernelRequest& r) const override {
-        const CieGlareSpread gsf = cie_glare_spread(r.glare.cie);
+        const CieGlareSpread gsf = cie_glare_spread(cie_observer(r.glare));
         return glare_kernel_from_radial([gsf](double theta, double) { return gsf.density_sr(theta); }, r.samples,
                                         r.pixels_per_degree, default_glare_radius_deg(r.glare, 0.0), r.glare.window);
     }
 };
 
 }  // namespace
+
+CieObserver cie_observer(const GlareSettings& g) {
+    return CieObserver{glare_number(g, kAge), glare_number(g, kPigmentation)};
+}
 
 const GlareModelType& glare_model_cie() {
     static const CieVeil model;

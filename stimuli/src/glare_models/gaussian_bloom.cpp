@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <string>
 
 #include "atonlab/common/toml_reader.h"
 #include "atonlab/stimuli/error.h"
@@ -13,7 +14,23 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr std::string_view kKeys[] = {"bloom_sigma_deg"};
+constexpr std::string_view kSigma = "bloom_sigma_deg";
+
+const GlareSetting kSettings[] = {
+    {.key = kSigma,
+     .type = "number",
+     .unit = "°",
+     .default_text = "0.25",
+     .doc = "`gaussian-bloom`: standard deviation",
+     .example = "0.5",
+     .default_value = 0.25,
+     .check =
+         [](const GlareSettingValue& v) {
+             const double s = std::get<double>(v);
+             return s > 0 ? std::string()
+                          : fmt::format("bloom_sigma_deg must be greater than 0, got {}.", toml_reader::number_text(s));
+         }},
+};
 
 class GaussianBloom final : public GlareModelType {
 public:
@@ -21,15 +38,10 @@ public:
     std::string_view summary() const override {
         return "a monochromatic Gaussian blur of standard deviation bloom_sigma_deg (K2012 §3.4.1)";
     }
-    std::span<const std::string_view> glare_keys() const override { return kKeys; }
-    void read_glare_keys(const toml_reader::Document&, const toml_reader::Section& s, GlareSettings& g,
-                         double) const override {
-        g.bloom_sigma_deg = s.number_or("bloom_sigma_deg", g.bloom_sigma_deg);
-        s.greater_than("bloom_sigma_deg", g.bloom_sigma_deg, 0.0);
-    }
+    std::span<const GlareSetting> settings() const override { return kSettings; }
     bool on_images() const override { return true; }
     /// 4σ: the Gaussian's tail beyond holds 3e-4 of its energy (restored by the renormalisation).
-    double default_radius_deg(const GlareSettings& g, double) const override { return 4.0 * g.bloom_sigma_deg; }
+    double default_radius_deg(const GlareSettings& g, double) const override { return 4.0 * glare_number(g, kSigma); }
 
     GlareModelKernel billboard_kernel(const GlareKernelRequest& r) const override {
         GlareModelKernel k;
@@ -43,7 +55,7 @@ public:
 
 private:
     static GlareKernel kernel(const GlareKernelRequest& r, double radius_deg) {
-        const double s = r.glare.bloom_sigma_deg;
+        const double s = glare_number(r.glare, kSigma);
         if (!(s > 0))
             throw InputError(SourceLocation{"", 0, 0, "bloom_sigma_deg"},
                              fmt::format("the bloom's standard deviation must be positive, not {} degrees.", s));

@@ -2,6 +2,8 @@
 // for the photopic, mesopic or scotopic eye (spencer_vision).
 #include <fmt/format.h>
 
+#include <string>
+
 #include "atonlab/common/toml_reader.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -10,7 +12,24 @@
 namespace atonlab::stimuli {
 namespace {
 
-constexpr std::string_view kKeys[] = {"spencer_vision"};
+constexpr std::string_view kVision = "spencer_vision";
+
+const GlareSetting kSettings[] = {
+    {.key = kVision,
+     .type = "string",
+     .unit = "—",
+     .default_text = "`\"auto\"`",
+     .doc = "`\"photopic\"`, `\"mesopic\"`, `\"scotopic\"`; auto: ≥ 3 cd/m² photopic, ≤ 0.001 cd/m² scotopic",
+     .example = "\"photopic\"",
+     .default_value = std::string("auto"),
+     .check =
+         [](const GlareSettingValue& v) {
+             const std::string& s = std::get<std::string>(v);
+             if (s == "photopic" || s == "mesopic" || s == "scotopic" || s == "auto") return std::string();
+             return fmt::format(
+                 "unknown vision \"{}\"; it must be \"photopic\", \"mesopic\", \"scotopic\" or \"auto\".", s);
+         }},
+};
 constexpr double kDefaultRadiusDeg = 6.0;  // the billboard radius glare_stage.h gives Spencer's PSF
 
 class Spencer final : public GlareModelType {
@@ -19,22 +38,7 @@ public:
     std::string_view summary() const override {
         return "the analytic PSF of Spencer et al. 1995, photopic, mesopic or scotopic (spencer_vision)";
     }
-    std::span<const std::string_view> glare_keys() const override { return kKeys; }
-    void read_glare_keys(const toml_reader::Document&, const toml_reader::Section& s, GlareSettings& g,
-                         double) const override {
-        const auto v = s.string("spencer_vision");
-        if (!v) return;
-        if (*v == "photopic")
-            g.spencer_vision = SpencerVision::photopic;
-        else if (*v == "mesopic")
-            g.spencer_vision = SpencerVision::mesopic;
-        else if (*v == "scotopic")
-            g.spencer_vision = SpencerVision::scotopic;
-        else if (*v != "auto")
-            s.fail(s.get("spencer_vision"), "spencer_vision",
-                   fmt::format("unknown vision \"{}\"; it must be \"photopic\", \"mesopic\", \"scotopic\" or \"auto\".",
-                               *v));
-    }
+    std::span<const GlareSetting> settings() const override { return kSettings; }
     bool on_images() const override { return true; }
     double default_radius_deg(const GlareSettings&, double) const override { return kDefaultRadiusDeg; }
     std::string kernel_scene_key(const Scene& scene) const override {
@@ -61,6 +65,16 @@ private:
 };
 
 }  // namespace
+
+SpencerVision spencer_vision_for(const Scene& scene) {
+    const std::string v = glare_text(scene.glare, kVision);
+    if (v == "photopic") return SpencerVision::photopic;
+    if (v == "mesopic") return SpencerVision::mesopic;
+    if (v == "scotopic") return SpencerVision::scotopic;
+    if (scene.adaptation_cd_m2 >= 3.0) return SpencerVision::photopic;
+    if (scene.adaptation_cd_m2 <= 0.001) return SpencerVision::scotopic;
+    return SpencerVision::mesopic;
+}
 
 const GlareModelType& glare_model_spencer() {
     static const Spencer model;

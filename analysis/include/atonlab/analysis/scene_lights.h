@@ -7,14 +7,18 @@
 // (stimuli::SceneTemplate) is not at hand. The runner has already checked the
 // scene with these very overrides (it refuses a session otherwise), so this
 // reads only the few keys a report names, with the common TOML parser, and
-// applies the overrides as the loader does: "light.NAME.key" or
-// "light[INDEX].key", later ones winning, and `colour`, `xy` and `spd`
-// excluding each other (a value that is not TOML is a string, as for --set).
+// applies the overrides as the loader does, with the loader's own addressing
+// (common/scene_override.h element_address: "light.NAME.key" or
+// "light[INDEX].key") and typed values (a value that is not TOML is a string,
+// as for --set), later ones winning, and `colour`, `xy` and `spd` excluding
+// each other.
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "atonlab/common/scene_override.h"
 
 namespace atonlab::analysis {
 
@@ -42,11 +46,10 @@ public:
     /// does not parse or its [[light]] array is not an array of tables.
     static std::optional<SceneLights> parse(std::string_view scene_text, std::string& error);
 
-    /// Light (or disc) `name` with `overrides` ((key, TOML value) pairs, as
-    /// stored in a trial's frame) applied in order. "NAME/LETTER" names one
+    /// Light (or disc) `name` with `overrides` (as stored in a trial's frame,
+    /// read by SceneOverride::parse) applied in order. "NAME/LETTER" names one
     /// colour of an alternating light. std::nullopt: no light or disc has the name.
-    std::optional<LightLook> look(std::string_view name,
-                                  const std::vector<std::pair<std::string, std::string>>& overrides) const;
+    std::optional<LightLook> look(std::string_view name, const std::vector<SceneOverride>& overrides) const;
 
 private:
     struct Entry {

@@ -18,6 +18,23 @@
 
 namespace atonlab {
 
+/// One "key=value" as a person wrote it: a `--set`, a protocol's `set` line,
+/// a stored override, `check --set`, `simulate --observer` and `--protocol-set`.
+/// The one reader of that form: split at the first '=', blanks around the key
+/// and the value trimmed, the value parsed once (toml_value.h).
+struct KeyValue {
+    std::string key;
+    std::string text;  ///< the value as written (trimmed)
+    /// The TOML value, or the text as a string when it is not one (not_toml
+    /// then says why); nullopt when it cannot be read even as a string
+    /// (unreadable says why).
+    std::optional<TomlValue> value;
+    std::string not_toml;
+    std::string unreadable;
+};
+/// nullopt when `text` has no '='. `source`: the values' nodes' source path.
+std::optional<KeyValue> read_key_value(std::string_view text, std::string_view source = {});
+
 struct SceneOverride {
     std::string key;    ///< dotted scene key: "eye.glare", "light.buoy.intensity_cd", "light[0].rhythm"
     /// The value's TOML text as written: "\"none\"", "120", "[0.0, 3.0, -500.0]".
@@ -66,5 +83,19 @@ private:
     std::string not_toml_;
     std::string unreadable_;
 };
+
+/// What an override of a [[light]] or [[disc]] table addresses: "ARRAY.NAME.KEY"
+/// or "ARRAY[INDEX].KEY" (NAME may hold dots; KEY, after the last dot, never
+/// does). The one reading of this addressing: the scene loader applies
+/// overrides with it and the analysis names a trial's lights with it.
+struct ElementAddress {
+    std::optional<std::size_t> index;  ///< ARRAY[INDEX]; nullopt: by name
+    std::string name;                  ///< ARRAY.NAME; empty when by index
+    std::string key;                   ///< the key inside the element
+};
+/// The address `key` gives in `array` ("light", "disc"). nullopt when it is
+/// not one: `key` does not start with "ARRAY." or "ARRAY[", has no key after
+/// its last dot, or an index that is not 1 to 6 digits closed by "]." .
+std::optional<ElementAddress> element_address(std::string_view key, std::string_view array);
 
 }  // namespace atonlab

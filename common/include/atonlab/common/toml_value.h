@@ -9,6 +9,7 @@
 // source path they were parsed with, so a reader can say where they came from.
 #include <toml++/toml.h>
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +31,18 @@ public:
     /// nullopt when it cannot be one (it is not UTF-8); `error` then says why.
     static std::optional<TomlValue> string(std::string_view text, std::string* error = nullptr,
                                            std::string_view source = {});
+
+    /// `text` as the TOML text of a basic string: quoted, quotes and
+    /// backslashes escaped, control characters written \uXXXX. What string()
+    /// parses; also the value text of an override's stored form ("key=\"red\"").
+    static std::string quoted(std::string_view text);
+
+    /// A value made in code, not read from text (a Python keyword's value):
+    /// its nodes have no source.
+    static TomlValue of(bool v);
+    static TomlValue of(std::int64_t v);
+    static TomlValue of(double v);
+    static TomlValue of(std::string_view v);
 
     /// The value (never a table of the document itself: an inline table is one).
     const toml::node& node() const noexcept { return *doc_->get(kKey); }

@@ -53,6 +53,11 @@ struct CieObserver {
     double pigmentation = 0.5;  ///< p: 0 very dark, 0.5 brown, 1.0 light blue-green, 1.2 very light blue eyes
 };
 
+struct GlareSettings;
+/// The `cie` model's observer of these settings ([eye] cie_age_years and
+/// cie_pigmentation, declared in glare_models/cie.cpp).
+CieObserver cie_observer(const GlareSettings& g);
+
 /// The CIE glare spread function of Vos & van den Berg (CIE 135/1-1999), the
 /// `cie` model's equation: L_veil / E_glare in sr⁻¹ ((cd/m²)/lx) at θ degrees
 /// from a point source. Finite and defined for every θ ≥ 0 (the header comment).

@@ -72,7 +72,8 @@ double glare_pupil_mm(const Scene& scene);
 double cached_pupil_mm(double pupil_mm, double tolerance_mm);
 
 /// Spencer's vision class from the adaptation luminance when not given:
-/// photopic ≥ 3 cd/m², scotopic ≤ 0.001 cd/m², mesopic between (CIE 191 limits).
+/// photopic ≥ 3 cd/m², scotopic ≤ 0.001 cd/m², mesopic between (CIE 191 limits)
+/// ([glare] spencer_vision, declared in glare_models/spencer.cpp).
 SpencerVision spencer_vision_for(const Scene& scene);
 
 class GlareStage {

@@ -17,6 +17,7 @@
 #include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
+#include "atonlab/stimuli/glare_models/glare_setting.h"
 #include "atonlab/stimuli/output_settings.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
@@ -101,7 +102,8 @@ std::string_view spectral_path_name(SpectralPath p);
 std::optional<SpectralPath> spectral_path_from_name(std::string_view name);
 
 /// The glare stage's settings (docs/architecture.md "The pipeline, one frame", step 3; K2012 §4.2-4.3): the
-/// models are glare_models/glare_model_list.h, each reading its own keys (glare_model.h).
+/// ones every model shares, the wave-optics eye (its typed home, which the pupil and hippus code share), and
+/// the other models' declared settings (values). The models are glare_models/glare_model_list.h.
 struct GlareSettings {
     GlareModel model = GlareModel::none;
     /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).
@@ -114,12 +116,11 @@ struct GlareSettings {
     GlareWindow window = GlareWindow::silverman;  ///< K2012 §5.3.1: Silverman is safe at 16 bits
     std::optional<double> radius_deg;   ///< billboard radius; default per model (see glare_stage.h)
     int area_layers = 16;               ///< at most this many disc layers (K2012 §4.2.6)
-    double bloom_sigma_deg = 0.25;      ///< gaussian-bloom: standard deviation (degrees)
-    std::optional<SpencerVision> spencer_vision;  ///< nullopt: from the adaptation luminance
-    std::string aperture_image;         ///< aperture: PNG or EXR, transmittance = luminance (white = clear)
-    double aperture_width_mm = 18.0;    ///< aperture: the side of the plane the image spans
-    bool aperture_with_pupil = false;   ///< aperture: also clip by the eye's pupil
-    CieObserver cie;                    ///< cie: the observer's age and ocular pigmentation
+    /// The models' own settings that a file or an option gave, by key; each
+    /// model declares its keys, defaults and checks in its own file
+    /// (GlareModelType::settings(), glare_setting.h) and reads them with
+    /// glare_number / glare_flag / glare_text.
+    GlareSettingValues values;
     /// Where the `cie` veil's convolution and a one-scale PSF's FFT run
     /// (placement.h): automatic = the GPU on a hardware driver, the CPU on a
     /// software rasteriser.

@@ -40,7 +40,7 @@ public:
     std::string_view summary() const override {
         return "the eye model's PSF by FFT of its pupil plane, over the light's spectrum (K2012 §4.2)";
     }
-    std::span<const std::string_view> glare_keys() const override { return wave_optics::kKeys; }
+    std::span<const GlareSetting> settings() const override { return wave_optics::settings(); }
     void read_glare_keys(const toml_reader::Document&, const toml_reader::Section& s, GlareSettings& g,
                          double pupil_mm) const override {
         wave_optics::read_keys(s, g, pupil_mm);

@@ -21,6 +21,7 @@
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/glare_models/glare_model_list.h"
+#include "atonlab/stimuli/glare_models/glare_setting.h"
 #include "atonlab/stimuli/psf.h"
 
 namespace atonlab::toml_reader {
@@ -84,16 +85,21 @@ public:
     /// How it draws a light.
     virtual GlarePath path() const { return GlarePath::billboard; }
 
-    /// The keys only this model reads, of [glare] and of [eye] (the scene
-    /// reader reads the ones the models share). docs/scene-file.md describes them.
-    virtual std::span<const std::string_view> glare_keys() const { return {}; }
-    virtual std::span<const std::string_view> eye_keys() const { return {}; }
-    /// Reads its keys of [glare] into g (absent keys keep GlareSettings'
-    /// defaults) and checks them, failing at the key's line. pupil_mm: the
-    /// pupil the scene's frames use (the darkest one for dynamic adaptation).
+    /// The settings only this model reads, keys of [glare] and of [eye], each
+    /// with its default, check and documentation line (glare_setting.h). The
+    /// scene reader, `atonlab glare`'s options, the Python module and the
+    /// glare stage's kernel cache key read these; docs/scene-file.md has a row
+    /// for each, which the registry test holds to the declaration.
+    virtual std::span<const GlareSetting> settings() const { return {}; }
+    /// Reads its settings of [glare] into g and checks them, failing at the
+    /// key's line. The default reads every declared setting stored in
+    /// GlareSettings::values; a model overrides it for what a declaration
+    /// cannot say (a typed home, a path relative to the file, a check of two
+    /// keys together) and calls it for the rest. pupil_mm: the pupil the
+    /// scene's frames use (the darkest one for dynamic adaptation).
     virtual void read_glare_keys(const toml_reader::Document& doc, const toml_reader::Section& s, GlareSettings& g,
                                  double pupil_mm) const;
-    /// The same for its keys of [eye].
+    /// The same for its settings of [eye].
     virtual void read_eye_keys(const toml_reader::Section& s, GlareSettings& g) const;
 
     /// Whether `atonlab view`'s m key offers it with these settings (aperture needs an image).
@@ -109,8 +115,8 @@ public:
     /// The pupil (mm) its kernel is computed for at time_s, from the frame's pupil (before the cache's rounding).
     virtual double kernel_pupil_mm(const GlareSettings& g, double pupil_mm, double time_s) const;
 
-    /// What of the scene, beyond GlareSettings and the pupil, its kernel
-    /// depends on, as text for the glare stage's cache key (Spencer's: the
+    /// What of the scene, beyond its declared settings, the shared ones and
+    /// the pupil, its kernel depends on, as text for the glare stage's cache key (Spencer's: the
     /// vision class its adaptation implies); empty for none. A change of it
     /// rebuilds the kernel, so a model must name only what it reads.
     virtual std::string kernel_scene_key(const Scene&) const { return {}; }
@@ -147,5 +153,20 @@ std::string glare_model_choices(std::string_view quote = "\"",
                                 const std::function<bool(const GlareModelType&)>& keep = {});
 
 GlarePath glare_path(GlareModel m);
+
+/// Adds a model defined outside glare_model_list.h (a test's toy model, from
+/// one file): `instance` returns its one instance, built with the enumerator
+/// given (the next value after the list's). Its name must be new. Call it
+/// before any scene is read (a namespace-scope initialiser in the model's
+/// file), since the scene reader's key lists are made once.
+GlareModel register_glare_model(std::string_view name, const GlareModelType& (*instance)(GlareModel id));
+
+/// The glare stage's kernel cache key for `model`'s kernels of the light
+/// SPD `spd` in `scene` (everything a kernel depends on but the pupil): the
+/// model, the shared [glare] settings, each of the model's declared settings
+/// (glare_setting.h) by key and value, the display's pixels per degree and the
+/// model's kernel_scene_key. A declared setting is in it without being named
+/// here, so none can be forgotten.
+std::string glare_kernel_key(const Scene& scene, GlareModel model, std::string_view spd);
 
 }  // namespace atonlab::stimuli
