@@ -30,25 +30,6 @@ InputError csv_error(const std::string& file, int line, std::string column, cons
 
 }  // namespace
 
-std::string_view to_string(Task t) noexcept {
-    switch (t) {
-        case Task::TwoAfc:
-            return "2afc";
-        case Task::YesNo:
-            return "yes-no";
-        case Task::Adjust:
-            return "adjust";
-    }
-    return "2afc";
-}
-
-std::optional<Task> parse_task(std::string_view text) noexcept {
-    if (text == "2afc") return Task::TwoAfc;
-    if (text == "yes-no") return Task::YesNo;
-    if (text == "adjust") return Task::Adjust;
-    return std::nullopt;
-}
-
 const std::vector<std::string>& required_csv_columns() {
     static const std::vector<std::string> cols{"observer", "condition", "level", "response"};
     return cols;
@@ -201,7 +182,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     t.observer = row.required("observer");
     t.condition = row.required("condition");
     if (const auto task = row.text("task")) {
-        const auto parsed = parse_task(*task);
+        const auto parsed = protocols::parse_task(*task);
         if (!parsed) row.fail("task", fmt::format("'{}' is not a task (2afc, yes-no, adjust)", *task));
         t.task = *parsed;
     }
@@ -213,7 +194,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
         if (*s != "log10" && *s != "linear") row.fail("level_scale", fmt::format("'{}' is not log10 or linear", *s));
         t.level_scale = *s;
     }
-    t.level_on = t.task == Task::YesNo ? "test" : "reference";
+    t.level_on = t.task == protocols::Task::YesNo ? "test" : "reference";
     if (const auto s = row.text("level_on")) {
         if (*s != "test" && *s != "reference") row.fail("level_on", fmt::format("'{}' is not test or reference", *s));
         t.level_on = *s;
@@ -224,7 +205,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     // yes/no value or (2AFC) a side with test_on_left.
     if (const auto o = row.boolean("outcome")) {
         t.outcome = o;
-    } else if (t.task == Task::Adjust) {
+    } else if (t.task == protocols::Task::Adjust) {
         if (!is_adjust_word(t.response))
             row.fail("response", fmt::format("'{}' is not an adjustment action (confirm or match for a match; "
                                              "coarse_up, coarse_down, fine_up, fine_down)",
@@ -232,7 +213,7 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
     } else if (const auto b = RowReader::parse_bool(t.response)) {
         t.outcome = b;
     } else if (const std::optional<p::Response> side = p::parse_response_word(t.response);
-               t.task == Task::TwoAfc && (side == p::Response::Left || side == p::Response::Right)) {
+               t.task == protocols::Task::TwoAfc && (side == p::Response::Left || side == p::Response::Right)) {
         if (!t.test_on_left)
             row.fail("test_on_left", "is needed to score the answer 'left' or 'right' (where was the test?)");
         const bool chose_test = (side == p::Response::Left) == *t.test_on_left;
@@ -417,7 +398,7 @@ namespace {
 /// 2AFC: 1 when the observer chose the reference stimulus, 0 the test; "" for
 /// other tasks and for answers that chose neither (a timeout).
 std::string chose_reference(const Trial& t) {
-    if (t.task != Task::TwoAfc || !t.test_on_left || (t.response != "left" && t.response != "right")) return {};
+    if (t.task != protocols::Task::TwoAfc || !t.test_on_left || (t.response != "left" && t.response != "right")) return {};
     const bool chose_test = (t.response == "left") == *t.test_on_left;
     return chose_test ? "0" : "1";
 }

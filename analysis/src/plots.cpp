@@ -44,7 +44,7 @@ std::pair<double, double> proportion_interval(int k, int n, double level) {
 using Drawer = detail::FigureDrawer;
 
 std::string outcome_label(const ConditionInfo& c) {
-    if (c.task == Task::YesNo) return "P(yes)";
+    if (c.task == protocols::Task::YesNo) return "P(yes)";
     return c.level_on == "test" ? "P(chose the test)" : "P(chose the reference)";
 }
 
@@ -563,7 +563,7 @@ PlotResult make_figures(const fs::path& out_dir, const Dataset& data, const Stud
     const std::map<std::string, std::string> slugs = condition_slugs(results);
     for (const ConditionInfo& c : results.conditions) {
         const std::string& slug = slugs.at(c.condition);
-        if (c.task != Task::Adjust) psychometric_figure(d, results, c, slug);
+        if (c.task != protocols::Task::Adjust) psychometric_figure(d, results, c, slug);
         tracks_figure(d, results, c, slug);
     }
     pse_figure(d, results);

@@ -212,8 +212,8 @@ std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
         esc(c.glare_test.empty() ? "(scene default)" : c.glare_test),
         esc(c.glare_reference.empty() ? "(scene default)" : c.glare_reference), g3(c.test_intensity_cd),
         lights_sentence(c),
-        c.task == Task::YesNo    ? "yes"
-        : c.task == Task::Adjust ? "the confirmed match"
+        c.task == protocols::Task::YesNo    ? "yes"
+        : c.task == protocols::Task::Adjust ? "the confirmed match"
         : c.level_on == "test"   ? "chose the test"
                                  : "chose the reference",
         c.guess_rate, c.target_p, c.n_trials);

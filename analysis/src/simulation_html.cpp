@@ -157,10 +157,10 @@ void write_simulation_report_html(const std::filesystem::path& file, const Simul
     h += fmt::format(
         "<p>Simulation folder <code>{}</code>: protocol <code>{}</code> (SHA-256 <code>{}</code>), {} "
         "design(s):</p>\n<ul>\n",
-        esc(r.folder.string()), esc(r.manifest.protocol), esc(r.manifest.protocol_sha256.substr(0, 16)),
+        esc(r.folder.string()), esc(r.manifest.protocol()), esc(r.manifest.protocol_sha256().substr(0, 16)),
         r.manifest.designs.size());
     for (std::size_t i = 0; i < r.manifest.designs.size(); ++i) {
-        const SimulationDesign& d = r.manifest.designs[i];
+        const ManifestDesign& d = r.manifest.designs[i];
         h += fmt::format("<li>{}: <b>{}</b>{}</li>\n", i, esc(d.label.empty() ? "(the protocol as it is)" : d.label),
                          d.overrides.empty() || (d.overrides.size() == 1 && d.overrides[0] == d.label)
                              ? std::string()

@@ -19,7 +19,6 @@
 #include "atonlab/analysis/simulation.h"
 #include "atonlab/analysis/study_analysis.h"
 #include "atonlab/common/input_error.h"
-#include "atonlab/common/read_file.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/json.h"
 
@@ -28,9 +27,6 @@ namespace atonlab::analysis {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr const char* kManifest = "simulation.json";
-constexpr int kManifestVersion = 1;
 
 bool ends_with(const std::string& s, std::string_view tail) {
     return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -139,42 +135,6 @@ std::string read_truth(const std::string& json, SessionSummary& s, std::map<std:
 
 const char* to_string(IntervalMethod m) noexcept {
     return m == IntervalMethod::Bootstrap ? "bootstrap" : "profile";
-}
-
-bool is_simulation_folder(const fs::path& dir) {
-    std::error_code ec;
-    return fs::is_directory(dir, ec) && fs::is_regular_file(dir / kManifest, ec);
-}
-
-SimulationManifest read_simulation_manifest(const fs::path& dir) {
-    const fs::path file = dir / kManifest;
-    const std::string text = files::read_text(file, "simulation manifest");
-    const auto at = [&](const std::string& key) { return SourceLocation{file.string(), 0, 0, key}; };
-    nlohmann::json j;
-    try {
-        j = store::parse_json(text, "the simulation manifest");
-    } catch (const store::StoreError& e) {
-        throw InputError(at(""), e.what());
-    }
-    if (store::string_at(j, "/format") != "atonlab-simulation")
-        throw InputError(at("format"), "this is not an atonlab simulation manifest (format \"atonlab-simulation\")");
-    const auto version = store::number_at(j, "/version");
-    if (!version || *version < 1 || *version > kManifestVersion)
-        throw InputError(at("version"),
-                         fmt::format("version {} is not one this atonlab reads (1 to {})",
-                                     version ? fmt::format("{}", *version) : "(none)", kManifestVersion));
-    SimulationManifest m;
-    m.protocol = store::string_at(j, "/protocol").value_or("");
-    m.protocol_sha256 = store::string_at(j, "/protocol_sha256").value_or("");
-    for (const nlohmann::json& d : store::array_at(j, "/designs")) {
-        SimulationDesign design;
-        design.label = store::string_at(d, "/label").value_or("");
-        for (const nlohmann::json& o : store::array_at(d, "/overrides"))
-            if (o.is_string()) design.overrides.push_back(o.get<std::string>());
-        m.designs.push_back(std::move(design));
-    }
-    if (m.designs.empty()) throw InputError(at("designs"), "the manifest names no design");
-    return m;
 }
 
 SessionRead read_simulated_session(const fs::path& file, int design_index, const SimulationOptions& options) {

@@ -115,10 +115,10 @@ void write_simulation_summary_json(const std::filesystem::path& file, const Simu
     j["command_line"] = ctx.command_line;
     j["folder"] = r.folder.string();
     Json designs = Json::array();
-    for (const SimulationDesign& d : r.manifest.designs)
+    for (const ManifestDesign& d : r.manifest.designs)
         designs.push_back(Json{{"label", d.label}, {"overrides", d.overrides}});
-    j["simulation"] = Json{{"protocol", r.manifest.protocol},
-                           {"protocol_sha256", r.manifest.protocol_sha256},
+    j["simulation"] = Json{{"protocol", r.manifest.protocol()},
+                           {"protocol_sha256", r.manifest.protocol_sha256()},
                            {"designs", std::move(designs)}};
     j["options"] = Json{
         {"intervals", to_string(r.options.intervals)},

@@ -252,7 +252,7 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
     }
     const bool log_levels = info.level_scale == "log10";
 
-    if (info.task == Task::Adjust) {
+    if (info.task == protocols::Task::Adjust) {
         analyse_matches(g, info, trials, o, label);
         return g;
     }

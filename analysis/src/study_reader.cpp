@@ -90,10 +90,10 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
         problems.push_back(e.what());
         return;
     }
-    if (const auto task = parse_task(store::string_at(j, "/task").value_or(""))) t.task = *task;
+    if (const auto task = protocols::parse_task(store::string_at(j, "/task").value_or(""))) t.task = *task;
     t.level_key = store::string_at(j, "/level_key").value_or("");
     t.level_scale = store::string_at(j, "/level_scale").value_or("log10");
-    t.level_on = store::string_at(j, "/level_on").value_or(t.task == Task::YesNo ? "test" : "reference");
+    t.level_on = store::string_at(j, "/level_on").value_or(t.task == protocols::Task::YesNo ? "test" : "reference");
     std::vector<Frame> frames;
     for (const nlohmann::json& f : store::array_at(j, "/frames")) {
         Frame frame;
@@ -192,12 +192,12 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
 
 /// The binary outcome of a trial (Trial::outcome).
 std::optional<bool> outcome_of(const Trial& t) {
-    if (t.task == Task::TwoAfc) {
+    if (t.task == protocols::Task::TwoAfc) {
         if ((t.response != "left" && t.response != "right") || !t.test_on_left) return std::nullopt;
         const bool chose_test = (t.response == "left") == *t.test_on_left;
         return t.level_on == "test" ? chose_test : !chose_test;
     }
-    if (t.task == Task::YesNo) {
+    if (t.task == protocols::Task::YesNo) {
         if (t.response == "yes") return true;
         if (t.response == "no") return false;
     }

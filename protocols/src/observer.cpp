@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <boost/math/distributions/normal.hpp>
 #include <boost/math/special_functions/erf.hpp>
 #include <boost/math/tools/roots.hpp>
 #include <cmath>
@@ -118,11 +117,6 @@ double log_difference(double a, double b) {
     return a - b;
 }
 
-double phi(double z) {
-    if (z == kInf) return 1.0;
-    if (z == -kInf) return 0.0;
-    return 0.5 * std::erfc(-z / std::numbers::sqrt2);
-}
 
 /// z such that λ/2 + (1−λ)Φ(z) = p.
 double z_for(double p, double lapse) {
@@ -131,7 +125,7 @@ double z_for(double p, double lapse) {
         throw std::invalid_argument(
             fmt::format("the probability {} is out of reach with a lapse rate of {}", p, lapse));
     if (q == 0.5) return 0.0;
-    return boost::math::quantile(boost::math::normal_distribution<double>(), q);
+    return standard_normal_quantile(q);
 }
 
 /// The root of f in [lo, hi], f increasing or decreasing (TOMS 748).
@@ -219,18 +213,27 @@ ModelObserver::ModelObserver(ModelObserverParams params, std::uint64_t seed) : p
     validate(params_);
 }
 
+double model_response_time_s(const ModelObserverParams& params, double delta_over_sigma) {
+    return params.rt_base_s + params.rt_hard_s * std::exp(-std::abs(delta_over_sigma));
+}
+
+double standard_normal_cdf(double z) {
+    if (z == kInf) return 1.0;
+    if (z == -kInf) return 0.0;
+    return 0.5 * std::erfc(-z / std::numbers::sqrt2);
+}
+
+double standard_normal_quantile(double u) {
+    return std::numbers::sqrt2 * boost::math::erf_inv(2.0 * u - 1.0);
+}
+
 double ModelObserver::log10_brightness(const View& v) const {
     return params_.exponent * log10_or_minus_inf(window_light_lux(*v.image, v.light_px, params_.window_radius_deg));
 }
 
 double ModelObserver::gaussian() {
     // One uniform in (0, 1) through the inverse normal CDF: the same on every platform.
-    const double u = rng_.uniform() + 0x1.0p-54;
-    return std::numbers::sqrt2 * boost::math::erf_inv(2.0 * u - 1.0);
-}
-
-double ModelObserver::response_time(double delta_over_sigma) const {
-    return params_.rt_base_s + params_.rt_hard_s * std::exp(-std::abs(delta_over_sigma));
+    return standard_normal_quantile(rng_.uniform() + 0x1.0p-54);
 }
 
 Answer ModelObserver::answer(const Shown& shown) {
@@ -262,7 +265,7 @@ Answer ModelObserver::answer_2afc(const Shown& shown) {
 Answer ModelObserver::answer_2afc_delta(double delta) {
     const double sigma = params_.noise_sd_log10;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
-    const Answer easy{Response::Left, response_time(z)};
+    const Answer easy{Response::Left, model_response_time_s(params_, z)};
     if (rng_.uniform() < params_.lapse_rate)
         return {rng_.coin() ? Response::Left : Response::Right, easy.response_time_s};
     const double d = sigma > 0 ? delta + sigma * gaussian() : delta;
@@ -278,7 +281,7 @@ Answer ModelObserver::answer_yes_no(const Shown& shown) {
 Answer ModelObserver::answer_yes_no_delta(double delta) {
     const double sigma = params_.noise_sd_log10;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
-    const double rt = response_time(z);
+    const double rt = model_response_time_s(params_, z);
     if (rng_.uniform() < params_.lapse_rate) return {rng_.coin() ? Response::Yes : Response::No, rt};
     const double d = sigma > 0 && std::isfinite(delta) ? delta + sigma * gaussian() : delta;
     return {d > 0 ? Response::Yes : Response::No, rt};
@@ -292,7 +295,7 @@ Answer ModelObserver::answer_adjust(const Shown& shown) {
         log_difference(log10_brightness(view_at(shown, 1 - adjusted)), log10_brightness(view_at(shown, adjusted)));
     const double sigma = params_.noise_sd_log10;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
-    const double rt = response_time(z);
+    const double rt = model_response_time_s(params_, z);
     const double d = sigma > 0 && std::isfinite(delta) ? delta + sigma * gaussian() : delta;
     ++actions_;
     const bool coarse = std::abs(d) > params_.adjust_coarse_log10;
@@ -315,7 +318,7 @@ double model_p_yes(const ModelObserverParams& params, const View& view) {
     const double e = increment_illuminance_lux(*view.image, view.light_px, params.window_radius_deg);
     const double delta = e > 0 ? params.exponent * std::log10(e / params.detection_threshold_lux) : -kInf;
     const double sigma = params.noise_sd_log10;
-    const double p = sigma > 0 ? phi(delta / sigma) : (delta > 0 ? 1.0 : 0.0);
+    const double p = sigma > 0 ? standard_normal_cdf(delta / sigma) : (delta > 0 ? 1.0 : 0.0);
     return params.lapse_rate / 2.0 + (1.0 - params.lapse_rate) * p;
 }
 
@@ -326,7 +329,7 @@ double model_p_first(const ModelObserverParams& params, const View& first, const
     };
     const double delta = log_difference(log_b(first), log_b(second));
     const double sigma = params.noise_sd_log10;
-    const double p = sigma > 0 ? phi(delta / sigma) : (delta > 0 ? 1.0 : (delta < 0 ? 0.0 : 0.5));
+    const double p = sigma > 0 ? standard_normal_cdf(delta / sigma) : (delta > 0 ? 1.0 : (delta < 0 ? 0.0 : 0.5));
     return params.lapse_rate / 2.0 + (1.0 - params.lapse_rate) * p;
 }
 

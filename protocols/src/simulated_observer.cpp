@@ -5,7 +5,6 @@
 
 #include <array>
 #include <boost/math/special_functions/beta.hpp>
-#include <boost/math/special_functions/erf.hpp>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -64,11 +63,6 @@ std::string key_list() {
     return s;
 }
 
-/// The standard normal quantile of u in (0, 1) (inverse normal CDF, as ModelObserver draws its noise).
-double normal_quantile(double u) {
-    return std::numbers::sqrt2 * boost::math::erf_inv(2.0 * u - 1.0);
-}
-
 }  // namespace
 
 std::span<const ObserverKey> observer_keys() noexcept {
@@ -119,7 +113,7 @@ double ObserverDrift::at(std::size_t step) {
     if (d_.fluctuation_sd_log10 > 0.0) {
         const double a = d_.fluctuation_decay, sd = d_.fluctuation_sd_log10;
         while (ar_.size() <= step) {
-            const double e = normal_quantile(rng_.uniform() + 0x1.0p-54);
+            const double e = standard_normal_quantile(rng_.uniform() + 0x1.0p-54);
             ar_.push_back(ar_.empty() ? sd * e : a * ar_.back() + sd * std::sqrt(1.0 - a * a) * e);
         }
         shift += ar_[step];
@@ -163,7 +157,7 @@ Answer simulated_answer(const SimulatedObserverParams& params, Task task, double
     if (!std::isfinite(delta)) {
         phi = delta > 0 ? 1.0 : 0.0;
     } else if (sigma > 0) {
-        phi = 0.5 * std::erfc(-delta / (sigma * std::numbers::sqrt2));
+        phi = standard_normal_cdf(delta / sigma);
     } else if (delta != 0) {
         phi = delta > 0 ? 1.0 : 0.0;
     }
@@ -172,7 +166,7 @@ Answer simulated_answer(const SimulatedObserverParams& params, Task task, double
     Rng rng(trial_seed);
     const bool first = rng.uniform() < p;
     const double z = sigma > 0 ? delta / sigma : (delta == 0 ? 0.0 : std::copysign(kInf, delta));
-    const double rt = m.rt_base_s + m.rt_hard_s * std::exp(-std::abs(z));
+    const double rt = model_response_time_s(m, z);
     if (task == Task::TwoAfc) return {first ? Response::Left : Response::Right, rt};
     return {first ? Response::Yes : Response::No, rt};
 }
@@ -181,7 +175,7 @@ std::optional<double> decision_at_probability(const ModelObserverParams& params,
     const double lapse = params.lapse_rate;
     const double q = (p - 0.5 * lapse) / (1.0 - lapse);
     if (!(q > 0.0 && q < 1.0)) return std::nullopt;
-    return params.noise_sd_log10 * normal_quantile(q);
+    return params.noise_sd_log10 * standard_normal_quantile(q);
 }
 
 }  // namespace atonlab::protocols

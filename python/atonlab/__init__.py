@@ -143,7 +143,7 @@ def run(protocol, db, observer="model", headless=True, progress=None, *, script=
     observer may also be a callable, your own observer (docs/python.md "Your
     own observer"): observer(trial) gets each trial's facts and what the model
     observer would see (trial["views"]: each judged light's window of
-    displayed luminance, cd/m²) and returns a response word ("left", "right",
+    displayed luminance, cd/m², and of display codes) and returns a response word ("left", "right",
     "yes", "no", ...) or (word, response_time_s). It is stored with the code
     observer_code (default "custom") and, in each trial's state, the kind
     "custom" and observer_name (default the callable's __name__). An exception

@@ -64,6 +64,14 @@ py::dict trial_dict(const protocols::ScheduledTrial& t, const protocols::Shown& 
         view["frame"] = sv.frame;
         view["displayed_cd_m2"] = window(img.luminance_cd_m2);
         view["background_cd_m2"] = window(img.background_cd_m2);
+        if (img.codes_rgb.empty()) {
+            view["codes"] = py::none();
+        } else {
+            py::array_t<std::uint16_t> codes({py::ssize_t{img.height}, py::ssize_t{img.width}, py::ssize_t{3}});
+            std::copy(img.codes_rgb.begin(), img.codes_rgb.end(), codes.mutable_data());
+            view["codes"] = codes;
+        }
+        view["bits"] = img.code_bits;
         view["light_px"] = py::make_tuple(v.light_px.x, v.light_px.y);
         view["deg_per_px"] = img.deg_per_px;
         view["focal_px"] = img.focal_px;

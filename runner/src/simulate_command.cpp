@@ -42,11 +42,11 @@ struct Pending {
     fs::path file;
 };
 
-SimulationManifest manifest_of(const std::vector<SimulationDesign>& designs, const SimulateOptions& o,
+analysis::SimulationManifest manifest_of(const std::vector<SimulationDesign>& designs, const SimulateOptions& o,
                                std::uint64_t seed) {
-    SimulationManifest m;
+    analysis::SimulationManifest m;
     for (const SimulationDesign& d : designs)
-        m.designs.push_back(ManifestDesign{d.label, d.protocol_path, store::sha256_hex(d.protocol_text), d.overrides,
+        m.designs.push_back(analysis::ManifestDesign{d.label, d.protocol_path, store::sha256_hex(d.protocol_text), d.overrides,
                                            o.render_every_trial ? std::string() : d.table_key});
     m.seed = seed;
     m.sessions = o.sessions;
@@ -139,7 +139,7 @@ std::size_t run_rendered(const std::vector<Pending>& todo, std::uint64_t seed, b
 
 /// --first I --count K: a share inside a simulation set up before (its
 /// manifest written), within its sessions.
-void check_share(const SimulateOptions& o, const std::optional<SimulationManifest>& existing) {
+void check_share(const SimulateOptions& o, const std::optional<analysis::SimulationManifest>& existing) {
     if (!existing)
         throw InputError(SourceLocation::command_line("--first"),
                          fmt::format("{} holds no simulation.json: a share of the sessions (--first) runs inside a "
@@ -244,10 +244,10 @@ int run_simulate(const SimulateOptions& o) {
                                  "learning or fluctuation needs the decision table (leave --render-every-trial out).");
     const fs::path dir = o.out;
     check_writable(dir);
-    const std::optional<SimulationManifest> existing = read_manifest(dir);
+    const std::optional<analysis::SimulationManifest> existing = read_manifest(dir);
     if (o.first) check_share(o, existing);
     const std::uint64_t seed = o.seed.value_or(designs.front().protocol.seed);
-    SimulationManifest manifest = manifest_of(designs, o, seed);
+    analysis::SimulationManifest manifest = manifest_of(designs, o, seed);
     if (existing) {
         if (const std::string diff = existing->identity_difference(manifest); !diff.empty())
             throw InputError(SourceLocation::command_line("--out"),
@@ -272,7 +272,7 @@ int run_simulate(const SimulateOptions& o) {
     fs::create_directories(dir);
     if (!o.first) {
         if (!o.render_every_trial) save_tables(designs, cache);
-        files::write_file_atomically(manifest_path(dir), manifest.json());
+        files::write_file_atomically(analysis::simulation_manifest_path(dir), manifest.json());
     }
     if (o.slurm) return submit_slurm_array(o, seed, designs.size(), per_task);
     if (o.print_commands) {
@@ -284,9 +284,9 @@ int run_simulate(const SimulateOptions& o) {
     std::vector<Pending> todo;
     std::size_t before = 0;
     for (const SimulationDesign& d : designs) {
-        fs::create_directories(session_file(dir, d.index, 0).parent_path());
+        fs::create_directories(analysis::simulation_session_file(dir, d.index, 0).parent_path());
         for (std::size_t i = lo; i < hi; ++i) {
-            const fs::path file = session_file(dir, d.index, i);
+            const fs::path file = analysis::simulation_session_file(dir, d.index, i);
             if (fs::exists(file)) {
                 ++before;
             } else {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis_test_data.h"
+#include "atonlab/analysis/simulation_manifest.h"
 #include "atonlab/store/json.h"
 
 namespace fs = std::filesystem;
@@ -38,21 +39,19 @@ int main(int argc, char** argv) {
     }
     const int distinct = argc > 4 ? std::min(n, std::stoi(argv[4])) : n;
     using Json = nlohmann::ordered_json;
-    Json manifest_designs = Json::array();
+    atonlab::analysis::SimulationManifest manifest;
     for (const int reps : designs) {
         const std::string label = designs.size() > 1 ? fmt::format("repetitions={}", reps) : std::string();
-        manifest_designs.push_back(
-            Json{{"label", label}, {"overrides", label.empty() ? Json::array() : Json::array({label})}});
+        manifest.designs.push_back(atonlab::analysis::ManifestDesign{
+            label, "sim.toml", "0", label.empty() ? std::vector<std::string>{} : std::vector<std::string>{label}, ""});
     }
+    manifest.sessions = static_cast<std::size_t>(n);
+    manifest.observer_json = "{}";
+    manifest.decisions = "table";
     fs::create_directories(dir);
-    std::ofstream(dir / "simulation.json") << atonlab::store::dump_json(Json{{"format", "atonlab-simulation"},
-                                                                             {"version", 1},
-                                                                             {"protocol", "sim.toml"},
-                                                                             {"protocol_sha256", "0"},
-                                                                             {"designs", manifest_designs}},
-                                                                        2);
+    std::ofstream(atonlab::analysis::simulation_manifest_path(dir)) << manifest.json();
     for (std::size_t d = 0; d < designs.size(); ++d) {
-        const fs::path folder = dir / "sessions" / fmt::format("{:02}", d);
+        const fs::path folder = atonlab::analysis::simulation_session_file(dir, d, 0).parent_path();
         fs::create_directories(folder);
         const std::string protocol = td::constant_stimuli_protocol(designs[d]);
         for (int i = 0; i < n; ++i) {
@@ -67,7 +66,7 @@ int main(int argc, char** argv) {
             Json truth;
             for (const char* c : {"night-empirical", "night-perceptual"})
                 truth[c] = {{"value", 2.0}, {"what", "pse"}, {"p", 0.5}};
-            obs.simulation_json = atonlab::store::dump_json(Json{{"design", manifest_designs[d]["label"]},
+            obs.simulation_json = atonlab::store::dump_json(Json{{"design", manifest.designs[d].label},
                                                                  {"design_index", d},
                                                                  {"index", i},
                                                                  {"seed", i + 1},

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import SOURCE, atonlab
+from test_displayed import rec709_luminance_shares, srgb_eotf
 
 pd = pytest.importorskip("pandas", reason="missing tool: python3-pandas")
 
@@ -63,6 +64,17 @@ def test_a_custom_observer_answers_and_is_stored_as_its_own_kind(gl, tmp_path):
     v = t["views"][0]
     assert v["displayed_cd_m2"].shape == v["background_cd_m2"].shape and v["displayed_cd_m2"].ndim == 2
     assert v["focal_px"] == pytest.approx(0.9 * 320 / 0.1)
+    # The codes it was shown, decoded independently (the scene's sRGB display:
+    # each channel between its Rec.709 share of black and of peak, IEC 61966-2-1),
+    # sum to the displayed luminance it was given.
+    assert v["codes"].shape == v["displayed_cd_m2"].shape + (3,) and v["codes"].dtype == np.uint16
+    assert v["bits"] == 8 and v["codes"].max() > 0
+    d = atonlab.Scene.load(str(TINY.parent / "small.scene.toml")).render().display
+    assert d["transfer"] == "srgb"
+    share = rec709_luminance_shares()
+    black, white = share * d["black_cd_m2"], share * d["peak_cd_m2"]
+    decoded = (black + (white - black) * srgb_eotf(v["codes"] / 255.0)).sum(axis=2)
+    np.testing.assert_allclose(v["displayed_cd_m2"], decoded, rtol=1e-5, atol=1e-9)
     # The answers are the energy observer's: the stored responses follow from what it was shown.
     assert list(df["response"]) == [brighter(t) for t in seen]
 

@@ -65,7 +65,7 @@ TEST(AnalysisCsv, MinimalColumnsGiveOutcomesAndSessions) {
     EXPECT_NE(d.trials[0].session, d.trials[2].session);
     EXPECT_EQ(d.trials[1].trial_index, 1);
     EXPECT_EQ(d.trials[2].trial_index, 0);
-    EXPECT_EQ(d.trials[0].task, Task::TwoAfc);
+    EXPECT_EQ(d.trials[0].task, protocols::Task::TwoAfc);
     EXPECT_EQ(d.trials[0].level_scale, "log10");
 }
 
@@ -155,7 +155,7 @@ TEST(AnalysisStudy, ReadsEveryTrialWithItsStimulusParameters) {
     ASSERT_EQ(d.sessions.size(), 1u);
     ASSERT_EQ(d.trials.size(), 2u * 7u * 2u);  // 2 conditions x 7 levels x 2 repetitions
     const Trial& t = d.trials.front();
-    EXPECT_EQ(t.task, Task::TwoAfc);
+    EXPECT_EQ(t.task, protocols::Task::TwoAfc);
     EXPECT_EQ(t.procedure, "constant-stimuli");
     EXPECT_EQ(t.level_key, "light.reference.intensity_cd");
     EXPECT_EQ(t.level_on, "reference");
@@ -240,7 +240,7 @@ TEST(AnalysisStudy, StaircaseReversalsAndQuestPosteriorsMatchTheProceduresOwn) {
         const p::Protocol protocol = p::parse_protocol(text, "sim.toml");
         std::vector<p::Response> answers;
         for (const Trial& t : d.trials) {
-            if (t.task == Task::TwoAfc)
+            if (t.task == protocols::Task::TwoAfc)
                 answers.push_back(t.response == "left" ? p::Response::Left : p::Response::Right);
             else
                 answers.push_back(t.response == "yes" ? p::Response::Yes : p::Response::No);

@@ -41,7 +41,7 @@ Trial trial(const std::string& condition, double level, std::optional<bool> outc
     t.level = level;
     t.outcome = outcome;
     t.response = outcome ? (*outcome ? "yes" : "no") : "timeout";
-    t.task = Task::YesNo;
+    t.task = protocols::Task::YesNo;
     t.level_on = "test";
     t.level_key = "light.flash.intensity_cd";
     return t;

@@ -49,15 +49,14 @@ private:
 };
 
 void write_manifest(const fs::path& dir, int n_designs) {
-    nlohmann::ordered_json designs = nlohmann::ordered_json::array();
-    for (int d = 0; d < n_designs; ++d)
-        designs.push_back({{"label", fmt::format("repetitions={}", 10 * (d + 1))},
-                           {"overrides", {fmt::format("repetitions={}", 10 * (d + 1))}}});
-    std::ofstream(dir / "simulation.json") << store::dump_json(nlohmann::ordered_json{{"format", "atonlab-simulation"},
-                                                                                      {"version", 1},
-                                                                                      {"protocol", "sim.toml"},
-                                                                                      {"protocol_sha256", "00"},
-                                                                                      {"designs", designs}});
+    SimulationManifest m;
+    for (int d = 0; d < n_designs; ++d) {
+        const std::string o = fmt::format("repetitions={}", 10 * (d + 1));
+        m.designs.push_back(ManifestDesign{o, "sim.toml", "00", {o}, ""});
+    }
+    m.observer_json = "{}";
+    m.decisions = "rendered";
+    std::ofstream(simulation_manifest_path(dir)) << m.json();
 }
 
 /// simulation_json of a session whose conditions' true PSE is `truth`.
@@ -75,9 +74,10 @@ std::string simulation_json(int design, int index, double truth) {
 }
 
 fs::path session_file(const fs::path& dir, int design, int index) {
-    const fs::path folder = dir / "sessions" / fmt::format("{:02}", design);
-    fs::create_directories(folder);
-    return folder / fmt::format("session-{:06}.db", index);
+    const fs::path file =
+        simulation_session_file(dir, static_cast<std::size_t>(design), static_cast<std::size_t>(index));
+    fs::create_directories(file.parent_path());
+    return file;
 }
 
 /// `n` sessions of design `design`: the constant-stimuli glare protocol

@@ -159,18 +159,19 @@ TEST(SimulateParts, ASessionFromATableIsWholeRecomputableAndStoresItsObserverAnd
 }
 
 TEST(SimulateParts, AFolderHoldsOneSimulationAndSaysHowAnotherDiffers) {
-    SimulationManifest m;
-    m.designs = {ManifestDesign{"", "q.toml", "abc", {}, "t1"}};
+    analysis::SimulationManifest m;
+    m.designs = {analysis::ManifestDesign{"", "q.toml", "abc", {}, "t1"}};
     m.seed = 1;
     m.sessions = 10;
     m.observer_json = "{\"eta\":0.0}";
     m.decisions = "table";
-    const SimulationManifest back = SimulationManifest::parse(m.json());
+    const analysis::SimulationManifest back = analysis::SimulationManifest::parse(m.json(), "simulation.json");
     EXPECT_EQ(back.identity_difference(m), "");
-    SimulationManifest more = m;
+    EXPECT_EQ(back.protocol(), "q.toml");
+    analysis::SimulationManifest more = m;
     more.sessions = 20;  // more sessions continue the same simulation
     EXPECT_EQ(m.identity_difference(more), "");
-    SimulationManifest other = m;
+    analysis::SimulationManifest other = m;
     other.designs[0].protocol_sha256 = "def";
     EXPECT_NE(m.identity_difference(other).find("design 0"), std::string::npos);
     other = m;
@@ -183,7 +184,16 @@ TEST(SimulateParts, AFolderHoldsOneSimulationAndSaysHowAnotherDiffers) {
     EXPECT_THROW(read_manifest(dir), InputError);  // someone else's files
     EXPECT_THROW(check_writable("/proc/atonlab-simulation"), InputError);
     EXPECT_THROW(check_writable("/dev/null/x"), InputError);
-    EXPECT_EQ(session_file("D", 2, 17), fs::path("D/sessions/02/session-000017.db"));
+    EXPECT_EQ(analysis::simulation_session_file("D", 2, 17), fs::path("D/sessions/02/session-000017.db"));
+    // What is not a manifest is refused naming the key.
+    EXPECT_THROW(analysis::SimulationManifest::parse("{\"format\":\"atonlab-simulation\",\"version\":2}", "m"),
+                 InputError);
+    try {
+        analysis::SimulationManifest::parse("{\"format\":\"atonlab-simulation\",\"version\":1,\"designs\":[]}", "m");
+        ADD_FAILURE() << "a manifest without designs was read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("designs"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace

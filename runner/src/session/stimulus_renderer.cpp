@@ -73,6 +73,24 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const display::D
     return out;
 }
 
+/// The codes of the n x n pixels from (x0, y0) (row 0 at the top), R, G, B
+/// per pixel; 0 beyond the screen.
+std::vector<std::uint16_t> codes_window(const s::EncodedImage& codes, int x0, int y0, int n) {
+    std::vector<std::uint16_t> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n) * 3, 0);
+    for (int v = 0; v < n; ++v) {
+        const int y = y0 + v;
+        if (y < 0 || y >= codes.height) continue;
+        for (int u = 0; u < n; ++u) {
+            const int x = x0 + u;
+            if (x < 0 || x >= codes.width) continue;
+            const glm::ivec3 code = code_at(codes, x, y);
+            const std::size_t i = (static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)) * 3;
+            for (int ch = 0; ch < 3; ++ch) out[i + static_cast<std::size_t>(ch)] = static_cast<std::uint16_t>(code[ch]);
+        }
+    }
+    return out;
+}
+
 /// The codes of window `w` (n x n pixels from (x0, y0), row 0 at the top)
 /// against the same pixels of `off` (the judged lights off, the same dither
 /// frame; null: none, then the frame is its own background), and the
@@ -307,6 +325,9 @@ std::shared_ptr<const FrameViews> StimulusRenderer::render(const p::Frame& frame
         const bool on_screen = !behind && std::isfinite(centre.x) && std::isfinite(centre.y);
         w.image.luminance_cd_m2 = on_screen ? emitted_window(codes, sc.output.display, x0, y0, n)
                                             : std::vector<float>(static_cast<std::size_t>(n) * n, 0.0f);
+        w.image.codes_rgb = on_screen ? codes_window(codes, x0, y0, n)
+                                      : std::vector<std::uint16_t>(static_cast<std::size_t>(n) * n * 3, 0);
+        w.image.code_bits = codes.bits;
         placed.push_back({{x0, y0}, on_screen});
         out->windows.push_back(std::move(w));
     }

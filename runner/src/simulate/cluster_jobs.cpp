@@ -148,7 +148,7 @@ bool task_done(const fs::path& dir, const SlurmJobs& s, std::size_t task) {
     std::error_code ec;
     for (std::size_t d = 0; d < s.designs; ++d)
         for (std::size_t i = share.first; i < share.first + share.count; ++i)
-            if (!fs::exists(session_file(dir, d, i), ec)) return false;
+            if (!fs::exists(analysis::simulation_session_file(dir, d, i), ec)) return false;
     return true;
 }
 

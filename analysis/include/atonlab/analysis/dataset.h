@@ -26,6 +26,7 @@
 #include "atonlab/analysis/calibration_drift.h"
 #include "atonlab/analysis/scene_lights.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/protocols/protocol.h"
 
 namespace atonlab::analysis {
 
@@ -33,12 +34,6 @@ namespace atonlab::analysis {
 // not a number, a study file given twice) is the one InputError
 // (common/input_error.h): what() is "FILE:LINE: column 'COLUMN': MESSAGE" with
 // the parts that are known (SourceLocation::csv).
-
-/// What the observer was asked (docs/protocol-file.md, `task`).
-enum class Task : std::uint8_t { TwoAfc, YesNo, Adjust };
-/// "2afc", "yes-no", "adjust".
-std::string_view to_string(Task t) noexcept;
-std::optional<Task> parse_task(std::string_view text) noexcept;
 
 /// One trial: one row of the study's `trials` table, or of a CSV.
 struct Trial {
@@ -56,7 +51,7 @@ struct Trial {
     std::string procedure;
 
     // --- what was shown and answered --------------------------------------------
-    Task task = Task::TwoAfc;
+    protocols::Task task = protocols::Task::TwoAfc;
     /// The procedure's level, its own units; from a study file without the
     /// noise of decimal steps summed in binary (-0.30000000000000004 is -0.3:
     /// within 1e-12, docs/analysis.md "trials.csv"; the file keeps it bit for bit).
@@ -105,7 +100,7 @@ struct Trial {
     std::optional<double> quest_mean, quest_sd, quest_lower, quest_upper;
 
     /// An adjustment trial that confirms a match (its level is the match).
-    bool is_match() const noexcept { return task == Task::Adjust && (response == "confirm" || response == "match"); }
+    bool is_match() const noexcept { return task == protocols::Task::Adjust && (response == "confirm" || response == "match"); }
 };
 
 /// A session of a study file (or of a CSV's session column).

@@ -24,28 +24,9 @@
 
 #include "atonlab/analysis/psychometric.h"
 #include "atonlab/analysis/resample.h"
+#include "atonlab/analysis/simulation_manifest.h"
 
 namespace atonlab::analysis {
-
-/// One design of a simulation (a `--vary` value, or one protocol of several).
-struct SimulationDesign {
-    std::string label;                   ///< "max_trials=20"; "" or the protocol's file name for one design
-    std::vector<std::string> overrides;  ///< the overrides that make it, "key=value"
-};
-
-/// DIR/simulation.json (docs/simulate.md, "The simulation folder").
-struct SimulationManifest {
-    std::string protocol;         ///< the protocol's path as given to simulate
-    std::string protocol_sha256;  ///< of its text
-    std::vector<SimulationDesign> designs;
-};
-
-/// Reads DIR/simulation.json. Throws InputError naming the file and key for a
-/// file that is missing, not JSON, of another format or a newer version.
-SimulationManifest read_simulation_manifest(const std::filesystem::path& dir);
-
-/// True when `dir` is a folder holding simulation.json.
-bool is_simulation_folder(const std::filesystem::path& dir);
 
 /// How each session's interval is obtained.
 enum class IntervalMethod : std::uint8_t {

@@ -49,7 +49,7 @@ struct AnalysisOptions {
 /// `mixed` and the first value is shown.
 struct ConditionInfo {
     std::string condition;
-    Task task = Task::TwoAfc;
+    protocols::Task task = protocols::Task::TwoAfc;
     std::string procedure;
     std::string level_key, level_scale, level_on;
     std::optional<double> adaptation_cd_m2;
@@ -76,7 +76,7 @@ struct ConditionInfo {
     std::string level_unit() const;
     /// Glare on the test and not (or differently) on the reference: the glare-brightness question.
     bool compares_glare() const noexcept {
-        return task != Task::YesNo && !glare_test.empty() && glare_test != "none" && glare_test != glare_reference;
+        return task != protocols::Task::YesNo && !glare_test.empty() && glare_test != "none" && glare_test != glare_reference;
     }
     /// Both lights are known from the stored scene.
     bool lights_known() const noexcept { return !test_look.colour.empty() && !reference_look.colour.empty(); }

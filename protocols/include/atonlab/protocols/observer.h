@@ -53,6 +53,12 @@ struct DisplayedImage {
     /// brightness is the whole window's and its increment is over the annulus
     /// mean (see window_light_lux, increment_illuminance_lux).
     std::vector<float> background_cd_m2;
+    /// The display codes the same pixels were given: empty, or width * height * 3
+    /// values (R, G, B; row 0 at the top; 0 beyond the screen) of code_bits bits.
+    /// luminance_cd_m2 is these decoded through the display model. The model
+    /// observer judges the luminance; a custom observer (docs/python.md) gets both.
+    std::vector<std::uint16_t> codes_rgb;
+    int code_bits = 0;
 
     float at(int x, int y) const { return luminance_cd_m2[static_cast<std::size_t>(y) * width + x]; }
     bool has_background() const noexcept { return !background_cd_m2.empty(); }
@@ -181,7 +187,6 @@ private:
     Answer answer_2afc(const Shown& shown);
     Answer answer_yes_no(const Shown& shown);
     Answer answer_adjust(const Shown& shown);
-    double response_time(double delta_over_sigma) const;
 
     ModelObserverParams params_;
     Rng rng_;
@@ -190,6 +195,15 @@ private:
     int last_fine_sign_ = 0;
     int fine_reversals_ = 0;
 };
+
+/// The model observer's response time (s) for a decision of delta_over_sigma:
+/// rt_base_s + rt_hard_s · exp(−|Δ/σ|) (ModelObserverParams).
+double model_response_time_s(const ModelObserverParams& params, double delta_over_sigma);
+/// The standard normal CDF Φ(z) = erfc(−z/√2)/2: 0 at −∞, 1 at +∞.
+double standard_normal_cdf(double z);
+/// The standard normal quantile Φ⁻¹(u) = √2 erf⁻¹(2u − 1) of u in (0, 1), by
+/// Boost.Math: the same on every platform (the model observer's noise draws).
+double standard_normal_quantile(double u);
 
 /// P(yes) of the model for a view (lapses included).
 double model_p_yes(const ModelObserverParams& params, const View& view);
