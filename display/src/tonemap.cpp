@@ -21,6 +21,7 @@ namespace {
 constexpr std::array<std::string_view, 6> kOperatorNames = {"empirical", "perceptual", "reinhard",
                                                             "kakimoto",  "linear",     "clamp"};
 constexpr std::array<std::string_view, 3> kHueNames = {"none", "xyY", "rgb"};
+constexpr std::array<std::string_view, 2> kMesopicNames = {"k2012", "cie191"};
 
 // Rows of the Rec.709 RGB -> XYZ matrix (glm is column-major: m[col][row]).
 glm::dvec3 xyz_row(int row) {
@@ -117,6 +118,17 @@ std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view
     return std::nullopt;
 }
 
+std::string_view mesopic_model_name(MesopicModel m) {
+    return kMesopicNames.at(static_cast<std::size_t>(m));
+}
+
+std::optional<MesopicModel> mesopic_model_from_name(std::string_view name) {
+    for (std::size_t i = 0; i < kMesopicNames.size(); ++i) {
+        if (kMesopicNames[i] == name) return static_cast<MesopicModel>(i);
+    }
+    return std::nullopt;
+}
+
 std::vector<std::string> hue_preservation_names() {
     return {kHueNames.begin(), kHueNames.end()};
 }
@@ -209,6 +221,25 @@ glm::dvec3 scotopic_weights_rgb() {
 
 double scotopic_luminance_rgb(glm::dvec3 rgb) {
     return glm::dot(scotopic_weights_rgb(), glm::max(rgb, glm::dvec3(0.0)));
+}
+
+double mesopic_field_s_p_ratio() {
+    static const double sp = scotopic_to_photopic_ratio(*named_spectrum("d65"));
+    return sp;
+}
+
+double mesopic_field_adaptation(double adaptation_cd_m2) {
+    // CIE 191:2010 MES2 for the field: m of (L_wa, S/P_field) by the standard's own solution.
+    return mesopic_luminance_cd_m2(clamp_adaptation(adaptation_cd_m2), mesopic_field_s_p_ratio()).adaptation_m;
+}
+
+double mesopic_equivalent_cd_m2(double photopic_cd_m2, double scotopic_cd_m2, double adaptation_m) {
+    // CIE 191:2010 MES2 L_mes of the pixel over L_mes of a field-spectrum pixel per cd/m², at one m: the
+    // denominators (m + (1 - m) V'(λ0)) cancel.
+    const double m = std::clamp(adaptation_m, 0.0, 1.0);
+    const double v0 = kMesopicScotopicAt555;
+    const double lp = std::max(photopic_cd_m2, 0.0), ls = std::max(scotopic_cd_m2, 0.0);
+    return (m * lp + (1.0 - m) * v0 * ls) / (m + (1.0 - m) * v0 * mesopic_field_s_p_ratio());
 }
 
 double krawczyk_key(double adaptation_cd_m2) {
@@ -314,11 +345,17 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     const glm::dvec3 c = rgb / sum;
     const double y_w = glm::dot(xyz_row(1), c);
     const double lw = y_w * sum;
-    double v = 0.0;
-    if (s.tone_operator == ToneOperator::perceptual) {
-        v = scotopic_luminance_rgb(rgb);  // linear: adding light never lowers V
+    double ld = 0.0;
+    if (s.mesopic == MesopicModel::cie191) {
+        // CIE 191:2010 MES2: the curve sees the field-spectrum luminance of equal L_mes, and (perceptual)
+        // that pixel's scotopic luminance, so a field-spectrum pixel is drawn as under k2012.
+        const double l_eq = mesopic_equivalent_cd_m2(lw, scotopic_luminance_rgb(rgb), mesopic_field_adaptation(lwa));
+        ld = tone_curve(l_eq, mesopic_field_s_p_ratio() * l_eq, lwa, s);
+    } else {
+        // Linear: adding light never lowers V. Only the perceptual operator's curve reads it.
+        const double v = s.tone_operator == ToneOperator::perceptual ? scotopic_luminance_rgb(rgb) : 0.0;
+        ld = tone_curve(lw, v, lwa, s);
     }
-    const double ld = tone_curve(lw, v, lwa, s);
 
     // Blueshift weights (K2012 eq 4.27-4.29) from the pixel's own luminance L_w (the
     // equations' σ(L_w)) or from the adaptation luminance; the cone weight is L/(σ₀ + L)
@@ -379,7 +416,8 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     const double lda = display_adaptation_cd_m2(s);
     p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
-    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), 0.0f, 0.0f};
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2),
+             s.mesopic == MesopicModel::cie191 ? f(mesopic_field_s_p_ratio()) : 0.0f, 0.0f};
     p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
     const glm::dvec2 bxy = s.blueshift_xy;
     const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));

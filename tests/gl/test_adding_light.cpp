@@ -2,7 +2,8 @@
 // darkens"; the CPU reference's sweep is tests/display/test_adding_light.cpp): a red, a
 // green and a white light 500 m away over a uniform night-to-day sky, rendered by the
 // FrameRenderer with no glare and with the default eye's glare, then tone-mapped and
-// encoded by the DisplayPipeline for every operator × blueshift reading × hue mode on an
+// encoded by the DisplayPipeline for every operator × blueshift reading × hue mode × mesopic
+// model on an
 // 8-bit display. Against the same frame without the light (same dither frame), every
 // pixel of the 41 × 41 window around the light shows at least its displayed luminance
 // (decoded through the display model), to within one code step of each channel (a channel
@@ -90,6 +91,7 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                         o.tonemap.hue_preservation = s.hue_preservation;
                         o.tonemap.blueshift = s.blueshift;
                         o.tonemap.blueshift_luminance = s.blueshift_luminance;
+                        o.tonemap.mesopic = s.mesopic;
                         display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
                         out.push_back(window_of(display.read_codes(), scene.output.display));
                     }
@@ -123,13 +125,14 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                                 // channel of the core).
                                 ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * changed_steps;
                                 if (!ok && failures++ < 8) {
-                                    ADD_FAILURE() << colour << " light, glare " << glare << ", L_wa " << adaptation
-                                                  << ", sky " << sky << ", core x" << core_factor << ", "
-                                                  << tone_operator_name(s.tone_operator) << " hue "
-                                                  << hue_preservation_name(s.hue_preservation) << " blueshift "
-                                                  << s.blueshift << "/" << blueshift_luminance_name(s.blueshift_luminance)
-                                                  << ": window " << with[k].sum_cd_m2 << " against "
-                                                  << reference->sum_cd_m2 << " cd/m2 (summed)";
+                                    ADD_FAILURE()
+                                        << colour << " light, glare " << glare << ", L_wa " << adaptation << ", sky "
+                                        << sky << ", core x" << core_factor << ", "
+                                        << tone_operator_name(s.tone_operator) << " hue "
+                                        << hue_preservation_name(s.hue_preservation) << " blueshift " << s.blueshift
+                                        << "/" << blueshift_luminance_name(s.blueshift_luminance) << " mesopic "
+                                        << mesopic_model_name(s.mesopic) << ": window " << with[k].sum_cd_m2
+                                        << " against " << reference->sum_cd_m2 << " cd/m2 (summed)";
                                 }
                             }
                         }

@@ -79,52 +79,57 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
         double worst_op = 0.0, worst_op_abs = 0.0;
         for (HuePreservation h : hues) {
             for (const int blue : atonlab::test::kBlueshiftModes) {
-                ToneMapSettings s;
-                s.tone_operator = op;
-                s.hue_preservation = h;
-                atonlab::test::set_blueshift(s, blue);
-                if (op == ToneOperator::reinhard) s.reinhard_white_relative = 4.0;  // exercise eq 4
-                const ToneMapGpuParams p = tonemap_gpu_params(s);
-                params.upload(0, sizeof(p), &p);
-                glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
-                glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
-                glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-                out.download(0, n * sizeof(glm::vec4), got.data());
-                double worst = 0.0, worst_abs = 0.0;
-                std::size_t worst_i = 0;
-                int failures = 0;
-                for (std::size_t i = 0; i < n; ++i) {
-                    // The CPU gets exactly the fp32 values the GPU saw.
-                    const glm::dvec3 ref = tonemap_pixel(glm::dvec3(glm::vec3(px[i])), px[i].a, s);
-                    for (int c = 0; c < 3; ++c) {
-                        const double g = got[i][c], r = ref[c];
-                        ASSERT_TRUE(std::isfinite(g) && g >= 0.0) << i;
-                        const double diff = std::abs(g - r);
-                        // Relative 1e-4, or absolute 1e-6 near 0 (display-relative units).
-                        if (diff > 1e-4 * std::abs(r) && diff > 1e-6 && failures++ < 5) {
-                            ADD_FAILURE() << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
-                                          << atonlab::test::blueshift_label(blue) << " pixel " << i << " channel " << c
-                                          << ": gpu " << g << " cpu " << r << " (rgb " << px[i].r << "," << px[i].g
-                                          << "," << px[i].b << " adaptation " << px[i].a << ")";
-                        }
-                        if (std::abs(r) > 1e-6) {
-                            if (diff / std::abs(r) > worst) {
-                                worst = diff / std::abs(r);
-                                worst_i = i;
+                for (const MesopicModel mes : {MesopicModel::k2012, MesopicModel::cie191}) {
+                    ToneMapSettings s;
+                    s.tone_operator = op;
+                    s.hue_preservation = h;
+                    s.mesopic = mes;
+                    atonlab::test::set_blueshift(s, blue);
+                    if (op == ToneOperator::reinhard) s.reinhard_white_relative = 4.0;  // exercise eq 4
+                    const ToneMapGpuParams p = tonemap_gpu_params(s);
+                    params.upload(0, sizeof(p), &p);
+                    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
+                    glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
+                    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+                    out.download(0, n * sizeof(glm::vec4), got.data());
+                    double worst = 0.0, worst_abs = 0.0;
+                    std::size_t worst_i = 0;
+                    int failures = 0;
+                    for (std::size_t i = 0; i < n; ++i) {
+                        // The CPU gets exactly the fp32 values the GPU saw.
+                        const glm::dvec3 ref = tonemap_pixel(glm::dvec3(glm::vec3(px[i])), px[i].a, s);
+                        for (int c = 0; c < 3; ++c) {
+                            const double g = got[i][c], r = ref[c];
+                            ASSERT_TRUE(std::isfinite(g) && g >= 0.0) << i;
+                            const double diff = std::abs(g - r);
+                            // Relative 1e-4, or absolute 1e-6 near 0 (display-relative units).
+                            if (diff > 1e-4 * std::abs(r) && diff > 1e-6 && failures++ < 5) {
+                                ADD_FAILURE()
+                                    << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
+                                    << atonlab::test::blueshift_label(blue) << " mesopic " << mesopic_model_name(mes)
+                                    << " pixel " << i << " channel " << c << ": gpu " << g << " cpu " << r << " (rgb "
+                                    << px[i].r << "," << px[i].g << "," << px[i].b << " adaptation " << px[i].a << ")";
                             }
-                        } else {
-                            worst_abs = std::max(worst_abs, diff);
+                            if (std::abs(r) > 1e-6) {
+                                if (diff / std::abs(r) > worst) {
+                                    worst = diff / std::abs(r);
+                                    worst_i = i;
+                                }
+                            } else {
+                                worst_abs = std::max(worst_abs, diff);
+                            }
                         }
                     }
+                    worst_op = std::max(worst_op, worst);
+                    worst_op_abs = std::max(worst_op_abs, worst_abs);
+                    std::printf(
+                        "  %-10s hue %-4s blueshift %-10s mesopic %-6s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), "
+                        "absolute %.2e\n",
+                        std::string(tone_operator_name(op)).c_str(), std::string(hue_preservation_name(h)).c_str(),
+                        atonlab::test::blueshift_label(blue), std::string(mesopic_model_name(mes)).c_str(), worst,
+                        worst_i, luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))),
+                        static_cast<double>(px[worst_i].a), worst_abs);
                 }
-                worst_op = std::max(worst_op, worst);
-                worst_op_abs = std::max(worst_op_abs, worst_abs);
-                std::printf(
-                    "  %-10s hue %-4s blueshift %-10s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), absolute %.2e\n",
-                    std::string(tone_operator_name(op)).c_str(), std::string(hue_preservation_name(h)).c_str(),
-                    atonlab::test::blueshift_label(blue), worst, worst_i,
-                    luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))), static_cast<double>(px[worst_i].a),
-                    worst_abs);
             }
         }
         std::printf("worst GPU-vs-CPU error, %-10s: relative %.2e, absolute (near 0) %.2e\n",

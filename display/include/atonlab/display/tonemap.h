@@ -60,6 +60,14 @@ enum class BlueshiftLuminance : std::uint8_t {
 std::string_view blueshift_luminance_name(BlueshiftLuminance b);  ///< "adaptation", "pixel"
 std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name);
 
+/// Which luminance the tone curve aims for (tonemap.mesopic; docs/tone-mapping.md "The mesopic variant").
+enum class MesopicModel : std::uint8_t {
+    k2012 = 0,   ///< each operator's own: photopic L_w, and perceptual's rods by eq 4.21-4.26 (K2012)
+    cie191 = 1,  ///< the pixel's MES2 mesopic luminance (CIE 191:2010) with m from the adaptation field
+};
+std::string_view mesopic_model_name(MesopicModel m);  ///< "k2012", "cie191"
+std::optional<MesopicModel> mesopic_model_from_name(std::string_view name);
+
 std::string_view hue_preservation_name(HuePreservation h);  ///< "none", "xyY", "rgb"
 std::optional<HuePreservation> hue_preservation_from_name(std::string_view name);
 std::vector<std::string> hue_preservation_names();
@@ -127,6 +135,10 @@ struct ToneMapSettings {
     glm::dvec2 blueshift_xy{0.3, 0.3};
 
     HuePreservation hue_preservation = HuePreservation::xyY;
+
+    /// The luminance the tone curve aims for: K2012's (default) or CIE 191:2010's MES2 mesopic
+    /// luminance of the pixel's (L_p, L_s) with m of the adaptation field (mesopic_equivalent_cd_m2).
+    MesopicModel mesopic = MesopicModel::k2012;
 };
 
 /// Throws InputError naming the key ("tonemap.white_relative", ...) in its SourceLocation
@@ -174,6 +186,24 @@ double scotopic_luminance(glm::dvec3 xyz);
 /// ratios and D65 white its S/P (2.4645); docs/tone-mapping.md "Scotopic weights".
 double scotopic_luminance_rgb(glm::dvec3 rgb_cd_m2);
 glm::dvec3 scotopic_weights_rgb();  ///< the weights w above, scotopic cd/m² per cd/m² of each channel
+
+/// S/P ratio the cie191 variant gives the adaptation field: D65's (2.4645, scotopic_to_photopic_ratio of
+/// the CIE D65 table). The pipeline adapts to a photopic log-average only; its sky defaults to D65.
+double mesopic_field_s_p_ratio();
+
+/// CIE 191:2010 (MES2) adaptation coefficient m of the adaptation field L_wa (cd/m², clamped as in
+/// tonemap_pixel) of S/P mesopic_field_s_p_ratio(): mesopic_luminance_cd_m2(L_wa, S/P).adaptation_m,
+/// 0 at or below 0.005 cd/m², 1 at or above 5 cd/m².
+double mesopic_field_adaptation(double adaptation_cd_m2);
+
+/// The photopic luminance (cd/m²) of a pixel of the field's spectrum (S/P_f = mesopic_field_s_p_ratio())
+/// whose MES2 mesopic luminance at the field's m equals that of a pixel of photopic L_p and scotopic L_s:
+///   L_eq = (m L_p + (1 − m) V'(λ0) L_s) / (m + (1 − m) V'(λ0) S/P_f),  V'(λ0) = 683/1699,
+/// CIE 191:2010's L_mes = (m L_p + (1 − m) L_s V'(λ0)) / (m + (1 − m) V'(λ0)) divided by the same of a
+/// field-spectrum pixel per cd/m². A pixel of the field's spectrum gets L_eq = L_p; the cie191 variant
+/// feeds L_eq to the tone curve, so ratios of displayed luminance follow ratios of L_mes. Linear with
+/// non-negative weights in (L_p, L_s), so adding light never lowers it. m in [0, 1].
+double mesopic_equivalent_cd_m2(double photopic_cd_m2, double scotopic_cd_m2, double adaptation_m);
 
 /// K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1): the scene key
 /// α(L_wa) = 1.002 - 2 / (2 + log10(L_wa + 1)). The thesis drops the "+ 1", which makes
@@ -230,7 +260,7 @@ struct ToneMapGpuParams {
         mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
     std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
     std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), 0, 0
+    std::array<float, 4> tvi{};      ///< log10 ε_C(L_da), σ₀ (cd/m²), field S/P if mesopic = cie191 else 0, 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)
