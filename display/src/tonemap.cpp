@@ -320,9 +320,7 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
             const double log_eps_display = log10_tvi_cone(std::log10(lda));
             const double m_c = std::pow(10.0, log_eps_display - log10_tvi_cone(log_lwa));  // eq 4.22
             const double m_r = std::pow(10.0, log_eps_display - log10_tvi_rod(log_lwa));
-            // V <= 1.33 (1 + kMaxScotopicRatio) Y (scotopic_luminance's cap).
-            const double v_max = 1.33 * (1.0 + kMaxScotopicRatio) * kMaxInputCdM2;
-            const double v = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, v_max) : 0.0;
+            const double v = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, kMaxScotopicCdM2) : 0.0;
             return (m_c * lw + rod_sensitivity(lwa) * m_r * v) / s.display_peak_cd_m2;  // eq 4.26
         }
         case ToneOperator::linear:
@@ -333,6 +331,16 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
 }
 
 glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s) {
+    // Linear in RGB with non-negative weights: adding light never lowers V.
+    const glm::dvec3 rgb(sanitize_component(rgb_cd_m2.r), sanitize_component(rgb_cd_m2.g),
+                         sanitize_component(rgb_cd_m2.b));
+    return tonemap_pixel(rgb, scotopic_luminance_rgb(rgb), adaptation_cd_m2, s);
+}
+
+glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double scotopic_cd_m2, double adaptation_cd_m2,
+                         const ToneMapSettings& s) {
+    // NaN, negative -> 0; capped where tone_curve caps V (scotopic_luminance's bound at kMaxInputCdM2).
+    const double scotopic = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, kMaxScotopicCdM2) : 0.0;
     const glm::dvec3 rgb(sanitize_component(rgb_cd_m2.r), sanitize_component(rgb_cd_m2.g),
                          sanitize_component(rgb_cd_m2.b));
     const double sum = glm::dot(xyz_sum_row(), rgb);  // X + Y + Z
@@ -349,11 +357,11 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     if (s.mesopic == MesopicModel::cie191) {
         // CIE 191:2010 MES2: the curve sees the field-spectrum luminance of equal L_mes, and (perceptual)
         // that pixel's scotopic luminance, so a field-spectrum pixel is drawn as under k2012.
-        const double l_eq = mesopic_equivalent_cd_m2(lw, scotopic_luminance_rgb(rgb), mesopic_field_adaptation(lwa));
+        const double l_eq = mesopic_equivalent_cd_m2(lw, scotopic, mesopic_field_adaptation(lwa));
         ld = tone_curve(l_eq, mesopic_field_s_p_ratio() * l_eq, lwa, s);
     } else {
-        // Linear: adding light never lowers V. Only the perceptual operator's curve reads it.
-        const double v = s.tone_operator == ToneOperator::perceptual ? scotopic_luminance_rgb(rgb) : 0.0;
+        // Only the perceptual operator's curve reads the rod signal.
+        const double v = s.tone_operator == ToneOperator::perceptual ? scotopic : 0.0;
         ld = tone_curve(lw, v, lwa, s);
     }
 

@@ -2,6 +2,8 @@
 // main, no bindings. Include it, declare a block holding a ToneMapParams (filled on the CPU
 // by tonemap_gpu_params(), tonemap.h, whose ToneMapGpuParams has this exact layout) and call
 //   vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p)
+// or, with the pixel's own scotopic luminance (scotopic cd/m², the frame's scotopic channel),
+//   vec3 tonemap_pixel_scotopic(vec3 rgb_cd_m2, float scotopic_cd_m2, float adaptation_cd_m2, ToneMapParams p)
 // Input: linear Rec.709 RGB in cd/m²; output: display-relative linear Rec.709 RGB
 // (1 = display peak), never negative or NaN.
 //
@@ -152,7 +154,9 @@ float tone_curve(float lw, float vw, float lwa, ToneMapParams p) {
     return lw / white;
 }
 
-vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
+// scotopic_cd_m2: the pixel's scotopic luminance (the frame's scotopic channel), or < 0 for none:
+// then V = the scotopic weights · RGB (scotopic_luminance_rgb()). NaN counts as 0 (tonemap.cpp).
+vec3 tonemap_pixel_scotopic(vec3 rgb_cd_m2, float scotopic_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     // Clip to [0, max]; the comparisons send NaN to 0 (and NaN adaptation to the minimum).
     vec3 rgb = vec3(rgb_cd_m2.r > 0.0 ? min(rgb_cd_m2.r, TM_MAX_INPUT) : 0.0,
                     rgb_cd_m2.g > 0.0 ? min(rgb_cd_m2.g, TM_MAX_INPUT) : 0.0,
@@ -166,15 +170,18 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     float y_w = dot(p.rgb_to_y.xyz, c);
     if (!(y_w > 0.0)) return vec3(0.0);
     float lw = y_w * sum;
+    // scotopic_luminance_rgb(): linear, so adding light never lowers V
+    const float v_max = 1.33 * (1.0 + TM_MAX_SCOTOPIC_RATIO) * TM_MAX_INPUT;  // kMaxScotopicCdM2
+    float v_in = scotopic_cd_m2 < 0.0 ? dot(p.scotopic.xyz, rgb)
+                                      : (scotopic_cd_m2 > 0.0 ? min(scotopic_cd_m2, v_max) : 0.0);
     float ld;
     if (p.tvi.z > 0.0) {
         // mesopic = cie191 (tonemap.cpp): the curve sees the field-spectrum luminance of equal L_mes.
         float sp = p.tvi.z;
-        float l_eq = tm_mesopic_equivalent(lw, dot(p.scotopic.xyz, rgb), tm_mesopic_m(lwa, sp), sp);
+        float l_eq = tm_mesopic_equivalent(lw, v_in, tm_mesopic_m(lwa, sp), sp);
         ld = tone_curve(l_eq, sp * l_eq, lwa, p);
     } else {
-        // scotopic_luminance_rgb(): linear, so adding light never lowers V
-        float v = p.mode.x == TONE_PERCEPTUAL ? dot(p.scotopic.xyz, rgb) : 0.0;
+        float v = p.mode.x == TONE_PERCEPTUAL ? v_in : 0.0;
         ld = tone_curve(lw, v, lwa, p);
     }
 
@@ -202,6 +209,10 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     }
     if (p.mode.x == TONE_CLAMP) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);  // luminance first (tonemap.cpp)
     return max(outc, vec3(0.0));
+}
+
+vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
+    return tonemap_pixel_scotopic(rgb_cd_m2, -1.0, adaptation_cd_m2, p);
 }
 
 #endif  // ATONLAB_TONEMAP_GLSL

@@ -104,5 +104,25 @@ TEST(MesopicVariant, DisplayedLuminanceStandsInMes2sRatios) {
     }
 }
 
+TEST(MesopicVariant, TheRodSignalIsThePixelsScotopicLuminanceWhenGiven) {
+    // tonemap_pixel(rgb, V, ...) takes V as the rod signal (the frame's scotopic channel); without V
+    // it is the RGB weights' V. With V = the weights' V the two agree; a green pixel carrying its
+    // die's S/P (5.38 per cd/m²) is drawn brighter at night than with the drawn chromaticity's weights.
+    const glm::dvec3 green = *iala_colour_rgb("green") / luminance_of_linear_rgb(*iala_colour_rgb("green")) * 0.003;
+    for (const MesopicModel mes : {MesopicModel::k2012, MesopicModel::cie191}) {
+        ToneMapSettings s;
+        s.tone_operator = ToneOperator::perceptual;
+        s.mesopic = mes;
+        const glm::dvec3 a = tonemap_pixel(green, 0.01, s),
+                         b = tonemap_pixel(green, scotopic_luminance_rgb(green), 0.01, s);
+        for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(a[c], b[c]) << mesopic_model_name(mes);
+        const double die = luminance_of_linear_rgb(tonemap_pixel(green, sp_of("green") * 0.003, 0.01, s));
+        EXPECT_GT(die, 1.5 * luminance_of_linear_rgb(a)) << mesopic_model_name(mes);
+        // NaN and negative V count as 0.
+        EXPECT_EQ(tonemap_pixel(green, std::nan(""), 0.01, s), tonemap_pixel(green, 0.0, 0.01, s));
+        EXPECT_EQ(tonemap_pixel(green, -1.0, 0.01, s), tonemap_pixel(green, 0.0, 0.01, s));
+    }
+}
+
 }  // namespace
 }  // namespace atonlab::display

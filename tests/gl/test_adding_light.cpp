@@ -9,7 +9,7 @@
 // (decoded through the display model), to within one code step of each channel (a channel
 // whose drive falls as the chroma turns may round down alone: see the CPU test), the
 // window's sum is at least the sky's and does not fall as the light brightens (to within
-// half a code step of each pixel the light changes). The suite's bounded form checks each
+// 0.75 of a code step of each pixel the light changes). The suite's bounded form checks each
 // setting in a third of the scenes (every setting and every scene still checked, the
 // settings of a scene rotating with it); ATONLAB_LONG_TESTS=1 checks every setting in
 // every scene.
@@ -92,7 +92,9 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                         o.tonemap.blueshift = s.blueshift;
                         o.tonemap.blueshift_luminance = s.blueshift_luminance;
                         o.tonemap.mesopic = s.mesopic;
-                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
+                        // The frame's scotopic channel, as the pipeline uses it (pipeline.cpp).
+                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure(),
+                                        true);
                         out.push_back(window_of(display.read_codes(), scene.output.display));
                     }
                     return out;
@@ -118,12 +120,14 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                                     if (with[k].pixel_cd_m2[i] != reference->pixel_cd_m2[i]) changed_steps += step;
                                     ok = ok && reference->pixel_cd_m2[i] - with[k].pixel_cd_m2[i] <= step * (1.0 + 1e-9);
                                 }
-                                // The sum: to within half a code step of each pixel the light changes (a
-                                // light that turns a pixel's chroma may round one channel down by a step
-                                // while the others' rise is still below one, in each of the few pixels
-                                // a faint light touches; the reported failure was 4-6 codes in every
-                                // channel of the core).
-                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * changed_steps;
+                                // The sum: to within 0.75 of a code step of each pixel the light changes
+                                // (a light that turns a pixel's chroma may round one channel down by a
+                                // step while the others' rise is still below one, in each of the few
+                                // pixels a faint light touches: green, 0.7152 of a grey step, at most;
+                                // measured 0.69 of one pixel's step, a red light adding 10 % of a
+                                // 0.001 cd/m² sky under cie191; the reported failure was 4-6 codes in
+                                // every channel of the core).
+                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.75 * changed_steps;
                                 if (!ok && failures++ < 8) {
                                     ADD_FAILURE()
                                         << colour << " light, glare " << glare << ", L_wa " << adaptation << ", sky "
@@ -132,7 +136,8 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                                         << hue_preservation_name(s.hue_preservation) << " blueshift " << s.blueshift
                                         << "/" << blueshift_luminance_name(s.blueshift_luminance) << " mesopic "
                                         << mesopic_model_name(s.mesopic) << ": window " << with[k].sum_cd_m2
-                                        << " against " << reference->sum_cd_m2 << " cd/m2 (summed)";
+                                        << " against " << reference->sum_cd_m2
+                                        << " cd/m2 (summed; the changed pixels' code steps " << changed_steps << ")";
                                 }
                             }
                         }

@@ -93,6 +93,9 @@ inline constexpr double kMaxInputCdM2 = 1e15;
 /// (Y+Z)/X of a real colour is at most 274 (monochromatic light at 504 nm, where x̄ is
 /// smallest); scotopic_luminance() caps the ratio here so that X -> 0 stays finite.
 inline constexpr double kMaxScotopicRatio = 1000.0;
+/// The largest scotopic luminance the tone curve takes (scotopic cd/m²): scotopic_luminance()'s bound
+/// 1.33 (1 + kMaxScotopicRatio) kMaxInputCdM2; larger values (and +inf) are capped to it.
+inline constexpr double kMaxScotopicCdM2 = 1.33 * (1.0 + kMaxScotopicRatio) * kMaxInputCdM2;
 
 /// Parameters of the tone-mapping stage. Units in every name; defaults follow K2012.
 /// validate_tonemap_settings() says which values are allowed.
@@ -249,6 +252,13 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
 /// clamp and in eq 4.28/4.30's hue-preserving modes). Settings must be valid
 /// (validate_tonemap_settings).
 glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s);
+
+/// The same with the pixel's own scotopic luminance (scotopic cd/m², the V'-weighted channel the renderer
+/// carries beside RGB from each light's spectrum; docs/tone-mapping.md "The scotopic channel"): the rod
+/// signal of the perceptual operator and cie191's L_s. The overload above uses scotopic_luminance_rgb(rgb).
+/// Negative or NaN scotopic luminance counts as 0.
+glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double scotopic_cd_m2, double adaptation_cd_m2,
+                         const ToneMapSettings& s);
 
 // ---------------------------------------------------------------------------
 // The GPU twin's parameters: `struct ToneMapParams` of tonemap.glsl, byte for byte (all
