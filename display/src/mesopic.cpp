@@ -15,10 +15,9 @@ namespace {
 // CIE 191:2010 MES2: m = a + b log10(L_mes). a and b as the report prints them; note that they put m = 1
 // at L_mes = 10^((1 - a)/b) = 4.998 cd/m² and m = 0 at 10^(-a/b) = 0.005005 cd/m², the ends of the
 // mesopic range to the printed precision.
-constexpr double kMesopicA = 0.7670;
-constexpr double kMesopicB = 0.3334;
-// V'(lambda_0) at lambda_0 = 555 nm as CIE 191:2010 writes it: 683/1699 (= 0.402, the table's V'(555)).
-constexpr double kScotopicAt555 = 683.0 / 1699.0;
+constexpr double kMesopicA = kMesopicAdaptationA;
+constexpr double kMesopicB = kMesopicAdaptationB;
+constexpr double kScotopicAt555 = kMesopicScotopicAt555;
 
 // The standard's fixed-point iteration stops when m moves by less than this; m's own precision (the
 // printed a and b have 4 decimals) is far coarser.

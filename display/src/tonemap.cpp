@@ -21,6 +21,7 @@ namespace {
 constexpr std::array<std::string_view, 6> kOperatorNames = {"empirical", "perceptual", "reinhard",
                                                             "kakimoto",  "linear",     "clamp"};
 constexpr std::array<std::string_view, 3> kHueNames = {"none", "xyY", "rgb"};
+constexpr std::array<std::string_view, 2> kMesopicNames = {"k2012", "cie191"};
 
 // Rows of the Rec.709 RGB -> XYZ matrix (glm is column-major: m[col][row]).
 glm::dvec3 xyz_row(int row) {
@@ -114,6 +115,17 @@ std::string_view blueshift_luminance_name(BlueshiftLuminance b) {
 std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name) {
     if (name == "adaptation") return BlueshiftLuminance::adaptation;
     if (name == "pixel") return BlueshiftLuminance::pixel;
+    return std::nullopt;
+}
+
+std::string_view mesopic_model_name(MesopicModel m) {
+    return kMesopicNames.at(static_cast<std::size_t>(m));
+}
+
+std::optional<MesopicModel> mesopic_model_from_name(std::string_view name) {
+    for (std::size_t i = 0; i < kMesopicNames.size(); ++i) {
+        if (kMesopicNames[i] == name) return static_cast<MesopicModel>(i);
+    }
     return std::nullopt;
 }
 
@@ -211,6 +223,25 @@ double scotopic_luminance_rgb(glm::dvec3 rgb) {
     return glm::dot(scotopic_weights_rgb(), glm::max(rgb, glm::dvec3(0.0)));
 }
 
+double mesopic_field_s_p_ratio() {
+    static const double sp = scotopic_to_photopic_ratio(*named_spectrum("d65"));
+    return sp;
+}
+
+double mesopic_field_adaptation(double adaptation_cd_m2) {
+    // CIE 191:2010 MES2 for the field: m of (L_wa, S/P_field) by the standard's own solution.
+    return mesopic_luminance_cd_m2(clamp_adaptation(adaptation_cd_m2), mesopic_field_s_p_ratio()).adaptation_m;
+}
+
+double mesopic_equivalent_cd_m2(double photopic_cd_m2, double scotopic_cd_m2, double adaptation_m) {
+    // CIE 191:2010 MES2 L_mes of the pixel over L_mes of a field-spectrum pixel per cd/m², at one m: the
+    // denominators (m + (1 - m) V'(λ0)) cancel.
+    const double m = std::clamp(adaptation_m, 0.0, 1.0);
+    const double v0 = kMesopicScotopicAt555;
+    const double lp = std::max(photopic_cd_m2, 0.0), ls = std::max(scotopic_cd_m2, 0.0);
+    return (m * lp + (1.0 - m) * v0 * ls) / (m + (1.0 - m) * v0 * mesopic_field_s_p_ratio());
+}
+
 double krawczyk_key(double adaptation_cd_m2) {
     // K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1). Written as
     // 0.002 + δ/(2 + δ), δ = log10(1 + L) — algebraically 1.002 - 2/(2 + δ) — so that the
@@ -289,9 +320,7 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
             const double log_eps_display = log10_tvi_cone(std::log10(lda));
             const double m_c = std::pow(10.0, log_eps_display - log10_tvi_cone(log_lwa));  // eq 4.22
             const double m_r = std::pow(10.0, log_eps_display - log10_tvi_rod(log_lwa));
-            // V <= 1.33 (1 + kMaxScotopicRatio) Y (scotopic_luminance's cap).
-            const double v_max = 1.33 * (1.0 + kMaxScotopicRatio) * kMaxInputCdM2;
-            const double v = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, v_max) : 0.0;
+            const double v = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, kMaxScotopicCdM2) : 0.0;
             return (m_c * lw + rod_sensitivity(lwa) * m_r * v) / s.display_peak_cd_m2;  // eq 4.26
         }
         case ToneOperator::linear:
@@ -302,6 +331,16 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
 }
 
 glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s) {
+    // Linear in RGB with non-negative weights: adding light never lowers V.
+    const glm::dvec3 rgb(sanitize_component(rgb_cd_m2.r), sanitize_component(rgb_cd_m2.g),
+                         sanitize_component(rgb_cd_m2.b));
+    return tonemap_pixel(rgb, scotopic_luminance_rgb(rgb), adaptation_cd_m2, s);
+}
+
+glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double scotopic_cd_m2, double adaptation_cd_m2,
+                         const ToneMapSettings& s) {
+    // NaN, negative -> 0; capped where tone_curve caps V (scotopic_luminance's bound at kMaxInputCdM2).
+    const double scotopic = scotopic_cd_m2 > 0.0 ? std::min(scotopic_cd_m2, kMaxScotopicCdM2) : 0.0;
     const glm::dvec3 rgb(sanitize_component(rgb_cd_m2.r), sanitize_component(rgb_cd_m2.g),
                          sanitize_component(rgb_cd_m2.b));
     const double sum = glm::dot(xyz_sum_row(), rgb);  // X + Y + Z
@@ -314,11 +353,17 @@ glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const To
     const glm::dvec3 c = rgb / sum;
     const double y_w = glm::dot(xyz_row(1), c);
     const double lw = y_w * sum;
-    double v = 0.0;
-    if (s.tone_operator == ToneOperator::perceptual) {
-        v = scotopic_luminance_rgb(rgb);  // linear: adding light never lowers V
+    double ld = 0.0;
+    if (s.mesopic == MesopicModel::cie191) {
+        // CIE 191:2010 MES2: the curve sees the field-spectrum luminance of equal L_mes, and (perceptual)
+        // that pixel's scotopic luminance, so a field-spectrum pixel is drawn as under k2012.
+        const double l_eq = mesopic_equivalent_cd_m2(lw, scotopic, mesopic_field_adaptation(lwa));
+        ld = tone_curve(l_eq, mesopic_field_s_p_ratio() * l_eq, lwa, s);
+    } else {
+        // Only the perceptual operator's curve reads the rod signal.
+        const double v = s.tone_operator == ToneOperator::perceptual ? scotopic : 0.0;
+        ld = tone_curve(lw, v, lwa, s);
     }
-    const double ld = tone_curve(lw, v, lwa, s);
 
     // Blueshift weights (K2012 eq 4.27-4.29) from the pixel's own luminance L_w (the
     // equations' σ(L_w)) or from the adaptation luminance; the cone weight is L/(σ₀ + L)
@@ -381,7 +426,8 @@ ToneMapGpuParams tonemap_gpu_params(const ToneMapSettings& s) {
     const double lda = display_adaptation_cd_m2(s);
     p.display = {f(s.kakimoto_k), f(s.white_cd_m2.value_or(0.0)), f(s.display_peak_cd_m2), f(lda)};
     const glm::dvec3 b = blueshift_rgb(s.blueshift_xy);
-    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(static_cast<double>(s.out_of_gamut)), 0.0f};
+    p.tvi = {f(log10_tvi_cone(std::log10(lda))), f(kRodSigmaCdM2), f(static_cast<double>(s.out_of_gamut)),
+             s.mesopic == MesopicModel::cie191 ? f(mesopic_field_s_p_ratio()) : 0.0f};
     p.blue_rgb = {f(b.r), f(b.g), f(b.b), f(s.blueshift_xy.y)};
     const glm::dvec2 bxy = s.blueshift_xy;
     const glm::dvec3 c_b = xyz_to_linear_rgb(glm::dvec3(bxy, 1.0 - bxy.x - bxy.y));

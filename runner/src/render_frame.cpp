@@ -46,7 +46,7 @@ RenderedFrame render_frame(stimuli::Pipeline& pipeline, const stimuli::Scene& sc
     const double adapted = pipeline.display().adaptation_cd_m2();
     meta.strings["tonemap"] = fmt::format(
         "operator={} adaptation={} adapted_cd_m2={:.6g} blueshift={} hue_preservation={} display={} peak_cd_m2={} "
-        "black_cd_m2={} bits={}{}",
+        "black_cd_m2={} bits={}{}{}",
         display::tone_operator_name(scene.output.tonemap.tone_operator),
         scene.output.adaptation.mode == stimuli::AdaptationMode::dynamic ? "dynamic" : "fixed", adapted,
         scene.output.tonemap.blueshift
@@ -54,7 +54,9 @@ RenderedFrame render_frame(stimuli::Pipeline& pipeline, const stimuli::Scene& sc
             : std::string("off"),
         display::hue_preservation_name(scene.output.tonemap.hue_preservation), scene.output.display.name,
         scene.output.display.peak_cd_m2, scene.output.display.black_cd_m2, scene.output.encode.bits,
-        scene.output.ldr_glare ? " ldr_glare" : "");
+        scene.output.ldr_glare ? " ldr_glare" : "",
+        // Named only when not the default, so the default's metadata stays as it was.
+        scene.output.tonemap.mesopic == display::MesopicModel::cie191 ? " mesopic=cie191" : "");
     std::string& glare_note = out.glare_note;
     for (const auto& g : renderer.glare().report()) {
         const std::string line = fmt::format(

@@ -14,6 +14,7 @@ uniform float sky_luminance;    // cd/m²
 uniform float sea_f0;           // Schlick R_F(0°)
 uniform int sky_sea;            // 0: uniform field
 uniform float pre_exposure;     // the HDR target stores luminance × pre_exposure (frame_renderer.h)
+uniform float sky_s_p;          // S/P of the sky's spectrum (D65: 2.4645), for the scotopic channel
 
 void main() {
     vec3 dir_view = normalize(vec3((gl_FragCoord.xy - principal_px) / focal_px, -1.0));
@@ -27,6 +28,7 @@ void main() {
         float t = eye_position_m.y / cos_i;
         depth = t * -dir_view.z;
     }
-    radiance = vec4(vec3(L * pre_exposure), 1.0);
+    // alpha: the scotopic channel (scotopic cd/m² × pre-exposure; docs/tone-mapping.md).
+    radiance = vec4(vec3(L * pre_exposure), L * pre_exposure * sky_s_p);
     view_depth = depth;
 }

@@ -2,7 +2,9 @@
 // the background, area-weighted at its edge. disc.h is the CPU reference and
 // says why the coverage below is the pixel's covered area. Blended with
 // (SRC_ALPHA, ONE_MINUS_SRC_ALPHA): L = (1 − c) L_below + c L_disc, so the
-// inside holds the disc's luminance exactly (c = 1). Not a light: no glare.
+// inside holds the disc's luminance exactly (c = 1). Not a light: no glare. The
+// scotopic channel (alpha) blends the same way through the blend constant
+// (frame_renderer.cpp): a = (1 − c) a_below + c V_disc.
 layout(location = 0) out vec4 radiance;
 
 uniform vec2 principal_px;  // image centre (px, window coordinates)

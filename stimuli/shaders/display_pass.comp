@@ -21,6 +21,9 @@ layout(std430, binding = 8) writeonly buffer Codes { uvec2 codes[]; };  // (r | 
 
 uniform ivec2 size;
 uniform uint frame_index;
+// 1: the input's alpha holds the pixel's scotopic luminance (scotopic cd/m², × pre-exposure like RGB;
+// the FrameRenderer's frames, docs/tone-mapping.md "The scotopic channel"); 0: V from RGB's weights.
+uniform int scotopic_alpha;
 #if !defined(LDR_PATH)
 uniform float inv_pre_exposure;  // the frame holds cd/m² × pre-exposure (frame_renderer.h)
 #endif
@@ -38,9 +41,11 @@ void main() {
 #if defined(LDR_PATH)
     vec3 scene = max(texelFetch(frame_in, p, 0).rgb, vec3(0.0));
     if (ldr_scale > 0.0) scene = min(scene * ldr_scale, vec3(1.0));
-    vec3 relative = scene + tonemap_pixel(texelFetch(glare_hdr, p, 0).rgb, adaptation, tone);
+    vec4 g = texelFetch(glare_hdr, p, 0);
+    vec3 relative = scene + tonemap_pixel_scotopic(g.rgb, scotopic_alpha != 0 ? g.a : -1.0, adaptation, tone);
 #else
-    vec3 relative = tonemap_pixel(texelFetch(frame_in, p, 0).rgb * inv_pre_exposure, adaptation, tone);
+    vec4 hdr = texelFetch(frame_in, p, 0) * inv_pre_exposure;
+    vec3 relative = tonemap_pixel_scotopic(hdr.rgb, scotopic_alpha != 0 ? hdr.a : -1.0, adaptation, tone);
 #endif
     uvec3 c = encode_pixel(relative, p, frame_index, display);
     codes[p.y * size.x + p.x] = uvec2(c.r | (c.g << 16), c.b);

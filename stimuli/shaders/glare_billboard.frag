@@ -17,6 +17,7 @@ uniform float pre_exposure;  // the HDR target stores luminance × pre_exposure 
 
 flat in vec2 g_centre;
 flat in vec3 g_illuminance;
+flat in float g_s_p;
 flat in float g_layer;
 
 layout(location = 0) out vec4 radiance;
@@ -43,5 +44,9 @@ void main() {
     if (all(lessThanEqual(K, vec3(0.0)))) discard;
     vec2 p0 = floor(gl_FragCoord.xy);
     float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);
-    radiance = vec4(g_illuminance * K / omega * pre_exposure, 0.0);
+    // alpha: the scotopic channel, S/P × this pixel's photopic luminance. Its sum over the billboard is
+    // S/P × E_Y (each kernel channel sums to 1); its shape is the kernel's luminance-weighted mix
+    // (the V'-weighted PSF is not computed: docs/tone-mapping.md "The scotopic channel").
+    vec3 rgb = g_illuminance * K / omega * pre_exposure;
+    radiance = vec4(rgb, g_s_p * dot(vec3(0.2126, 0.7152, 0.0722), rgb));
 }

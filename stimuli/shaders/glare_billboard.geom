@@ -28,6 +28,7 @@ uniform int layer_count;
 
 flat out vec2 g_centre;
 flat out vec3 g_illuminance;
+flat out float g_s_p;  // S/P of the light's spectrum (LightDraw skip.w)
 flat out float g_layer;
 
 void main() {
@@ -45,6 +46,7 @@ void main() {
         vec2 corner = vec2(k & 1, (k >> 1) & 1) * 2.0 - 1.0;
         g_centre = c;
         g_illuminance = d.illuminance.rgb;
+        g_s_p = d.skip.w;
         g_layer = layer;
         gl_Position = vec4((c + corner * extent) / image_size * 2.0 - 1.0, 0.0, 1.0);
         EmitVertex();

@@ -7,6 +7,7 @@ flat in vec2 v_centre;
 flat in float v_area;
 flat in float v_radius;
 flat in vec3 v_illuminance;
+flat in float v_scotopic;
 
 uniform vec2 image_size;
 uniform float focal_px;
@@ -21,5 +22,6 @@ void main() {
     if (c <= 0.0) discard;
     float omega = pixel_solid_angle(p0 + 0.5 - 0.5 * image_size, focal_px);
     // The footprint holds max(A, 1) px² in all: A for a disc, 1 for the box.
-    radiance = vec4(v_illuminance * (c / (max(v_area, 1.0) * omega)) * pre_exposure, 0.0);
+    // alpha: the scotopic channel (scotopic cd/m², the light's own S/P; docs/tone-mapping.md).
+    radiance = vec4(v_illuminance, v_scotopic) * (c / (max(v_area, 1.0) * omega) * pre_exposure);
 }

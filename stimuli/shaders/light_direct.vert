@@ -15,12 +15,14 @@ flat out vec2 v_centre;
 flat out float v_area;
 flat out float v_radius;  // disc radius (px), for disc footprints
 flat out vec3 v_illuminance;
+flat out float v_scotopic;  // scotopic illuminance (scotopic lux): S/P (skip.w) × the photopic lux
 
 void main() {
     LightDraw d = draws[gl_InstanceID];
     v_centre = d.centre.xy;
     v_area = d.centre.w;
     v_illuminance = d.illuminance.rgb;
+    v_scotopic = d.skip.w * dot(vec3(0.2126, 0.7152, 0.0722), d.illuminance.rgb);
     v_radius = sqrt(max(d.centre.w, 0.0) / 3.14159265358979);
     if (d.centre.w <= 0.0 || (path >= 0 && int(d.skip.z) != path)) {  // not drawn: a degenerate quad outside the clip volume
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);

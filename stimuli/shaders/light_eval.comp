@@ -53,7 +53,8 @@ void main() {
     float invisible = L.rhythm_period.y;  // lux (Y); 0: never culled or cropped
     uint path = L.rhythm.w;  // scene.h GlarePath of the light's own glare model, else the eye's
     bool billboard = path == 1u;
-    d.skip = vec4(0.0, invisible, float(path), 0.0);
+    // w: the S/P of the light's spectrum (scotopic cd/m² per cd/m²), for the frame's scotopic channel.
+    d.skip = vec4(0.0, invisible, float(path), L.rhythm_period.z);
 
     vec3 v = view_from_world * L.position_radius.xyz;
     float radius = L.position_radius.w;

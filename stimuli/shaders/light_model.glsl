@@ -8,7 +8,7 @@ struct GpuLight {
     vec4 intensity_phase;   // rgb: I · rgb_per_cd (cd per channel); w: rhythm phase (s)
     uvec4 tables;           // x, y: vertical profile offset, count; z, w: horizontal offset, count
     uvec4 rhythm;           // x, y: rhythm knot offset, count; z: glare group; w: glare path (scene.h GlarePath)
-    vec4 rhythm_period;     // x: rhythm period (s), 0 = fixed
+    vec4 rhythm_period;     // x: rhythm period (s), 0 = fixed; y: invisible lux; z: S/P of the light's spectrum
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };

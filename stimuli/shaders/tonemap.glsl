@@ -2,6 +2,8 @@
 // main, no bindings. Include it, declare a block holding a ToneMapParams (filled on the CPU
 // by tonemap_gpu_params(), tonemap.h, whose ToneMapGpuParams has this exact layout) and call
 //   vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p)
+// or, with the pixel's own scotopic luminance (scotopic cd/m², the frame's scotopic channel),
+//   vec3 tonemap_pixel_scotopic(vec3 rgb_cd_m2, float scotopic_cd_m2, float adaptation_cd_m2, ToneMapParams p)
 // Input: linear Rec.709 RGB in cd/m²; output: display-relative linear Rec.709 RGB
 // (1 = display peak), never negative or NaN.
 //
@@ -38,7 +40,7 @@ struct ToneMapParams {
     uvec4 mode;          // x: operator (TONE_*), y: hue preservation (HUE_*), z: blueshift (BLUE_*), w: white_cd_m2 given 0/1
     vec4 curve;          // x: 1/L_white² (empirical), y: Reinhard key, z: 1/L_white² (Reinhard), w: Kakimoto g
     vec4 display;        // x: Kakimoto k, y: white_cd_m2, z: L_dmax (cd/m²), w: L_da (cd/m²)
-    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), z: display.out_of_gamut (0 = keep-luminance), w: 0
+    vec4 tvi;            // x: log10 ε_C(L_da), y: σ₀ (cd/m², eq 4.27), z: display.out_of_gamut (0 = keep-luminance), w: field S/P if mesopic = cie191, else 0
     vec4 blue_rgb;       // xyz: blueshift RGB at Y = 1 (eq 4.29); w: blueshift y
     vec4 blue_per_sum;   // xyz: blueshift RGB per unit X+Y+Z (eq 4.28 path)
     vec4 rgb_to_x;       // rows of the Rec.709 RGB -> XYZ matrix
@@ -92,6 +94,32 @@ float krawczyk_key(float adaptation) {
     return 0.002 + delta / (2.0 + delta);
 }
 
+// CIE 191:2010 MES2 (mesopic.h): m = a + b log10(L_mes), V'(λ0) = 683/1699, range 0.005-5 cd/m².
+const float MES_A = 0.7670;
+const float MES_B = 0.3334;
+const float MES_V0 = 0.40200117715;  // 683/1699
+
+// Twin of mesopic_field_adaptation() (tonemap.cpp): m of the field (L_wa, S/P sp). For S/P > 1, L_mes
+// falls as m rises, so h(m) = a + b log10 L_mes(m) - m falls and has one root in [0, 1]; bisection
+// finds the fixed point mesopic_luminance_cd_m2's iteration converges to (to 2^-24 in m).
+float tm_mesopic_m(float lwa, float sp) {
+    if (lwa <= 0.005) return 0.0;
+    if (lwa >= 5.0) return 1.0;
+    float lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 24; ++i) {
+        float m = 0.5 * (lo + hi);
+        float lmes = lwa * (m + (1.0 - m) * MES_V0 * sp) / (m + (1.0 - m) * MES_V0);
+        float h = clamp(MES_A + MES_B * tm_log10(lmes), 0.0, 1.0) - m;
+        if (h > 0.0) lo = m; else hi = m;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// Twin of mesopic_equivalent_cd_m2(): the field-spectrum luminance of equal MES2 L_mes at m.
+float tm_mesopic_equivalent(float lp, float ls, float m, float sp) {
+    return (m * lp + (1.0 - m) * MES_V0 * ls) / (m + (1.0 - m) * MES_V0 * sp);
+}
+
 // Reinhard et al. 2002 eq 4 / K2012 eq 4.20 as L/(1+L)·(1 + L/W²).
 float reinhard_curve(float l, float inv_white_sq) { return l / (1.0 + l) * (1.0 + l * inv_white_sq); }
 
@@ -126,7 +154,9 @@ float tone_curve(float lw, float vw, float lwa, ToneMapParams p) {
     return lw / white;
 }
 
-vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
+// scotopic_cd_m2: the pixel's scotopic luminance (the frame's scotopic channel), or < 0 for none:
+// then V = the scotopic weights · RGB (scotopic_luminance_rgb()). NaN counts as 0 (tonemap.cpp).
+vec3 tonemap_pixel_scotopic(vec3 rgb_cd_m2, float scotopic_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     // Clip to [0, max]; the comparisons send NaN to 0 (and NaN adaptation to the minimum).
     vec3 rgb = vec3(rgb_cd_m2.r > 0.0 ? min(rgb_cd_m2.r, TM_MAX_INPUT) : 0.0,
                     rgb_cd_m2.g > 0.0 ? min(rgb_cd_m2.g, TM_MAX_INPUT) : 0.0,
@@ -140,11 +170,20 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     float y_w = dot(p.rgb_to_y.xyz, c);
     if (!(y_w > 0.0)) return vec3(0.0);
     float lw = y_w * sum;
-    float v = 0.0;
-    if (p.mode.x == TONE_PERCEPTUAL) {
-        v = dot(p.scotopic.xyz, rgb);  // scotopic_luminance_rgb(): linear, so adding light never lowers V
+    // scotopic_luminance_rgb(): linear, so adding light never lowers V
+    const float v_max = 1.33 * (1.0 + TM_MAX_SCOTOPIC_RATIO) * TM_MAX_INPUT;  // kMaxScotopicCdM2
+    float v_in = scotopic_cd_m2 < 0.0 ? dot(p.scotopic.xyz, rgb)
+                                      : (scotopic_cd_m2 > 0.0 ? min(scotopic_cd_m2, v_max) : 0.0);
+    float ld;
+    if (p.tvi.w > 0.0) {
+        // mesopic = cie191 (tonemap.cpp): the curve sees the field-spectrum luminance of equal L_mes.
+        float sp = p.tvi.w;
+        float l_eq = tm_mesopic_equivalent(lw, v_in, tm_mesopic_m(lwa, sp), sp);
+        ld = tone_curve(l_eq, sp * l_eq, lwa, p);
+    } else {
+        float v = p.mode.x == TONE_PERCEPTUAL ? v_in : 0.0;
+        ld = tone_curve(lw, v, lwa, p);
     }
-    float ld = tone_curve(lw, v, lwa, p);
 
     // Blueshift weights (eq 4.27) from the pixel's own luminance (BLUE_PIXEL) or the
     // adaptation luminance (BLUE_ADAPTATION); cone weight without 1 - σ.
@@ -171,6 +210,10 @@ vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
     // Luminance first (tonemap.cpp); another display.out_of_gamut leaves the fit to the encoder.
     if (p.mode.x == TONE_CLAMP && p.tvi.z == 0.0) outc = tm_fit_to_gamut(outc, p.rgb_to_y.xyz);
     return max(outc, vec3(0.0));
+}
+
+vec3 tonemap_pixel(vec3 rgb_cd_m2, float adaptation_cd_m2, ToneMapParams p) {
+    return tonemap_pixel_scotopic(rgb_cd_m2, -1.0, adaptation_cd_m2, p);
 }
 
 #endif  // ATONLAB_TONEMAP_GLSL

@@ -19,7 +19,8 @@
 //   VEIL_MULTIPLY  X <- conj(X · K̂) over Mx × My (K̂ real, 1/(Mx·My) included)
 //   VEIL_UNPACK    e_out = max(0, far + near); L = e_out / Ω into the image
 //                  (VEIL_ADD: added × scale to it, the HDR frame; else replacing
-//                  its rgb, alpha kept); VEIL_IMAGE_FORMAT its format qualifier
+//                  it), and its scotopic luminance (the RGB weights) to or into
+//                  alpha, the frame's scotopic channel; VEIL_IMAGE_FORMAT its format qualifier
 // and VEIL_NEAR_RADIUS R (an int literal).
 
 #if defined(VEIL_PACK) || defined(VEIL_UNPACK)
@@ -97,6 +98,9 @@ void main() {
 layout(std430, binding = 7) readonly buffer NearKernel { float k_near[]; };  // (R + 1)², [|dy| (R + 1) + |dx|]
 layout(VEIL_IMAGE_FORMAT, binding = 0) uniform image2D target;
 uniform float scale;  // VEIL_ADD: the HDR target's pre-exposure
+// The veil's scotopic luminance per unit RGB (display::scotopic_weights_rgb()): the veil mixes its lights,
+// so its scotopic channel is taken from its RGB, not from each light's spectrum (docs/tone-mapping.md).
+uniform vec3 scotopic_weights;
 
 const int R = VEIL_NEAR_RADIUS;
 const int TILE = 16 + 2 * R;
@@ -128,9 +132,9 @@ void main() {
     const vec3 luminance = max(far + near, vec3(0.0)) / omega[q.y * frame_size.x + q.x];
     const vec4 old = imageLoad(target, q);
 #ifdef VEIL_ADD
-    imageStore(target, q, vec4(old.rgb + luminance * scale, old.a));
+    imageStore(target, q, vec4(old.rgb + luminance * scale, old.a + dot(scotopic_weights, luminance) * scale));
 #else
-    imageStore(target, q, vec4(luminance, old.a));
+    imageStore(target, q, vec4(luminance, dot(scotopic_weights, luminance)));
 #endif
 }
 #endif

@@ -104,7 +104,7 @@ void DisplayPipeline::reset_adaptation() {
 }
 
 void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s, double adaptation_cd_m2, double dt_s,
-                              std::uint32_t frame, double pre_exposure) {
+                              std::uint32_t frame, double pre_exposure, bool scotopic_alpha) {
     Impl& m = *impl_;
     if (!(dt_s >= 0) || !std::isfinite(dt_s))
         throw InputError(SourceLocation{"", 0, 0, "dt_s"},
@@ -147,11 +147,12 @@ void DisplayPipeline::process(const gl::Texture2D& hdr, const OutputSettings& s,
     glDispatchCompute(1, 1, 1);
     hdr.bind(0);
     m.encode.set("inv_pre_exposure", inv_pre_exposure);
+    m.encode.set("scotopic_alpha", scotopic_alpha ? 1 : 0);
     m.run_encode(m.encode, frame);
 }
 
 void DisplayPipeline::process_ldr(const gl::Texture2D& ldr, const gl::Texture2D& glare, const OutputSettings& s,
-                                  double adaptation_cd_m2, std::uint32_t frame, double hdr_scale) {
+                                  double adaptation_cd_m2, std::uint32_t frame, double hdr_scale, bool scotopic_alpha) {
     Impl& m = *impl_;
     validate_adaptation(adaptation_cd_m2);
     if (ldr.width() != glare.width() || ldr.height() != glare.height())
@@ -166,6 +167,7 @@ void DisplayPipeline::process_ldr(const gl::Texture2D& ldr, const gl::Texture2D&
     ldr.bind(0);
     glare.bind(1);
     m.encode_ldr.set("ldr_scale", static_cast<float>(hdr_scale));
+    m.encode_ldr.set("scotopic_alpha", scotopic_alpha ? 1 : 0);
     m.run_encode(m.encode_ldr, frame);
 }
 

@@ -8,15 +8,18 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <string>
 
-#include <glm/gtc/quaternion.hpp>
-#include <glm/gtc/type_ptr.hpp>
-
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/colour.h"
+#include "atonlab/display/mesopic.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/stimuli/disc.h"
 #include "atonlab/stimuli/display_threshold.h"
 #include "atonlab/stimuli/footprint.h"
@@ -27,6 +30,25 @@ namespace atonlab::stimuli {
 
 namespace {
 constexpr std::size_t kDrawFloats = 16;  // struct LightDraw of light_eval.comp: 4 vec4
+
+double s_p_of_spectrum(const std::string& name) {
+    // Named spectra are few and fixed: each ratio is integrated once (mesopic.h) and kept.
+    static std::mutex mutex;
+    static std::map<std::string, double> cache;
+    const std::lock_guard lock(mutex);
+    if (auto it = cache.find(name); it != cache.end()) return it->second;
+    const auto spd = display::named_spectrum(name);
+    if (!spd) throw InputError(fmt::format("the light's spectrum \"{}\" is not a named spectrum", name));
+    return cache[name] = display::scotopic_to_photopic_ratio(*spd);
+}
+}  // namespace
+
+double light_s_p_ratio(const Light& light) {
+    return s_p_of_spectrum(light.spd.empty() ? "d65" : light.spd);
+}
+
+double sky_s_p_ratio() {
+    return s_p_of_spectrum("d65");
 }
 
 CameraProjection CameraProjection::from_scene(const Scene& scene) {
@@ -71,14 +93,30 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
         const glm::dvec3 I = L.rgb_per_cd * L.intensity_cd;
         const auto& v = vert.at(static_cast<std::size_t>(L.vertical_profile));
         const auto& h = hor.at(static_cast<std::size_t>(L.horizontal_profile));
-        const float rec[24] = {
-            static_cast<float>(rel.x), static_cast<float>(rel.y), static_cast<float>(rel.z), static_cast<float>(L.radius_m),
-            static_cast<float>(L.orientation.x), static_cast<float>(L.orientation.y),
-            static_cast<float>(L.orientation.z), static_cast<float>(L.orientation.w),
-            static_cast<float>(I.r), static_cast<float>(I.g), static_cast<float>(I.b), static_cast<float>(L.rhythm_phase_s),
-            bits(v.first), bits(v.second), bits(h.first), bits(h.second),
-            bits(knot_offset), bits(static_cast<std::uint32_t>(L.rhythm.size())), bits(group), bits(path),
-            static_cast<float>(L.rhythm_period_s), static_cast<float>(invisible), 0.0f, 0.0f};
+        const float rec[24] = {static_cast<float>(rel.x),
+                               static_cast<float>(rel.y),
+                               static_cast<float>(rel.z),
+                               static_cast<float>(L.radius_m),
+                               static_cast<float>(L.orientation.x),
+                               static_cast<float>(L.orientation.y),
+                               static_cast<float>(L.orientation.z),
+                               static_cast<float>(L.orientation.w),
+                               static_cast<float>(I.r),
+                               static_cast<float>(I.g),
+                               static_cast<float>(I.b),
+                               static_cast<float>(L.rhythm_phase_s),
+                               bits(v.first),
+                               bits(v.second),
+                               bits(h.first),
+                               bits(h.second),
+                               bits(knot_offset),
+                               bits(static_cast<std::uint32_t>(L.rhythm.size())),
+                               bits(group),
+                               bits(path),
+                               static_cast<float>(L.rhythm_period_s),
+                               static_cast<float>(invisible),
+                               static_cast<float>(light_s_p_ratio(L)),
+                               0.0f};
         t.lights.insert(t.lights.end(), std::begin(rec), std::end(rec));
     }
     if (t.profile_values.empty()) t.profile_values.push_back(1.0f);
@@ -236,6 +274,7 @@ void FrameRenderer::Impl::set_background_uniforms(const Scene& scene, const Came
     background.set("sea_f0", static_cast<float>(env.sea_reflectance_f0));
     background.set("sky_sea", env.background == Background::sky_sea ? 1 : 0);
     background.set("pre_exposure", pre);
+    background.set("sky_s_p", static_cast<float>(sky_s_p_ratio()));
 }
 
 // Pass 1b of render(): the discs, alpha-blended into the colour target only.
@@ -245,7 +284,9 @@ void FrameRenderer::Impl::draw_discs(const Scene& scene, const CameraProjection&
     const GLenum only_colour[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
     glNamedFramebufferDrawBuffers(fbo.id(), 2, only_colour);
     glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    // Colour: (1 − c) below + c disc (the fragment's alpha is the coverage c). Alpha, the scotopic
+    // channel: c · V_disc (the blend constant) + (1 − c) · below.
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_CONSTANT_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     glBlendEquation(GL_FUNC_ADD);
     disc.set("principal_px", 0.5f * w, 0.5f * h);
     disc.set("focal_px", f);
@@ -256,6 +297,8 @@ void FrameRenderer::Impl::draw_discs(const Scene& scene, const CameraProjection&
         disc.set("centre_view", static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
         disc.set("radius_rad", static_cast<float>(0.5 * d.diameter_deg * std::numbers::pi / 180.0));
         disc.set("rgb", static_cast<float>(rgb.r), static_cast<float>(rgb.g), static_cast<float>(rgb.b));
+        // A disc is drawn in RGB (no spectrum): its scotopic luminance from the RGB weights.
+        glBlendColor(0.0f, 0.0f, 0.0f, static_cast<float>(display::scotopic_luminance_rgb(rgb)));
         disc.use();
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
@@ -328,13 +371,19 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
     std::vector<float>& light = veil_light;
     glare_only.download_floats(light);
     veil_report.outside_frame = veil.apply(light, P.width_px, P.height_px, P.focal_px, cie_observer(scene.glare));
+    // The veil's scotopic luminance from its RGB (as veil_gpu.comp).
+    const glm::dvec3 sw = display::scotopic_weights_rgb();
     if (ldr) {
+        for (std::size_t i = 0; i + 3 < light.size(); i += 4)
+            light[i + 3] = static_cast<float>(glm::dot(sw, glm::dvec3(light[i], light[i + 1], light[i + 2])));
         glare_only.upload(light.data());
     } else {
         std::vector<float>& frame = veil_frame;
         hdr.download_floats(frame);
-        for (std::size_t i = 0; i < frame.size(); ++i)
-            if (i % 4 != 3) frame[i] += light[i] * pre;
+        for (std::size_t i = 0; i + 3 < frame.size(); i += 4) {
+            for (int c = 0; c < 3; ++c) frame[i + c] += light[i + c] * pre;
+            frame[i + 3] += static_cast<float>(glm::dot(sw, glm::dvec3(light[i], light[i + 1], light[i + 2])) * pre);
+        }
         hdr.upload(frame.data());
     }
 }

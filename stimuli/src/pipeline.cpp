@@ -27,9 +27,11 @@ void Pipeline::render_at(const Scene& scene, double time_s, double dt_s, std::ui
         // adaptation level), clipped; the glare is tone-mapped and added.
         const double white = display::linear_white_cd_m2(scene.adaptation_cd_m2, out.tonemap);
         display_.process_ldr(frame_.hdr_texture(), *glare, out, scene.adaptation_cd_m2, frame_index,
-                             1.0 / (white * frame_.pre_exposure()));
+                             1.0 / (white * frame_.pre_exposure()), true);
     } else {
-        display_.process(frame_.hdr_texture(), out, scene.adaptation_cd_m2, dt_s, frame_index, frame_.pre_exposure());
+        // The frame's alpha is its scotopic channel (frame_renderer.h).
+        display_.process(frame_.hdr_texture(), out, scene.adaptation_cd_m2, dt_s, frame_index, frame_.pre_exposure(),
+                         true);
     }
 }
 
@@ -42,7 +44,7 @@ void Pipeline::render_ldr(const gl::Texture2D& ldr, const Scene& scene, double t
             SourceLocation{"", 0, 0, "eye.glare"},
             "the LDR path adds glare to a display-referred frame; choose a glare model other than \"none\".");
     frame_.render(glare_scene, time_s);
-    display_.process_ldr(ldr, *frame_.glare_texture(), scene.output, scene.adaptation_cd_m2, frame_index_, 0.0);
+    display_.process_ldr(ldr, *frame_.glare_texture(), scene.output, scene.adaptation_cd_m2, frame_index_, 0.0, true);
     ++frame_index_;
 }
 

@@ -66,7 +66,7 @@ inline constexpr std::string_view kEyeOwnKeys[] = {"adaptation", "adaptation_cd_
 inline constexpr std::string_view kTonemapKeys[] = {
     "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
     "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
-    "ldr_glare"};
+    "ldr_glare", "mesopic"};
 /// The [glare] keys every model shares (the glare stage's); glare_keys() adds each model's own.
 inline constexpr std::string_view kSharedGlareKeys[] = {"psf_size", "spectral_samples", "window", "radius_deg",
                                                         "area_layers", "placement"};

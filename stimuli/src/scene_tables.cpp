@@ -282,6 +282,15 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
                                join(hue_preservation_names(), "\"")));
         tm.hue_preservation = *v;
     }
+    if (auto m = s.string("mesopic")) {
+        auto v = mesopic_model_from_name(*m);
+        if (!v)
+            s.fail(s.get("mesopic"), "mesopic",
+                   fmt::format("unknown mesopic model \"{}\"; it must be \"k2012\" (each operator's own rods) or "
+                               "\"cie191\" (CIE 191:2010's mesopic luminance).",
+                               text::echo(*m)));
+        tm.mesopic = *v;
+    }
     out.ldr_glare = s.boolean("ldr_glare").value_or(out.ldr_glare);
     try {
         validate_tonemap_settings(tm);

@@ -18,13 +18,16 @@ double log_average_luminance(const ImageRGBA32F& image, double epsilon_cd_m2) {
     return display::log_average_luminance(image.rgba, pixel_count(image), epsilon_cd_m2);
 }
 
-ImageRGBA32F tonemap_image(const ImageRGBA32F& hdr, double adaptation_cd_m2, const display::ToneMapSettings& s) {
+ImageRGBA32F tonemap_image(const ImageRGBA32F& hdr, double adaptation_cd_m2, const display::ToneMapSettings& s,
+                           bool scotopic_alpha) {
     display::validate_tonemap_settings(s);
     ImageRGBA32F out = hdr;
     const std::size_t n = pixel_count(hdr);
     for (std::size_t i = 0; i < n && i * 4 + 3 < out.rgba.size(); ++i) {
         float* p = &out.rgba[i * 4];
-        const glm::dvec3 d = display::tonemap_pixel(glm::dvec3(p[0], p[1], p[2]), adaptation_cd_m2, s);
+        const glm::dvec3 rgb(p[0], p[1], p[2]);
+        const glm::dvec3 d = scotopic_alpha ? display::tonemap_pixel(rgb, p[3], adaptation_cd_m2, s)
+                                            : display::tonemap_pixel(rgb, adaptation_cd_m2, s);
         p[0] = static_cast<float>(d.r);
         p[1] = static_cast<float>(d.g);
         p[2] = static_cast<float>(d.b);

@@ -11,11 +11,12 @@
 #include <map>
 #include <numbers>
 #include <span>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "atonlab/display/tonemap.h"
 #include "atonlab/stimuli/veiling_glare.h"
 #include "fftw_planner.h"
 #include "gl_enums.h"
@@ -300,6 +301,8 @@ glm::dvec3 GpuVeilingGlare::apply(gl::Texture2D& light, gl::Texture2D* add_to, d
     unpack.set("frame_size", w, h);
     unpack.set("pitch", static_cast<unsigned>(m.mx));
     unpack.set("scale", static_cast<float>(scale));
+    const glm::dvec3 sw = display::scotopic_weights_rgb();
+    unpack.set("scotopic_weights", static_cast<float>(sw.r), static_cast<float>(sw.g), static_cast<float>(sw.b));
     ATONLAB_GL_CHECK(glDispatchCompute(groups(w, 16), groups(h, 16), 1));
     ATONLAB_GL_CHECK(glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                                      GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT));

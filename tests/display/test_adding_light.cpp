@@ -1,5 +1,5 @@
 // Adding light never darkens (docs/tone-mapping.md "Adding light never darkens"): for every
-// tone operator × blueshift reading × hue mode, every IALA colour and random in-gamut
+// tone operator × blueshift reading × hue mode × mesopic model, every IALA colour and random in-gamut
 // chromaticities, adaptation 1e-4 … 1e4 cd/m², background 0 … 10× the adaptation, on 8-,
 // 10- and 16-bit displays, the displayed luminance of a pixel (its codes decoded through
 // the display model) with a light added is at least that of the pixel without it, and it
@@ -116,11 +116,11 @@ void sweep(const ToneMapSettings& s, const DisplayModel& d, int bits, Counts& n)
                                 ADD_FAILURE() << tone_operator_name(s.tone_operator) << " hue "
                                               << hue_preservation_name(s.hue_preservation) << " blueshift "
                                               << s.blueshift << "/" << static_cast<int>(s.blueshift_luminance)
-                                              << " bits " << bits << " L_wa " << adaptation << " bg " << bg_factor
-                                              << " colour (" << colour.r << ", " << colour.g << ", " << colour.b
-                                              << ") light " << light << ": mean " << with.mean_cd_m2 << " against "
-                                              << reference->mean_cd_m2 << " cd/m2 (" << mean_drop / mean_step
-                                              << " mean steps lower)";
+                                              << " mesopic " << mesopic_model_name(s.mesopic) << " bits " << bits
+                                              << " L_wa " << adaptation << " bg " << bg_factor << " colour ("
+                                              << colour.r << ", " << colour.g << ", " << colour.b << ") light " << light
+                                              << ": mean " << with.mean_cd_m2 << " against " << reference->mean_cd_m2
+                                              << " cd/m2 (" << mean_drop / mean_step << " mean steps lower)";
                             }
                         }
                         n.pixels += kTile * kTile;
@@ -132,7 +132,7 @@ void sweep(const ToneMapSettings& s, const DisplayModel& d, int bits, Counts& n)
     }
 }
 
-// 54 settings × 9 adaptations × 5 backgrounds × 2 skies × 10 colours × 7 levels × 16
+// 108 settings (both mesopic models) × 9 adaptations × 5 backgrounds × 2 skies × 10 colours × 7 levels × 16
 // dither positions on each display.
 TEST(AddingLight, NeverLowersTheDisplayedLuminanceOnEveryOperatorAndDisplay) {
     const DisplayModel srgb = DisplayModel::srgb(100.0, 0.1);

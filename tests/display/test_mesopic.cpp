@@ -162,6 +162,19 @@ TEST(MesopicLuminance, AgreesWithAnIndependentSolutionOfTheStandardsEquations) {
     }
 }
 
+TEST(MesopicLuminance, WorkedExamplesOfCieTn007) {
+    // CIE TN 007:2017 (Interim recommendation for practical application of CIE system for mesopic
+    // photometry in outdoor lighting), its worked examples of MES2: L_p = 0.3 cd/m² with S/P 1.8 gives
+    // m = 0.614 and L_mes = 0.348 cd/m²; with S/P 2.5, m = 0.629 and L_mes = 0.386 cd/m². The note prints
+    // three decimals, so each holds to half a unit of the last.
+    const MesopicLuminance a = mesopic_luminance_cd_m2(0.3, 1.8);
+    EXPECT_NEAR(a.adaptation_m, 0.614, 0.0005);
+    EXPECT_NEAR(a.luminance_cd_m2, 0.348, 0.0005);
+    const MesopicLuminance b = mesopic_luminance_cd_m2(0.3, 2.5);
+    EXPECT_NEAR(b.adaptation_m, 0.629, 0.0005);
+    EXPECT_NEAR(b.luminance_cd_m2, 0.386, 0.0005);
+}
+
 TEST(MesopicLuminance, SpRatioOneIsPhotopic) {
     // With L_s = L_p the MES2 weighted mean is L_p for every m (analytic), and m = a + b log10(L_p).
     for (double lp : {0.006, 0.01, 0.1, 1.0, 4.9}) {

@@ -2,13 +2,14 @@
 // darkens"; the CPU reference's sweep is tests/display/test_adding_light.cpp): a red, a
 // green and a white light 500 m away over a uniform night-to-day sky, rendered by the
 // FrameRenderer with no glare and with the default eye's glare, then tone-mapped and
-// encoded by the DisplayPipeline for every operator × blueshift reading × hue mode on an
+// encoded by the DisplayPipeline for every operator × blueshift reading × hue mode × mesopic
+// model on an
 // 8-bit display. Against the same frame without the light (same dither frame), every
 // pixel of the 41 × 41 window around the light shows at least its displayed luminance
 // (decoded through the display model), to within one code step of each channel (a channel
 // whose drive falls as the chroma turns may round down alone: see the CPU test), the
 // window's sum is at least the sky's and does not fall as the light brightens (to within
-// half a code step of each pixel the light changes). The suite's bounded form checks each
+// 0.75 of a code step of each pixel the light changes). The suite's bounded form checks each
 // setting in a third of the scenes (every setting and every scene still checked, the
 // settings of a scene rotating with it); ATONLAB_LONG_TESTS=1 checks every setting in
 // every scene.
@@ -90,7 +91,10 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                         o.tonemap.hue_preservation = s.hue_preservation;
                         o.tonemap.blueshift = s.blueshift;
                         o.tonemap.blueshift_luminance = s.blueshift_luminance;
-                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure());
+                        o.tonemap.mesopic = s.mesopic;
+                        // The frame's scotopic channel, as the pipeline uses it (pipeline.cpp).
+                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure(),
+                                        true);
                         out.push_back(window_of(display.read_codes(), scene.output.display));
                     }
                     return out;
@@ -116,20 +120,24 @@ TEST_F(AddingLight, NeverLowersTheDisplayedLuminanceOfARenderedFrame) {
                                     if (with[k].pixel_cd_m2[i] != reference->pixel_cd_m2[i]) changed_steps += step;
                                     ok = ok && reference->pixel_cd_m2[i] - with[k].pixel_cd_m2[i] <= step * (1.0 + 1e-9);
                                 }
-                                // The sum: to within half a code step of each pixel the light changes (a
-                                // light that turns a pixel's chroma may round one channel down by a step
-                                // while the others' rise is still below one, in each of the few pixels
-                                // a faint light touches; the reported failure was 4-6 codes in every
-                                // channel of the core).
-                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.5 * changed_steps;
+                                // The sum: to within 0.75 of a code step of each pixel the light changes
+                                // (a light that turns a pixel's chroma may round one channel down by a
+                                // step while the others' rise is still below one, in each of the few
+                                // pixels a faint light touches: green, 0.7152 of a grey step, at most;
+                                // measured 0.69 of one pixel's step, a red light adding 10 % of a
+                                // 0.001 cd/m² sky under cie191; the reported failure was 4-6 codes in
+                                // every channel of the core).
+                                ok = ok && reference->sum_cd_m2 - with[k].sum_cd_m2 <= 0.75 * changed_steps;
                                 if (!ok && failures++ < 8) {
-                                    ADD_FAILURE() << colour << " light, glare " << glare << ", L_wa " << adaptation
-                                                  << ", sky " << sky << ", core x" << core_factor << ", "
-                                                  << tone_operator_name(s.tone_operator) << " hue "
-                                                  << hue_preservation_name(s.hue_preservation) << " blueshift "
-                                                  << s.blueshift << "/" << blueshift_luminance_name(s.blueshift_luminance)
-                                                  << ": window " << with[k].sum_cd_m2 << " against "
-                                                  << reference->sum_cd_m2 << " cd/m2 (summed)";
+                                    ADD_FAILURE()
+                                        << colour << " light, glare " << glare << ", L_wa " << adaptation << ", sky "
+                                        << sky << ", core x" << core_factor << ", "
+                                        << tone_operator_name(s.tone_operator) << " hue "
+                                        << hue_preservation_name(s.hue_preservation) << " blueshift " << s.blueshift
+                                        << "/" << blueshift_luminance_name(s.blueshift_luminance) << " mesopic "
+                                        << mesopic_model_name(s.mesopic) << ": window " << with[k].sum_cd_m2
+                                        << " against " << reference->sum_cd_m2
+                                        << " cd/m2 (summed; the changed pixels' code steps " << changed_steps << ")";
                                 }
                             }
                         }

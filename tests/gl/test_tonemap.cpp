@@ -63,6 +63,7 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
     auto prog = gl::Program::build({{gl::ShaderStage::compute, "test_tonemap.comp"}});
     prog.use();
     prog.set("count", static_cast<unsigned>(n));
+    prog.set("scotopic_scale", 0.0f);
     in.bind_storage(0);
     out.bind_storage(1);
     params.bind_uniform(0);
@@ -79,56 +80,110 @@ TEST_F(ToneMapGpu, GlslTwinMatchesTheDoubleReference) {
         double worst_op = 0.0, worst_op_abs = 0.0;
         for (HuePreservation h : hues) {
             for (const int blue : atonlab::test::kBlueshiftModes) {
-                ToneMapSettings s;
-                s.tone_operator = op;
-                s.hue_preservation = h;
-                atonlab::test::set_blueshift(s, blue);
-                if (op == ToneOperator::reinhard) s.reinhard_white_relative = 4.0;  // exercise eq 4
-                const ToneMapGpuParams p = tonemap_gpu_params(s);
-                params.upload(0, sizeof(p), &p);
-                glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
-                glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
-                glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-                out.download(0, n * sizeof(glm::vec4), got.data());
-                double worst = 0.0, worst_abs = 0.0;
-                std::size_t worst_i = 0;
-                int failures = 0;
-                for (std::size_t i = 0; i < n; ++i) {
-                    // The CPU gets exactly the fp32 values the GPU saw.
-                    const glm::dvec3 ref = tonemap_pixel(glm::dvec3(glm::vec3(px[i])), px[i].a, s);
-                    for (int c = 0; c < 3; ++c) {
-                        const double g = got[i][c], r = ref[c];
-                        ASSERT_TRUE(std::isfinite(g) && g >= 0.0) << i;
-                        const double diff = std::abs(g - r);
-                        // Relative 1e-4, or absolute 1e-6 near 0 (display-relative units).
-                        if (diff > 1e-4 * std::abs(r) && diff > 1e-6 && failures++ < 5) {
-                            ADD_FAILURE() << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
-                                          << atonlab::test::blueshift_label(blue) << " pixel " << i << " channel " << c
-                                          << ": gpu " << g << " cpu " << r << " (rgb " << px[i].r << "," << px[i].g
-                                          << "," << px[i].b << " adaptation " << px[i].a << ")";
-                        }
-                        if (std::abs(r) > 1e-6) {
-                            if (diff / std::abs(r) > worst) {
-                                worst = diff / std::abs(r);
-                                worst_i = i;
+                for (const MesopicModel mes : {MesopicModel::k2012, MesopicModel::cie191}) {
+                    ToneMapSettings s;
+                    s.tone_operator = op;
+                    s.hue_preservation = h;
+                    s.mesopic = mes;
+                    atonlab::test::set_blueshift(s, blue);
+                    if (op == ToneOperator::reinhard) s.reinhard_white_relative = 4.0;  // exercise eq 4
+                    const ToneMapGpuParams p = tonemap_gpu_params(s);
+                    params.upload(0, sizeof(p), &p);
+                    glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
+                    glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
+                    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+                    out.download(0, n * sizeof(glm::vec4), got.data());
+                    double worst = 0.0, worst_abs = 0.0;
+                    std::size_t worst_i = 0;
+                    int failures = 0;
+                    for (std::size_t i = 0; i < n; ++i) {
+                        // The CPU gets exactly the fp32 values the GPU saw.
+                        const glm::dvec3 ref = tonemap_pixel(glm::dvec3(glm::vec3(px[i])), px[i].a, s);
+                        for (int c = 0; c < 3; ++c) {
+                            const double g = got[i][c], r = ref[c];
+                            ASSERT_TRUE(std::isfinite(g) && g >= 0.0) << i;
+                            const double diff = std::abs(g - r);
+                            // Relative 1e-4, or absolute 1e-6 near 0 (display-relative units).
+                            if (diff > 1e-4 * std::abs(r) && diff > 1e-6 && failures++ < 5) {
+                                ADD_FAILURE()
+                                    << tone_operator_name(op) << " " << hue_preservation_name(h) << " blueshift "
+                                    << atonlab::test::blueshift_label(blue) << " mesopic " << mesopic_model_name(mes)
+                                    << " pixel " << i << " channel " << c << ": gpu " << g << " cpu " << r << " (rgb "
+                                    << px[i].r << "," << px[i].g << "," << px[i].b << " adaptation " << px[i].a << ")";
                             }
-                        } else {
-                            worst_abs = std::max(worst_abs, diff);
+                            if (std::abs(r) > 1e-6) {
+                                if (diff / std::abs(r) > worst) {
+                                    worst = diff / std::abs(r);
+                                    worst_i = i;
+                                }
+                            } else {
+                                worst_abs = std::max(worst_abs, diff);
+                            }
                         }
                     }
+                    worst_op = std::max(worst_op, worst);
+                    worst_op_abs = std::max(worst_op_abs, worst_abs);
+                    std::printf(
+                        "  %-10s hue %-4s blueshift %-10s mesopic %-6s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), "
+                        "absolute %.2e\n",
+                        std::string(tone_operator_name(op)).c_str(), std::string(hue_preservation_name(h)).c_str(),
+                        atonlab::test::blueshift_label(blue), std::string(mesopic_model_name(mes)).c_str(), worst,
+                        worst_i, luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))),
+                        static_cast<double>(px[worst_i].a), worst_abs);
                 }
-                worst_op = std::max(worst_op, worst);
-                worst_op_abs = std::max(worst_op_abs, worst_abs);
-                std::printf(
-                    "  %-10s hue %-4s blueshift %-10s relative %.2e (pixel %zu: L %.3g, L_wa %.3g), absolute %.2e\n",
-                    std::string(tone_operator_name(op)).c_str(), std::string(hue_preservation_name(h)).c_str(),
-                    atonlab::test::blueshift_label(blue), worst, worst_i,
-                    luminance_of_linear_rgb(glm::dvec3(glm::vec3(px[worst_i]))), static_cast<double>(px[worst_i].a),
-                    worst_abs);
             }
         }
         std::printf("worst GPU-vs-CPU error, %-10s: relative %.2e, absolute (near 0) %.2e\n",
                     std::string(tone_operator_name(op)).c_str(), worst_op, worst_op_abs);
+    }
+}
+
+TEST_F(ToneMapGpu, ScotopicChannelTwinMatchesTheDoubleReference) {
+    // The rod signal from the frame's scotopic channel (tonemap_pixel_scotopic) rather than the RGB
+    // weights: V = 5.38 × G (the green die's S/P on the green channel), the same fp32 product on both.
+    constexpr std::size_t n = 8192;
+    const std::vector<glm::vec4> px = random_pixels(n, 20261207u);
+    auto in = gl::Buffer::from(std::span<const glm::vec4>(px));
+    gl::Buffer out(n * sizeof(glm::vec4), nullptr, gl::BufferUsage::dynamic_read);
+    gl::Buffer params(sizeof(ToneMapGpuParams), nullptr, gl::BufferUsage::dynamic_draw);
+    auto prog = gl::Program::build({{gl::ShaderStage::compute, "test_tonemap.comp"}});
+    prog.use();
+    prog.set("count", static_cast<unsigned>(n));
+    const float scale = 5.38f;
+    prog.set("scotopic_scale", scale);
+    in.bind_storage(0);
+    out.bind_storage(1);
+    params.bind_uniform(0);
+    std::vector<glm::vec4> got(n);
+    for (const ToneOperator op : {ToneOperator::perceptual, ToneOperator::empirical}) {
+        for (const MesopicModel mes : {MesopicModel::k2012, MesopicModel::cie191}) {
+            ToneMapSettings s;
+            s.tone_operator = op;
+            s.mesopic = mes;
+            const ToneMapGpuParams p = tonemap_gpu_params(s);
+            params.upload(0, sizeof(p), &p);
+            glMemoryBarrier(GL_UNIFORM_BARRIER_BIT);
+            glDispatchCompute(static_cast<unsigned>((n + 63) / 64), 1, 1);
+            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+            out.download(0, n * sizeof(glm::vec4), got.data());
+            double worst = 0.0;
+            int failures = 0;
+            for (std::size_t i = 0; i < n; ++i) {
+                const float v = scale * px[i].g;
+                const glm::dvec3 ref = tonemap_pixel(glm::dvec3(glm::vec3(px[i])), v, px[i].a, s);
+                for (int c = 0; c < 3; ++c) {
+                    const double diff = std::abs(got[i][c] - ref[c]);
+                    if (std::abs(ref[c]) > 1e-6) worst = std::max(worst, diff / std::abs(ref[c]));
+                    // As GlslTwinMatchesTheDoubleReference: relative 1e-4, or absolute 1e-6 near 0.
+                    if (diff > 1e-4 * std::abs(ref[c]) && diff > 1e-6 && failures++ < 5)
+                        ADD_FAILURE() << tone_operator_name(op) << " " << mesopic_model_name(mes) << " pixel " << i
+                                      << " channel " << c << ": gpu " << got[i][c] << " cpu " << ref[c];
+                }
+            }
+            std::printf("scotopic channel, %-10s %-6s: worst relative error %.2e\n",
+                        std::string(tone_operator_name(op)).c_str(), std::string(mesopic_model_name(mes)).c_str(),
+                        worst);
+        }
     }
 }
 

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <vector>
 
+#include "atonlab/display/tonemap.h"
 #include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/cpu_threads.h"
 #include "atonlab/stimuli/frame_renderer.h"
@@ -184,7 +185,11 @@ TEST_F(VeilGpu, AddsToAnHdrTargetOfEitherFormatRunsNoCpuFftAfterItsBuildAndRefus
         // Half floats: 11 significant bits, and a driver may convert toward zero: two units in the last place.
         const double tolerance = format == gl::PixelFormat::rgba16f ? 2.0 / 1024 : 1e-6;
         for (std::size_t p = 0; p < got.size(); ++p) {
-            const double want = p % 4 == 3 ? base[p] : base[p] + scale * alone[p];
+            // Alpha, the frame's scotopic channel, gains the veil's scotopic luminance by the RGB weights.
+            const glm::dvec3 sw = display::scotopic_weights_rgb();
+            const std::size_t q = p - p % 4;
+            const double veil_v = sw.r * alone[q] + sw.g * alone[q + 1] + sw.b * alone[q + 2];
+            const double want = p % 4 == 3 ? base[p] + scale * veil_v : base[p] + scale * alone[p];
             ASSERT_NEAR(got[p], want, tolerance * std::abs(want) + 1e-30) << p;
         }
     }

@@ -8,10 +8,15 @@ layout(std430, binding = 1) writeonly buffer Mapped { vec4 mapped[]; };  // rgb:
 layout(std140, binding = 0) uniform ToneMapBlock { ToneMapParams tm; };
 
 uniform uint count;
+// > 0: the pixel's scotopic luminance is scotopic_scale × its green channel (a rod signal that is not
+// the RGB weights'), through tonemap_pixel_scotopic; 0: tonemap_pixel.
+uniform float scotopic_scale;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
     vec4 px = pixels[i];
-    mapped[i] = vec4(tonemap_pixel(px.rgb, px.a, tm), 0.0);
+    vec3 rgb = scotopic_scale > 0.0 ? tonemap_pixel_scotopic(px.rgb, scotopic_scale * px.g, px.a, tm)
+                                    : tonemap_pixel(px.rgb, px.a, tm);
+    mapped[i] = vec4(rgb, 0.0);
 }

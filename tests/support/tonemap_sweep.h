@@ -1,8 +1,8 @@
 #pragma once
 // What the adding-light and mesopic tests sweep (tests/display/test_adding_light.cpp,
 // tests/gl/test_adding_light.cpp, tests/gl/test_mesopic_brightness.cpp): every tone operator ×
-// hue mode × blueshift setting (off, per pixel, per adaptation), and a scene of one light
-// 500 m ahead over a uniform sky on a 160 × 90 px display at 50 px/deg.
+// hue mode × blueshift setting (off, per pixel, per adaptation) × mesopic model (k2012, cie191), and a scene of one
+// light 500 m ahead over a uniform sky on a 160 × 90 px display at 50 px/deg.
 #include <string>
 #include <vector>
 
@@ -10,7 +10,8 @@
 
 namespace atonlab::test {
 
-/// 6 operators × 3 hue modes × 3 blueshift settings: 54 settings, the other keys at their defaults.
+/// 6 operators × 3 hue modes × 3 blueshift settings × 2 mesopic models: 108 settings, the other keys at
+/// their defaults.
 inline std::vector<display::ToneMapSettings> every_tonemap_setting() {
     using namespace atonlab::display;
     std::vector<ToneMapSettings> out;
@@ -18,12 +19,15 @@ inline std::vector<display::ToneMapSettings> every_tonemap_setting() {
                                   ToneOperator::kakimoto, ToneOperator::linear, ToneOperator::clamp}) {
         for (const HuePreservation hue : {HuePreservation::none, HuePreservation::xyY, HuePreservation::rgb}) {
             for (int blue = 0; blue < 3; ++blue) {
-                ToneMapSettings s;
-                s.tone_operator = op;
-                s.hue_preservation = hue;
-                s.blueshift = blue != 0;
-                s.blueshift_luminance = blue == 2 ? BlueshiftLuminance::adaptation : BlueshiftLuminance::pixel;
-                out.push_back(s);
+                for (const MesopicModel mesopic : {MesopicModel::k2012, MesopicModel::cie191}) {
+                    ToneMapSettings s;
+                    s.tone_operator = op;
+                    s.hue_preservation = hue;
+                    s.blueshift = blue != 0;
+                    s.blueshift_luminance = blue == 2 ? BlueshiftLuminance::adaptation : BlueshiftLuminance::pixel;
+                    s.mesopic = mesopic;
+                    out.push_back(s);
+                }
             }
         }
     }

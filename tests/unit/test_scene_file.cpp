@@ -552,6 +552,12 @@ TEST(SceneFileOutput, TonemapDisplayAndAdaptationAreRead) {
     expect_error_at(bad, line_of(bad, "black_cd_m2"), "display.black_cd_m2", "below its peak");
     const std::string white = std::string(kMinimal) + "[tonemap]\nwhite_relative = -1\n";
     expect_error_at(white, line_of(white, "white_relative"), "tonemap.white_relative", "white_relative");
+    // tonemap.mesopic: k2012 by default, cie191 read, anything else refused at its line.
+    EXPECT_EQ(scene.output.tonemap.mesopic, MesopicModel::k2012);
+    const Scene cie = parse_scene(std::string(kMinimal) + "[tonemap]\nmesopic = \"cie191\"\n", "out.toml");
+    EXPECT_EQ(cie.output.tonemap.mesopic, MesopicModel::cie191);
+    const std::string mes = std::string(kMinimal) + "[tonemap]\nmesopic = \"mes2\"\n";
+    expect_error_at(mes, line_of(mes, "mesopic"), "tonemap.mesopic", "\"k2012\"");
 }
 
 TEST(SceneFileGlare, BadGlareInputNamesTheKey) {

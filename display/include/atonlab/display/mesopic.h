@@ -38,6 +38,13 @@ struct MesopicLuminance {
     double adaptation_m = 1.0;     ///< adaptation coefficient m in [0, 1]: 1 photopic, 0 scotopic
 };
 
+/// MES2's m = a + b log10(L_mes): a and b as CIE 191:2010 prints them (the tone mapper's GLSL twin
+/// repeats them: stimuli/shaders/tonemap.glsl).
+inline constexpr double kMesopicAdaptationA = 0.7670;
+inline constexpr double kMesopicAdaptationB = 0.3334;
+/// V'(lambda_0) at lambda_0 = 555 nm as CIE 191:2010 writes it: 683/1699 (= 0.402, the table's V'(555)).
+inline constexpr double kMesopicScotopicAt555 = 683.0 / 1699.0;
+
 /// Lower and upper photopic luminance of the mesopic range of CIE 191:2010 (and CIE TN 007:2017), cd/m².
 inline constexpr double kMesopicLowerPhotopicCdM2 = 0.005;
 inline constexpr double kMesopicUpperPhotopicCdM2 = 5.0;

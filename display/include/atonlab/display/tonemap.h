@@ -62,6 +62,14 @@ enum class BlueshiftLuminance : std::uint8_t {
 std::string_view blueshift_luminance_name(BlueshiftLuminance b);  ///< "adaptation", "pixel"
 std::optional<BlueshiftLuminance> blueshift_luminance_from_name(std::string_view name);
 
+/// Which luminance the tone curve aims for (tonemap.mesopic; docs/tone-mapping.md "The mesopic variant").
+enum class MesopicModel : std::uint8_t {
+    k2012 = 0,   ///< each operator's own: photopic L_w, and perceptual's rods by eq 4.21-4.26 (K2012)
+    cie191 = 1,  ///< the pixel's MES2 mesopic luminance (CIE 191:2010) with m from the adaptation field
+};
+std::string_view mesopic_model_name(MesopicModel m);  ///< "k2012", "cie191"
+std::optional<MesopicModel> mesopic_model_from_name(std::string_view name);
+
 std::string_view hue_preservation_name(HuePreservation h);  ///< "none", "xyY", "rgb"
 std::optional<HuePreservation> hue_preservation_from_name(std::string_view name);
 std::vector<std::string> hue_preservation_names();
@@ -87,6 +95,9 @@ inline constexpr double kMaxInputCdM2 = 1e15;
 /// (Y+Z)/X of a real colour is at most 274 (monochromatic light at 504 nm, where x̄ is
 /// smallest); scotopic_luminance() caps the ratio here so that X -> 0 stays finite.
 inline constexpr double kMaxScotopicRatio = 1000.0;
+/// The largest scotopic luminance the tone curve takes (scotopic cd/m²): scotopic_luminance()'s bound
+/// 1.33 (1 + kMaxScotopicRatio) kMaxInputCdM2; larger values (and +inf) are capped to it.
+inline constexpr double kMaxScotopicCdM2 = 1.33 * (1.0 + kMaxScotopicRatio) * kMaxInputCdM2;
 
 /// Parameters of the tone-mapping stage. Units in every name; defaults follow K2012.
 /// validate_tonemap_settings() says which values are allowed.
@@ -135,6 +146,9 @@ struct ToneMapSettings {
     /// luminance (as always); under any other choice they leave it to the encoder, which
     /// applies the choice, so that the two never disagree.
     OutOfGamut out_of_gamut = OutOfGamut::keep_luminance;
+    /// The luminance the tone curve aims for: K2012's (default) or CIE 191:2010's MES2 mesopic
+    /// luminance of the pixel's (L_p, L_s) with m of the adaptation field (mesopic_equivalent_cd_m2).
+    MesopicModel mesopic = MesopicModel::k2012;
 };
 
 /// Throws InputError naming the key ("tonemap.white_relative", ...) in its SourceLocation
@@ -183,6 +197,24 @@ double scotopic_luminance(glm::dvec3 xyz);
 double scotopic_luminance_rgb(glm::dvec3 rgb_cd_m2);
 glm::dvec3 scotopic_weights_rgb();  ///< the weights w above, scotopic cd/m² per cd/m² of each channel
 
+/// S/P ratio the cie191 variant gives the adaptation field: D65's (2.4645, scotopic_to_photopic_ratio of
+/// the CIE D65 table). The pipeline adapts to a photopic log-average only; its sky defaults to D65.
+double mesopic_field_s_p_ratio();
+
+/// CIE 191:2010 (MES2) adaptation coefficient m of the adaptation field L_wa (cd/m², clamped as in
+/// tonemap_pixel) of S/P mesopic_field_s_p_ratio(): mesopic_luminance_cd_m2(L_wa, S/P).adaptation_m,
+/// 0 at or below 0.005 cd/m², 1 at or above 5 cd/m².
+double mesopic_field_adaptation(double adaptation_cd_m2);
+
+/// The photopic luminance (cd/m²) of a pixel of the field's spectrum (S/P_f = mesopic_field_s_p_ratio())
+/// whose MES2 mesopic luminance at the field's m equals that of a pixel of photopic L_p and scotopic L_s:
+///   L_eq = (m L_p + (1 − m) V'(λ0) L_s) / (m + (1 − m) V'(λ0) S/P_f),  V'(λ0) = 683/1699,
+/// CIE 191:2010's L_mes = (m L_p + (1 − m) L_s V'(λ0)) / (m + (1 − m) V'(λ0)) divided by the same of a
+/// field-spectrum pixel per cd/m². A pixel of the field's spectrum gets L_eq = L_p; the cie191 variant
+/// feeds L_eq to the tone curve, so ratios of displayed luminance follow ratios of L_mes. Linear with
+/// non-negative weights in (L_p, L_s), so adding light never lowers it. m in [0, 1].
+double mesopic_equivalent_cd_m2(double photopic_cd_m2, double scotopic_cd_m2, double adaptation_m);
+
 /// K2012 eq 4.19 with Krawczyk et al. 2005 eq 11's log10(L + 1): the scene key
 /// α(L_wa) = 1.002 - 2 / (2 + log10(L_wa + 1)). The thesis drops the "+ 1", which makes
 /// α singular at L_wa = 0.01 cd/m² and negative below it; with it, α runs from 0.002 in
@@ -228,6 +260,13 @@ double tone_curve(double luminance_cd_m2, double scotopic_cd_m2, double adaptati
 /// (validate_tonemap_settings).
 glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double adaptation_cd_m2, const ToneMapSettings& s);
 
+/// The same with the pixel's own scotopic luminance (scotopic cd/m², the V'-weighted channel the renderer
+/// carries beside RGB from each light's spectrum; docs/tone-mapping.md "The scotopic channel"): the rod
+/// signal of the perceptual operator and cie191's L_s. The overload above uses scotopic_luminance_rgb(rgb).
+/// Negative or NaN scotopic luminance counts as 0.
+glm::dvec3 tonemap_pixel(glm::dvec3 rgb_cd_m2, double scotopic_cd_m2, double adaptation_cd_m2,
+                         const ToneMapSettings& s);
+
 // ---------------------------------------------------------------------------
 // The GPU twin's parameters: `struct ToneMapParams` of tonemap.glsl, byte for byte (all
 // members 16-byte vectors, so the std140 and std430 layouts are this struct's layout).
@@ -238,7 +277,7 @@ struct ToneMapGpuParams {
         mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
     std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
     std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), OutOfGamut as a float, 0
+    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), OutOfGamut as a float, field S/P if mesopic = cie191 else 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)

@@ -34,17 +34,20 @@ public:
     /// is fixed (> 0, finite); unused when it is dynamic, where the level is the
     /// frames' log-average followed in time. dt_s: seconds since the previous
     /// frame (≥ 0; dynamic: the first frame after a reset adopts its log-average
-    /// at once). frame: dither frame index.
+    /// at once). frame: dither frame index. scotopic_alpha: hdr's alpha holds each pixel's scotopic
+    /// luminance (scotopic cd/m² × pre_exposure; FrameRenderer's frames do), the tone mapper's rod signal;
+    /// false: the scotopic luminance is derived from RGB (display::scotopic_luminance_rgb).
     void process(const gl::Texture2D& hdr, const OutputSettings& s, double adaptation_cd_m2, double dt_s,
-                 std::uint32_t frame, double pre_exposure = 1.0);
+                 std::uint32_t frame, double pre_exposure = 1.0, bool scotopic_alpha = false);
     /// The LDR integration path (K2012 §6.2.2): `ldr` is display-referred linear
     /// RGB relative to the display's white (what an LDR renderer produced) when
     /// hdr_scale = 0, or an HDR frame (cd/m²) that is shown by exposure
     /// (× hdr_scale, clipped at white); `glare` holds the glare billboards alone
     /// in cd/m², tone-mapped at adaptation_cd_m2 (Scene::adaptation_cd_m2, in
     /// either mode: there is no HDR scene to measure) and added.
+    /// scotopic_alpha: as for process(), of the glare buffer.
     void process_ldr(const gl::Texture2D& ldr, const gl::Texture2D& glare, const OutputSettings& s,
-                     double adaptation_cd_m2, std::uint32_t frame, double hdr_scale = 0.0);
+                     double adaptation_cd_m2, std::uint32_t frame, double hdr_scale = 0.0, bool scotopic_alpha = false);
     /// Forget the adapted luminance (the next dynamic frame adopts its log-average).
     void reset_adaptation();
 

@@ -173,11 +173,19 @@ private:
 /// GPU light records: the packed std430 layout of shaders/light_model.glsl,
 /// exposed so tests and benchmarks can drive the shader light model directly.
 struct GpuLightTables {
-    std::vector<float> lights;           ///< 24 floats (6 vec4) per light; integer fields bit-cast
-                                         ///< (float 21: the light's invisible illuminance, lux; 0 = never culled)
+    std::vector<float> lights;  ///< 24 floats (6 vec4) per light; integer fields bit-cast
+                                ///< (float 21: the light's invisible illuminance, lux; 0 = never culled;
+                                ///< float 22: light_s_p_ratio)
     std::vector<float> profile_values;
     std::vector<glm::vec2> rhythm_knots;
 };
+/// S/P of a light's spectrum (Light::spd; D65 when empty): the scotopic luminance, in scotopic cd/m², its
+/// light carries per photopic cd/m² (display::scotopic_to_photopic_ratio). The frame's scotopic channel
+/// (the HDR target's alpha) holds S/P × the luminance each light adds, plus sky_s_p_ratio() × the sky's.
+double light_s_p_ratio(const Light& light);
+/// S/P of the sky (D65: the background is drawn D65 white), 2.4645.
+double sky_s_p_ratio();
+
 /// Packs lights relative to the eye (positions differenced in double before the
 /// fp32 rounding, so distant lights keep their precision).
 /// glare_groups: each light's glare SPD group (GlareStage::light_groups()), 0 when empty.

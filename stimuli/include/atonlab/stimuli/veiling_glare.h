@@ -128,8 +128,10 @@ public:
     static std::string unsupported_reason(int width, int height);
 
     /// Convolves `light` (RGBA32F, cd/m²) with the observer's GSF; the result
-    /// replaces light's rgb (add_to == nullptr; alpha kept) or is added × scale
-    /// to add_to's rgb (RGBA32F or RGBA16F, light's size). Returns the outside
+    /// replaces light's rgb (add_to == nullptr) or is added × scale to add_to's
+    /// rgb (RGBA32F or RGBA16F, light's size); its scotopic luminance (the RGB
+    /// weights, display::scotopic_weights_rgb) replaces or is added to alpha,
+    /// the frame's scotopic channel. Returns the outside
     /// fractions as VeilingGlare::apply. The kernel is cached for the last
     /// (size, focal length, observer). Throws InputError for a bad observer,
     /// std::runtime_error for an unsupported size (unsupported_reason()).

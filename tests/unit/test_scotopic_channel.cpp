@@ -1,0 +1,58 @@
+// The scotopic channel's per-light S/P (docs/tone-mapping.md "The scotopic channel"): each light carries
+// the S/P of its own spectrum (its `spd`, else its IALA colour's representative die), computed here from
+// the CIE tables (CIE 1951 V'(λ) and the CIE 1931 ȳ = V(λ), K'm/Km = 1700/683) by a separate 1 nm sum,
+// not by the code's scotopic_to_photopic_ratio.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "atonlab/display/colour.h"
+#include "atonlab/display/mesopic.h"
+#include "atonlab/stimuli/frame_renderer.h"
+#include "atonlab/stimuli/scene_file.h"
+
+namespace atonlab::stimuli {
+namespace {
+
+double s_p_from_cie_tables(const display::Spectrum& spd) {
+    double scotopic = 0.0, photopic = 0.0;
+    for (int nm = 360; nm <= 830; ++nm) {
+        const double v = spd.at(nm);
+        scotopic += v * display::cie1951_scotopic_efficiency(nm);
+        photopic += v * display::cie1931_cmf(nm).y;
+    }
+    return 1700.0 * scotopic / (683.0 * photopic);
+}
+
+Light light_of(const std::string& keys) {
+    const std::string text =
+        "[display]\nwidth_px = 64\nheight_px = 64\nwidth_m = 0.05\nviewing_distance_m = 0.9\n"
+        "[[light]]\nname = \"l\"\nposition_m = [0.0, 0.0, -100.0]\nintensity_cd = 1.0\n" +
+        keys;
+    return parse_scene(text, "sp.toml", {}).lights.at(0);
+}
+
+TEST(ScotopicChannel, EachLightCarriesItsDiesSpFromTheCieTables) {
+    // The dies of IALA green (505 nm) and yellow (592 nm): S/P 5.38 and 0.211, against the display
+    // primaries' V/Y 1.80 and 0.68 the RGB weights gave them (docs/tone-mapping.md "Scotopic weights").
+    struct Case {
+        const char* colour;
+        double expected_about;
+        double within;
+    };
+    for (const Case c : {Case{"green", 5.38, 0.01}, Case{"yellow", 0.211, 0.001}, Case{"red", 0.047, 0.001},
+                         Case{"blue", 19.04, 0.05}, Case{"white", 2.4645, 0.001}}) {
+        const Light l = light_of(std::string("colour = \"") + c.colour + "\"\n");
+        const double own = s_p_from_cie_tables(*display::named_spectrum(l.spd));
+        EXPECT_NEAR(light_s_p_ratio(l), own, 1e-9 * own) << c.colour;
+        EXPECT_NEAR(own, c.expected_about, c.within) << c.colour;
+    }
+    // An explicit spd wins over the colour; a light built in code (no spd) is D65, as is the sky.
+    const Light led = light_of("spd = \"led-green\"\n");
+    EXPECT_NEAR(light_s_p_ratio(led), s_p_from_cie_tables(*display::named_spectrum("led-green")), 1e-9);
+    EXPECT_NEAR(light_s_p_ratio(Light{}), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+    EXPECT_NEAR(sky_s_p_ratio(), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+}
+
+}  // namespace
+}  // namespace atonlab::stimuli
