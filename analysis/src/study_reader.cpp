@@ -253,6 +253,36 @@ Dataset read_study(const std::filesystem::path& study_file, bool salvage) {
 
 namespace {
 
+/// The session's displayability record (displayability_json): whether it could show a match, its
+/// presentation margin and its gamut choice, into `info`; a note for each departure into `d`.
+void read_displayability(const std::string& text, std::int64_t session_id, const std::string& file, SessionInfo& info,
+                         Dataset& d) {
+    const nlohmann::json j =
+        store::parse_json(text, fmt::format("displayability_json of session {}", session_id));
+    info.displayable = store::boolean_at(j, "/displayable");
+    info.allowed_undisplayable = store::boolean_at(j, "/allowed_undisplayable").value_or(false);
+    for (const nlohmann::json& c : store::array_at(j, "/conditions"))
+        if (!store::boolean_at(c, "/displayable").value_or(true))
+            info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
+    if (const auto m = store::number_at(j, "/presentation/margin")) info.presentation_margin = *m;
+    // The scene's choice, or a condition's own (a `set` of display.out_of_gamut) where it differs.
+    info.out_of_gamut = store::string_at(j, "/display/out_of_gamut");
+    for (const nlohmann::json& c : store::array_at(j, "/conditions"))
+        for (const nlohmann::json& e : store::array_at(c, "/ends"))
+            if (const auto g = store::string_at(e, "/out_of_gamut"); g && *g != "keep-luminance") info.out_of_gamut = g;
+    if (info.out_of_gamut && *info.out_of_gamut != "keep-luminance")
+        d.notes.push_back(fmt::format(
+            "{} session {} showed colours its display cannot show by display.out_of_gamut = \"{}\", not "
+            "keep-luminance: its out-of-gamut lights gave up luminance (docs/tone-mapping.md \"Out of gamut: "
+            "colour or luminance\")",
+            file, session_id, *info.out_of_gamut));
+    if (info.displayable == false)
+        d.notes.push_back(fmt::format(
+            "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "
+            "display (docs/running.md, \"Displayability\"); their estimates say little about the observer",
+            file, session_id, fmt::join(info.undisplayable, ", ")));
+}
+
 /// One session and its trials into `d`: stimulus parameters, outcomes, the
 /// procedures replayed. `salvage`: a protocol text that cannot be read is a
 /// note, not an error.
@@ -287,32 +317,7 @@ void add_session(Dataset& d, const store::Store& db, const std::string& file, co
         info.calibration_id = s.calibration->value;
         calibrations.insert(s.calibration->value);
     }
-    if (s.displayability_json) {
-        const nlohmann::json j =
-            store::parse_json(*s.displayability_json, fmt::format("displayability_json of session {}", s.id.value));
-        info.displayable = store::boolean_at(j, "/displayable");
-        info.allowed_undisplayable = store::boolean_at(j, "/allowed_undisplayable").value_or(false);
-        for (const nlohmann::json& c : store::array_at(j, "/conditions"))
-            if (!store::boolean_at(c, "/displayable").value_or(true))
-                info.undisplayable.push_back(store::string_at(c, "/name").value_or("?"));
-        if (const auto m = store::number_at(j, "/presentation/margin")) info.presentation_margin = *m;
-        // The scene's choice, or a condition's own (a `set` of display.out_of_gamut) where it differs.
-        info.out_of_gamut = store::string_at(j, "/display/out_of_gamut");
-        for (const nlohmann::json& c : store::array_at(j, "/conditions"))
-            for (const nlohmann::json& e : store::array_at(c, "/ends"))
-                if (const auto g = store::string_at(e, "/out_of_gamut"); g && *g != "keep-luminance") info.out_of_gamut = g;
-        if (info.out_of_gamut && *info.out_of_gamut != "keep-luminance")
-            d.notes.push_back(fmt::format(
-                "{} session {} showed colours its display cannot show by display.out_of_gamut = \"{}\", not "
-                "keep-luminance: its out-of-gamut lights gave up luminance (docs/tone-mapping.md \"Out of gamut: "
-                "colour or luminance\")",
-                file, s.id.value, *info.out_of_gamut));
-        if (info.displayable == false)
-            d.notes.push_back(fmt::format(
-                "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "
-                "display (docs/running.md, \"Displayability\"); their estimates say little about the observer",
-                file, s.id.value, fmt::join(info.undisplayable, ", ")));
-    }
+    if (s.displayability_json) read_displayability(*s.displayability_json, s.id.value, file, info, d);
     if (s.stop_json) read_stops(*s.stop_json, s.id.value, file, info, d);
     info.scene_name = s.scene_name;
     info.scene_sha256 = s.scene_sha256.value_or("");

@@ -38,7 +38,7 @@ struct SceneSource {
 
 struct PyFrame {
     py::array hdr;       ///< H×W×3 float32, cd/m², a view of `rgba`'s memory
-    py::array rgba;      ///< H×W×4 float32, the frame's own buffer (A is 1)
+    py::array rgba;      ///< H×W×4 float32, the frame's own buffer (A: scotopic cd/m²)
     py::object codes;    ///< H×W×3 uint8 (8-bit display) or uint16, or None
     int bits = 0;        ///< the display's code depth
     double deg_per_px = 0.0;
@@ -193,7 +193,7 @@ void bind_render(py::module_& m) {
         .def_readonly("hdr", &PyFrame::hdr,
                       "H×W×3 float32: linear Rec.709 (sRGB primaries, D65), absolute cd/m² (Y = 0.2126 R + 0.7152 G "
                       "+ 0.0722 B is the luminance); row 0 is the top. A view of the frame's own memory (no copy).")
-        .def_readonly("rgba", &PyFrame::rgba, "H×W×4 float32: the same memory as hdr with its alpha (1).")
+        .def_readonly("rgba", &PyFrame::rgba, "H×W×4 float32: the same memory as hdr with its alpha, the frame's scotopic luminance (scotopic cd/m²).")
         .def_readonly("codes", &PyFrame::codes,
                       "H×W×3 display codes as the display gets them (tone-mapped, encoded, dithered): uint8 for an "
                       "8-bit display, uint16 for a deeper one (bits says).")

@@ -18,7 +18,8 @@
 // - every k2012 ratio lies within a factor 1.5 of CIE 191's, or is one of the deviations the docs
 //   explain (explained() below, with the reason): the test fails if one appears or goes;
 // - every cie191 ratio lies within a factor 1.1 of CIE 191's across MES2's range 0.005-5 cd/m²
-//   (0.01, 0.1, 1), with and without glare (the rod signal is the frame's scotopic channel, each
+//   (0.01, 0.1, 1 here; the ends 0.005 and 5 and 0.03, 0.3, 3 in Cie191FollowsMes2AcrossItsWholeRange),
+//   with and without glare (the rod signal is the frame's scotopic channel, each
 //   light's own spectrum);
 // - glare changes no light's displayed luminance by more than it changes white's, plus 5 %
 //   (glare redistributes light; only the tone curve's non-linearity can change the sum).
@@ -109,6 +110,39 @@ double cie191_ratio(const std::string& colour, double level) {
     return (m + (1.0 - m) * v0 * sp(colour)) / (m + (1.0 - m) * v0 * sp("white"));
 }
 
+// The displayed luminance (cd/m², summed over the frame) each colour's light adds over the sky
+// alone, by "<operator> <mesopic model>" and colour ("white", "red", …). `scale`: a colour's
+// intensity over white's (1 where not given).
+using AddedByColour = std::map<std::string, std::map<std::string, double>>;
+AddedByColour added_by_colour(FrameRenderer& frame, DisplayPipeline& display, const std::string& glare, double level,
+                              const std::vector<MesopicModel>& models, const std::map<std::string, double>& scale = {}) {
+    // The light's core is about its intensity × 32.8 cd/m² per cd (500 m, 50 px/deg):
+    // three times the sky's luminance, inside the tone curves' near-linear part and far
+    // above one code step at every level.
+    const double intensity = 3.0 * level / 32.8;
+    AddedByColour added;
+    for (const std::string colour : {"", "white", "red", "green", "yellow", "blue"}) {
+        const double i_cd = colour.empty() ? 0.0 : intensity * (scale.contains(colour) ? scale.at(colour) : 1.0);
+        const Scene scene = parse_scene(one_light_scene(glare, level, level, colour, i_cd), "mesopic.toml", {});
+        frame.render(scene, 0.0);
+        for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual}) {
+            for (const MesopicModel mes : models) {
+                OutputSettings o = scene.output;
+                o.tonemap.tone_operator = op;
+                o.tonemap.mesopic = mes;
+                display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure(), true);
+                const double sum = frame_sum_cd_m2(display.read_codes(), scene.output.display);
+                const std::string name = std::string(tone_operator_name(op)) + " " + std::string(mesopic_model_name(mes));
+                if (colour.empty())
+                    added[name]["sky"] = sum;
+                else
+                    added[name][colour] = sum - added[name]["sky"];
+            }
+        }
+    }
+    return added;
+}
+
 using MesopicBrightness = GLTest;
 
 TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
@@ -122,32 +156,8 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
         std::map<std::string, std::map<std::string, double>> glare_change;  // op -> colour -> with/without
         std::map<std::string, std::map<std::string, double>> without_glare;  // op -> colour -> cd/m² summed
         for (const std::string glare : {"none", "wave-optics"}) {
-            // The light's core is about its intensity × 32.8 cd/m² per cd (500 m, 50 px/deg):
-            // three times the sky's luminance, inside the tone curves' near-linear part and far
-            // above one code step at every level.
-            const double intensity = 3.0 * level / 32.8;
-            std::map<std::string, std::map<std::string, double>> added;  // op -> colour -> cd/m² summed
-            for (const std::string colour : {"", "white", "red", "green", "yellow", "blue"}) {
-                const Scene scene = parse_scene(one_light_scene(glare, level, level, colour, colour.empty() ? 0.0 : intensity),
-                                                "mesopic.toml", {});
-                frame.render(scene, 0.0);
-                for (const ToneOperator op : {ToneOperator::empirical, ToneOperator::perceptual}) {
-                    for (const MesopicModel mes : {MesopicModel::k2012, MesopicModel::cie191}) {
-                        OutputSettings o = scene.output;
-                        o.tonemap.tone_operator = op;
-                        o.tonemap.mesopic = mes;
-                        display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure(),
-                                        true);
-                        const double sum = frame_sum_cd_m2(display.read_codes(), scene.output.display);
-                        const std::string name =
-                            std::string(tone_operator_name(op)) + " " + std::string(mesopic_model_name(mes));
-                        if (colour.empty())
-                            added[name]["sky"] = sum;
-                        else
-                            added[name][colour] = sum - added[name]["sky"];
-                    }
-                }
-            }
+            const auto added = added_by_colour(frame, display, glare, level,
+                                               {MesopicModel::k2012, MesopicModel::cie191});
             for (const auto& [op, by_colour] : added) {
                 char head[96];
                 std::snprintf(head, sizeof head, "| %g | %s | %s | %s |", level, op.substr(0, op.find(' ')).c_str(),
@@ -226,5 +236,34 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
     EXPECT_EQ(explained_but_within, 0);
 }
 
+
+// Issue 43: cie191 within a factor 1.1 of MES2 over its whole range, 0.005-5 cd/m² (the ends and
+// points between the decades the table shows), with and without glare, for both operators.
+// Each coloured light's intensity is white's over its MES2 ratio, so that every light gives the
+// tone curve the same mesopic luminance if the renderer follows MES2: all sit at one point of the
+// curve, and a red light at 0.005 cd/m² (0.019 of white's L_mes) is not a code step or two over the
+// sky but as many as white's. The displayed ratio per candela is then (added / white's) × that
+// intensity ratio, and must be MES2's.
+TEST_F(MesopicBrightness, Cie191FollowsMes2AcrossItsWholeRange) {
+    FrameRenderer frame;
+    DisplayPipeline display;
+    for (const double level : {kMesopicLowerPhotopicCdM2, 0.03, 0.3, 3.0, kMesopicUpperPhotopicCdM2}) {
+        std::map<std::string, double> scale;
+        for (const char* colour : kColours) scale[colour] = 1.0 / cie191_ratio(colour, level);
+        for (const std::string glare : {"none", "wave-optics"}) {
+            for (const auto& [op, by_colour] :
+                 added_by_colour(frame, display, glare, level, {MesopicModel::cie191}, scale)) {
+                for (const char* colour : kColours) {
+                    const double ratio = by_colour.at(colour) / by_colour.at("white") / scale.at(colour),
+                                 cie = cie191_ratio(colour, level);
+                    std::printf("%g cd/m2 %s %s %s: %.3f / %.3f\n", level, op.c_str(), glare.c_str(), colour, ratio, cie);
+                    EXPECT_TRUE(ratio / cie <= 1.1 && cie / ratio <= 1.1)
+                        << op << " " << colour << " at " << level << " cd/m2 (" << glare << "): displayed " << ratio
+                        << " of white per cd, CIE 191 " << cie;
+                }
+            }
+        }
+    }
+}
 }  // namespace
 }  // namespace atonlab::test

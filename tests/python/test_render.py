@@ -53,7 +53,12 @@ def test_hdr_is_a_view_of_the_frames_memory(gl):
     assert hdr.strides == (480 * 16, 16, 4)  # R, G, B of the frame's RGBA pixels in place
     assert np.shares_memory(hdr, frame.rgba)
     assert frame.hdr.__array_interface__["data"][0] == hdr.__array_interface__["data"][0]
-    assert np.all(frame.rgba[..., 3] == 1.0)
+    # The alpha is the frame's scotopic channel (scotopic cd/m², docs/tone-mapping.md "The scotopic
+    # channel"): over the D65 sky, D65's S/P times its luminance. D65's S/P from the CIE tables is
+    # 2.46 (1700/683 × ∫V′(λ)S(λ)dλ / ∫V(λ)S(λ)dλ; e.g. Berman 1990's tables give 2.47).
+    luminance = frame.hdr @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+    sky = frame.rgba[..., 3][:20, :] / luminance[:20, :]  # the top rows: sky only
+    assert np.allclose(sky, 2.4645, rtol=2e-3)
 
 
 def test_typed_overrides_equal_set_text(gl, tmp_path):
