@@ -3,6 +3,7 @@
 #include "atonlab/analysis/dataset.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <charconv>
@@ -72,10 +73,10 @@ const std::vector<std::string>& trials_csv_columns() {
                                                "guess_rate",
                                                "target_p",
                                                "reversal",
-                                               "quest_mean",
-                                               "quest_sd",
-                                               "quest_lower",
-                                               "quest_upper",
+                                               "posterior_mean",
+                                               "posterior_sd",
+                                               "posterior_lower",
+                                               "posterior_upper",
                                                "source"};
     return cols;
 }
@@ -271,10 +272,10 @@ Trial trial_from_row(const RowReader& row, const std::string& file) {
         t.target_p = *v;
     }
     t.reversal = row.boolean("reversal");
-    t.quest_mean = row.number("quest_mean");
-    t.quest_sd = row.number("quest_sd");
-    t.quest_lower = row.number("quest_lower");
-    t.quest_upper = row.number("quest_upper");
+    t.posterior_mean = row.number("posterior_mean");
+    t.posterior_sd = row.number("posterior_sd");
+    t.posterior_lower = row.number("posterior_lower");
+    t.posterior_upper = row.number("posterior_upper");
     return t;
 }
 
@@ -304,18 +305,32 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
         if (name.empty()) throw csv_error(file, 1, "", fmt::format("column {} of the header has no name", i + 1));
         if (!index.emplace(name, i).second) throw csv_error(file, 1, name, "appears twice in the header");
     }
+    // The posterior's columns were quest_* until they were named for what they are (any procedure with a
+    // posterior writes them): the old names are still read, with a note.
+    std::vector<std::string> renamed;
+    for (const char* part : {"mean", "sd", "lower", "upper"}) {
+        const std::string old_name = fmt::format("quest_{}", part), new_name = fmt::format("posterior_{}", part);
+        const auto it = index.find(old_name);
+        if (it == index.end() || index.count(new_name)) continue;
+        index.emplace(new_name, it->second);
+        index.erase(it);
+        renamed.push_back(fmt::format("{} as {}", old_name, new_name));
+    }
     for (const std::string& col : required_csv_columns()) {
         if (!index.count(col)) {
             std::string have;
             for (const std::string& f : *header) have += (have.empty() ? "" : ", ") + f;
             throw csv_error(file, 1, col,
-                             fmt::format("the header has no column '{}', which is required (required: observer, "
-                                         "condition, level, response; the header has: {})",
-                                         col, have));
+                            fmt::format("the header has no column '{}', which is required (required: observer, "
+                                        "condition, level, response; the header has: {})",
+                                        col, have));
         }
     }
     Dataset d;
     d.sources.push_back(file);
+    if (!renamed.empty())
+        d.notes.push_back(fmt::format("{}: deprecated column names were read as their new ones: {} (write posterior_*)",
+                                      file, fmt::join(renamed, ", ")));
     std::vector<std::string> unknown;
     std::vector<std::pair<std::string, std::size_t>> setting_columns;  // Trial::settings: scene keys, with a dot
     const auto& known = trials_csv_columns();
@@ -338,9 +353,9 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
         const std::vector<std::string> fields = rec->texts();
         if (fields.size() == 1 && RowReader::trim(fields[0]).empty()) continue;  // a blank line
         if (fields.size() != header->size())
-            throw csv_error(file, rec->line, "",
-                             fmt::format("the row has {} fields where the header has {}", fields.size(),
-                                         header->size()));
+            throw csv_error(
+                file, rec->line, "",
+                fmt::format("the row has {} fields where the header has {}", fields.size(), header->size()));
         const RowReader row(file, rec->line, index, fields);
         Trial t = trial_from_row(row, file);
         // "KEY[0]", "KEY[1]", ...: one array setting (write_trials_csv writes a position so).
@@ -382,8 +397,8 @@ Dataset read_trials_csv(const std::filesystem::path& csv_file) {
             d.sessions.push_back(std::move(s));
         } else if (d.sessions[it->second].observer != t.observer) {
             throw csv_error(file, 0, "session",
-                             fmt::format("session '{}' has trials of two observers, '{}' and '{}'", t.session,
-                                         d.sessions[it->second].observer, t.observer));
+                            fmt::format("session '{}' has trials of two observers, '{}' and '{}'", t.session,
+                                        d.sessions[it->second].observer, t.observer));
         }
         ++d.sessions[it->second].trial_count;
     }
@@ -398,7 +413,8 @@ namespace {
 /// 2AFC: 1 when the observer chose the reference stimulus, 0 the test; "" for
 /// other tasks and for answers that chose neither (a timeout).
 std::string chose_reference(const Trial& t) {
-    if (t.task != protocols::Task::TwoAfc || !t.test_on_left || (t.response != "left" && t.response != "right")) return {};
+    if (t.task != protocols::Task::TwoAfc || !t.test_on_left || (t.response != "left" && t.response != "right"))
+        return {};
     const bool chose_test = (t.response == "left") == *t.test_on_left;
     return chose_test ? "0" : "1";
 }
@@ -476,10 +492,10 @@ void write_trials_csv(const std::filesystem::path& csv_file, const Dataset& data
                                          detail::number_text(t.guess_rate),
                                          detail::number_text(t.target_p),
                                          flag(t.reversal),
-                                         num(t.quest_mean),
-                                         num(t.quest_sd),
-                                         num(t.quest_lower),
-                                         num(t.quest_upper),
+                                         num(t.posterior_mean),
+                                         num(t.posterior_sd),
+                                         num(t.posterior_lower),
+                                         num(t.posterior_upper),
                                          csv_field(t.source)};
         for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
         for (const std::string& k : setting_keys) {
@@ -544,7 +560,7 @@ void merge(Dataset& into, Dataset&& more) {
     for (const SessionInfo& s : more.sessions)
         if (keys.count(s.key))
             throw csv_error(s.source, 0, "",
-                             fmt::format("session '{}' is given twice (the same input named twice?)", s.key));
+                            fmt::format("session '{}' is given twice (the same input named twice?)", s.key));
     auto append = [](auto& a, auto& b) {
         a.insert(a.end(), std::make_move_iterator(b.begin()), std::make_move_iterator(b.end()));
     };

@@ -118,10 +118,10 @@ std::string replay_track(const ConditionDesign& design, std::size_t track, const
         // a posterior per trial; the reversals are marked once the track is done.
         state = type.track_state(*proc);
         if (type.track_estimate == p::TrackEstimate::Posterior) {
-            t.quest_mean = state.mean;
-            t.quest_sd = state.sd;
-            t.quest_lower = state.lower;
-            t.quest_upper = state.upper;
+            t.posterior_mean = state.mean;
+            t.posterior_sd = state.sd;
+            t.posterior_lower = state.lower;
+            t.posterior_upper = state.upper;
         }
     }
     if (type.track_estimate == p::TrackEstimate::Reversals) {

@@ -36,7 +36,7 @@ ProtocolDesign design_of(std::string_view protocol_text, std::string_view protoc
 
 /// Replays one track's trials (in trial order, all of one session and one
 /// procedure_id) through a fresh copy of its procedure and fills
-/// Trial::reversal (staircases) or the Trial::quest_* fields (QUEST). Returns
+/// Trial::reversal (staircases) or the Trial::posterior_* fields (QUEST). Returns
 /// an empty string, or why nothing was filled (the logged levels differ from
 /// the procedure's proposals, an answer without an outcome, ...).
 std::string replay_track(const ConditionDesign& design, std::size_t track, const std::vector<Trial*>& trials);

@@ -106,10 +106,10 @@ Json track_json(const TrackResult& t) {
             {"n_reversals", r.n_reversals}, {"n_used", r.n_used},     {"mean", or_null(r.mean)}, {"sd", or_null(r.sd)},
             {"sem", or_null(r.sem)},        {"reliable", r.reliable}, {"reason", r.reason}};
     }
-    j["quest"] = nullptr;
-    if (t.quest) {
-        const QuestSummary& q = *t.quest;
-        j["quest"] = Json{{"mean", or_null(q.mean)},
+    j["posterior"] = nullptr;
+    if (t.posterior) {
+        const PosteriorSummary& q = *t.posterior;
+        j["posterior"] = Json{{"mean", or_null(q.mean)},
                           {"sd", or_null(q.sd)},
                           {"interval", interval(q.interval)},
                           {"interval_is_normal_approximation", q.interval_is_normal_approximation},
@@ -140,7 +140,7 @@ Json group_json(const GroupResult& g, const ConditionInfo& c) {
     j["tracks"] = Json::array();
     for (const TrackResult& t : g.tracks) j["tracks"].push_back(track_json(t));
     j["reversal_mean"] = or_null(g.reversal_mean);
-    j["quest_mean"] = or_null(g.quest_mean);
+    j["posterior_mean"] = or_null(g.posterior_mean);
     j["adjustment"] = nullptr;
     if (g.matches) {
         const AdjustmentSummary& m = *g.matches;
@@ -507,9 +507,9 @@ void write_fits_csv(const std::filesystem::path& file, const StudyResults& r) {
                      {"method",
                       csv_field(fmt::format("mean of the last {} of {} reversals", s.n_used, s.n_reversals))}});
             }
-            if (t.quest) {
-                const QuestSummary& q = *t.quest;
-                row("quest-track", t.session + " " + t.track,
+            if (t.posterior) {
+                const PosteriorSummary& q = *t.posterior;
+                row("posterior-track", t.session + " " + t.track,
                     {{"n_trials", std::to_string(t.levels.size())},
                      {"estimate", opt(q.mean)},
                      {"sd", opt(q.sd)},

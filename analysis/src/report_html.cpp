@@ -279,8 +279,8 @@ std::string procedure_estimates_html(const StudyResults& r, const ConditionInfo&
                     esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(s.mean), s.n_used,
                     s.n_reversals, g3(s.sd), "&ndash;", yes_no(s.reliable, s.reason, notes));
             }
-            if (t.quest) {
-                const QuestSummary& q = *t.quest;
+            if (t.posterior) {
+                const PosteriorSummary& q = *t.posterior;
                 tracks += fmt::format(
                     "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                     "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",

@@ -164,16 +164,16 @@ std::vector<TrackResult> tracks_of(const std::vector<const Trial*>& trials, cons
             }
         } else {
             const Trial& last = *ts.back();
-            QuestPosterior q;
-            q.mean = last.quest_mean;
-            q.sd = last.quest_sd;
-            if (last.quest_lower && last.quest_upper) {
-                q.quantiles.emplace_back(0.025, *last.quest_lower);
-                q.quantiles.emplace_back(0.975, *last.quest_upper);
+            StoredPosterior q;
+            q.mean = last.posterior_mean;
+            q.sd = last.posterior_sd;
+            if (last.posterior_lower && last.posterior_upper) {
+                q.quantiles.emplace_back(0.025, *last.posterior_lower);
+                q.quantiles.emplace_back(0.975, *last.posterior_upper);
             }
-            r.quest = summarize_quest(q, 0.95);
-            if (!last.quest_mean && r.quest->reason.empty())
-                r.quest->reason = "QUEST's posterior is unknown (the track could not be replayed)";
+            r.posterior = summarize_posterior(q, 0.95);
+            if (!last.posterior_mean && r.posterior->reason.empty())
+                r.posterior->reason = "QUEST's posterior is unknown (the track could not be replayed)";
         }
         out.push_back(std::move(r));
     }
@@ -295,13 +295,13 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
         g.bootstrap = bootstrap_psychometric(g.counts, *g.fit, resample_options(o, label));
 
     g.tracks = tracks_of(trials, o);
-    std::vector<double> rev_means, quest_means;
+    std::vector<double> rev_means, posterior_means;
     for (const TrackResult& tr : g.tracks) {
         if (tr.reversals && tr.reversals->mean) rev_means.push_back(*tr.reversals->mean);
-        if (tr.quest && tr.quest->mean) quest_means.push_back(*tr.quest->mean);
+        if (tr.posterior && tr.posterior->mean) posterior_means.push_back(*tr.posterior->mean);
     }
     g.reversal_mean = mean_of(rev_means);
-    g.quest_mean = mean_of(quest_means);
+    g.posterior_mean = mean_of(posterior_means);
 
     const std::string what = std::abs(info.target_p - 0.5) < 1e-12 && info.guess_rate == 0.0
                                  ? std::string("PSE")
@@ -331,15 +331,15 @@ GroupResult analyse_group(const ConditionInfo& info, const std::string& observer
     } else {
         // No fit: the procedure's own estimate, where it has one.
         const std::string why = g.fit->reason.empty() ? "no psychometric fit" : g.fit->reason;
-        if (g.tracks.size() == 1 && g.tracks[0].quest && g.tracks[0].quest->mean) {
-            const QuestSummary& q = *g.tracks[0].quest;
+        if (g.tracks.size() == 1 && g.tracks[0].posterior && g.tracks[0].posterior->mean) {
+            const PosteriorSummary& q = *g.tracks[0].posterior;
             h.value = q.mean;
             h.ci = q.interval;
             h.method = "QUEST's posterior mean (no psychometric fit)";
             h.reliable = false;
             h.reason = "the psychometric fit failed (" + why + "); QUEST's own estimate is shown";
-        } else if (g.quest_mean) {
-            h.value = g.quest_mean;
+        } else if (g.posterior_mean) {
+            h.value = g.posterior_mean;
             h.method = "mean of the QUEST tracks' posterior means (no psychometric fit)";
             h.reason = "the psychometric fit failed (" + why + "); QUEST's own estimate is shown, without an interval";
         } else if (g.reversal_mean) {

@@ -37,8 +37,10 @@ void read_stops(const std::string& text, std::int64_t id, const std::string& fil
     info.stop_text = fmt::format(
         "{}: {} of {} presentations missed their refresh, {} refreshes lost (worst {}, {:.0f} ms)",
         info.stop_reason == "missed_in_a_row" ? "missed presentations in a row" : "too many missed presentations",
-        store::number_at(last, "/missed_this_run").value_or(0), store::number_at(last, "/presented_this_run").value_or(0),
-        store::number_at(last, "/dropped_frames").value_or(0), store::number_at(last, "/worst_dropped_frames").value_or(0),
+        store::number_at(last, "/missed_this_run").value_or(0),
+        store::number_at(last, "/presented_this_run").value_or(0),
+        store::number_at(last, "/dropped_frames").value_or(0),
+        store::number_at(last, "/worst_dropped_frames").value_or(0),
         store::number_at(last, "/worst_dropped_frames").value_or(0) * period_ms);
     d.notes.push_back(fmt::format("{} session {} was stopped by the runner {} time(s), last at trial {}: {}", file, id,
                                   info.stops, store::number_at(last, "/trials_stored").value_or(0), info.stop_text));
@@ -170,10 +172,14 @@ void read_stimulus(Trial& t, const std::string& json, const SceneLights* scene, 
     std::set<std::string> keys;
     for (const Frame& f : frames)
         for (const SceneOverride& o : f.overrides) keys.insert(o.key);
-    const std::set<std::string> covered{t.level_key, "eye.adaptation_cd_m2", "tonemap.operator", "eye.glare",
-                                        test_light.empty() ? std::string() : "light." + test_light + ".intensity_cd",
-                                        test_light.empty() ? std::string() : "light." + test_light + ".glare",
-                                        reference_light.empty() ? std::string() : "light." + reference_light + ".glare"};
+    const std::set<std::string> covered{
+        t.level_key,
+        "eye.adaptation_cd_m2",
+        "tonemap.operator",
+        "eye.glare",
+        test_light.empty() ? std::string() : "light." + test_light + ".intensity_cd",
+        test_light.empty() ? std::string() : "light." + test_light + ".glare",
+        reference_light.empty() ? std::string() : "light." + reference_light + ".glare"};
     for (const std::string& key : keys) {
         if (covered.count(key)) continue;
         // The values as written (the factor columns' text).
@@ -257,8 +263,7 @@ namespace {
 /// presentation margin and its gamut choice, into `info`; a note for each departure into `d`.
 void read_displayability(const std::string& text, std::int64_t session_id, const std::string& file, SessionInfo& info,
                          Dataset& d) {
-    const nlohmann::json j =
-        store::parse_json(text, fmt::format("displayability_json of session {}", session_id));
+    const nlohmann::json j = store::parse_json(text, fmt::format("displayability_json of session {}", session_id));
     info.displayable = store::boolean_at(j, "/displayable");
     info.allowed_undisplayable = store::boolean_at(j, "/allowed_undisplayable").value_or(false);
     for (const nlohmann::json& c : store::array_at(j, "/conditions"))

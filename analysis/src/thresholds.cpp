@@ -86,8 +86,8 @@ double posterior_quantile(const std::vector<double>& grid, const std::vector<dou
 
 }  // namespace
 
-QuestSummary summarize_quest(const QuestPosterior& q, double level) {
-    QuestSummary s;
+PosteriorSummary summarize_posterior(const StoredPosterior& q, double level) {
+    PosteriorSummary s;
     std::vector<std::string> reasons;
     const bool level_ok = level > 0.0 && level < 1.0;
     if (!level_ok) reasons.push_back(fmt::format("interval level {} is outside (0, 1)", level));

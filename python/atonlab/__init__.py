@@ -170,7 +170,7 @@ def run(protocol, db, observer="model", headless=True, progress=None, *, script=
 _BOOL = ("outcome", "test_on_left", "missed_deadline", "chose_reference", "reversal")
 _INT = ("trial_index", "block_index", "dropped_frames")
 _FLOAT = ("level", "response_value", "response_time_s", "onset_time_s", "adaptation_cd_m2", "test_intensity_cd",
-          "guess_rate", "target_p", "quest_mean", "quest_sd", "quest_lower", "quest_upper")
+          "guess_rate", "target_p", "posterior_mean", "posterior_sd", "posterior_lower", "posterior_upper")
 #: A text column becomes categorical when it has at most this many distinct values ...
 CATEGORY_MAX_VALUES = 64
 #: ... and at most this fraction of the rows.

@@ -115,7 +115,8 @@ double cie191_ratio(const std::string& colour, double level) {
 // intensity over white's (1 where not given).
 using AddedByColour = std::map<std::string, std::map<std::string, double>>;
 AddedByColour added_by_colour(FrameRenderer& frame, DisplayPipeline& display, const std::string& glare, double level,
-                              const std::vector<MesopicModel>& models, const std::map<std::string, double>& scale = {}) {
+                              const std::vector<MesopicModel>& models,
+                              const std::map<std::string, double>& scale = {}) {
     // The light's core is about its intensity × 32.8 cd/m² per cd (500 m, 50 px/deg):
     // three times the sky's luminance, inside the tone curves' near-linear part and far
     // above one code step at every level.
@@ -132,7 +133,8 @@ AddedByColour added_by_colour(FrameRenderer& frame, DisplayPipeline& display, co
                 o.tonemap.mesopic = mes;
                 display.process(frame.hdr_texture(), o, scene.adaptation_cd_m2, 0.0, 0, frame.pre_exposure(), true);
                 const double sum = frame_sum_cd_m2(display.read_codes(), scene.output.display);
-                const std::string name = std::string(tone_operator_name(op)) + " " + std::string(mesopic_model_name(mes));
+                const std::string name =
+                    std::string(tone_operator_name(op)) + " " + std::string(mesopic_model_name(mes));
                 if (colour.empty())
                     added[name]["sky"] = sum;
                 else
@@ -153,11 +155,11 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
         "| L_wa (cd/m²) | operator | mesopic | glare | red | green | yellow | blue |\n"
         "|---|---|---|---|---|---|---|---|\n");
     for (const double level : kLevels) {
-        std::map<std::string, std::map<std::string, double>> glare_change;  // op -> colour -> with/without
+        std::map<std::string, std::map<std::string, double>> glare_change;   // op -> colour -> with/without
         std::map<std::string, std::map<std::string, double>> without_glare;  // op -> colour -> cd/m² summed
         for (const std::string glare : {"none", "wave-optics"}) {
-            const auto added = added_by_colour(frame, display, glare, level,
-                                               {MesopicModel::k2012, MesopicModel::cie191});
+            const auto added =
+                added_by_colour(frame, display, glare, level, {MesopicModel::k2012, MesopicModel::cie191});
             for (const auto& [op, by_colour] : added) {
                 char head[96];
                 std::snprintf(head, sizeof head, "| %g | %s | %s | %s |", level, op.substr(0, op.find(' ')).c_str(),
@@ -190,15 +192,16 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
                     const bool within = ratio / cie <= 1.5 && cie / ratio <= 1.5;
                     if (!within && !cie191 && !explained(op, colour, level)) {
                         ++unexplained;
-                        ADD_FAILURE() << op << " " << colour << " at " << level << " cd/m2 (" << glare << "): displayed "
-                                      << ratio << " of white, CIE 191 " << cie << ": not explained in the docs";
+                        ADD_FAILURE() << op << " " << colour << " at " << level << " cd/m2 (" << glare
+                                      << "): displayed " << ratio << " of white, CIE 191 " << cie
+                                      << ": not explained in the docs";
                     }
                     // An explanation is stale when the ratio is clearly within (a factor 1.4).
                     if (!cie191 && explained(op, colour, level) && ratio / cie < 1.4 && cie / ratio < 1.4) {
                         ++explained_but_within;
                         ADD_FAILURE() << op << " " << colour << " at " << level << " cd/m2 (" << glare
-                                      << "): explained as a deviation, but displayed " << ratio << " of white against CIE 191 "
-                                      << cie;
+                                      << "): explained as a deviation, but displayed " << ratio
+                                      << " of white against CIE 191 " << cie;
                     }
                     char cell[64];
                     std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", ratio, cie, within ? "" : " *");
@@ -236,7 +239,6 @@ TEST_F(MesopicBrightness, ColouredLightsAgainstWhiteBesideCie191) {
     EXPECT_EQ(explained_but_within, 0);
 }
 
-
 // Issue 43: cie191 within a factor 1.1 of MES2 over its whole range, 0.005-5 cd/m² (the ends and
 // points between the decades the table shows), with and without glare, for both operators.
 // Each coloured light's intensity is white's over its MES2 ratio, so that every light gives the
@@ -256,7 +258,8 @@ TEST_F(MesopicBrightness, Cie191FollowsMes2AcrossItsWholeRange) {
                 for (const char* colour : kColours) {
                     const double ratio = by_colour.at(colour) / by_colour.at("white") / scale.at(colour),
                                  cie = cie191_ratio(colour, level);
-                    std::printf("%g cd/m2 %s %s %s: %.3f / %.3f\n", level, op.c_str(), glare.c_str(), colour, ratio, cie);
+                    std::printf("%g cd/m2 %s %s %s: %.3f / %.3f\n", level, op.c_str(), glare.c_str(), colour, ratio,
+                                cie);
                     EXPECT_TRUE(ratio / cie <= 1.1 && cie / ratio <= 1.1)
                         << op << " " << colour << " at " << level << " cd/m2 (" << glare << "): displayed " << ratio
                         << " of white per cd, CIE 191 " << cie;

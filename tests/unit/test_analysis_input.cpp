@@ -96,6 +96,25 @@ TEST(AnalysisCsv, QuotedFieldsAndCrlf) {
     EXPECT_EQ(d.trials[0].outcome, std::optional<bool>(true));
 }
 
+TEST(AnalysisCsv, DeprecatedQuestColumnsAreReadAsThePosteriorsWithANote) {
+    TempDir dir;
+    write(
+        dir / "old.csv",
+        "observer,condition,level,response,quest_mean,quest_sd,quest_lower,quest_upper\nP,c,-1,1,-1.5,0.2,-1.9,-1.1\n");
+    const Dataset d = read_trials_csv(dir / "old.csv");
+    ASSERT_EQ(d.trials.size(), 1u);
+    EXPECT_EQ(d.trials[0].posterior_mean, std::optional<double>(-1.5));
+    EXPECT_EQ(d.trials[0].posterior_sd, std::optional<double>(0.2));
+    EXPECT_EQ(d.trials[0].posterior_lower, std::optional<double>(-1.9));
+    EXPECT_EQ(d.trials[0].posterior_upper, std::optional<double>(-1.1));
+    ASSERT_EQ(d.notes.size(), 1u);
+    EXPECT_NE(d.notes[0].find("quest_mean as posterior_mean"), std::string::npos) << d.notes[0];
+    // The new name wins where a file has both; the old column is then not used.
+    write(dir / "both.csv", "observer,condition,level,response,quest_mean,posterior_mean\nP,c,-1,1,-1.5,-1.25\n");
+    const Dataset both = read_trials_csv(dir / "both.csv");
+    EXPECT_EQ(both.trials[0].posterior_mean, std::optional<double>(-1.25));
+}
+
 TEST(AnalysisCsv, MissingRequiredColumnNamesItAndLineOne) {
     TempDir dir;
     write(dir / "t.csv", "observer,condition,response\nP,c,1\n");
@@ -128,18 +147,21 @@ TEST(AnalysisCsv, BadValuesNameLineAndColumn) {
 TEST(AnalysisCsv, StructuralErrors) {
     TempDir dir;
     write(dir / "empty.csv", "");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "empty.csv"); }).where().value_or(SourceLocation{}).line, 1);
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "empty.csv"); }).where().value_or(SourceLocation{}).line,
+              1);
     write(dir / "header-only.csv", "observer,condition,level,response\n");
     EXPECT_NE(
         std::string(expect_input_error([&] { read_trials_csv(dir / "header-only.csv"); }).what()).find("no trials"),
         std::string::npos);
     write(dir / "short.csv", "observer,condition,level,response\nP,c,1\n");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "short.csv"); }).where().value_or(SourceLocation{}).line, 2);
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "short.csv"); }).where().value_or(SourceLocation{}).line,
+              2);
     write(dir / "quote.csv", "observer,condition,level,response\nP,\"c,1,1\n");
     EXPECT_NE(std::string(expect_input_error([&] { read_trials_csv(dir / "quote.csv"); }).what()).find("never closed"),
               std::string::npos);
     write(dir / "dup.csv", "observer,condition,level,level,response\nP,c,1,1,1\n");
-    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "dup.csv"); }).where().value_or(SourceLocation{}).key, "level");
+    EXPECT_EQ(expect_input_error([&] { read_trials_csv(dir / "dup.csv"); }).where().value_or(SourceLocation{}).key,
+              "level");
     EXPECT_NE(
         std::string(expect_input_error([&] { read_trials_csv(dir / "missing.csv"); }).what()).find("cannot be opened"),
         std::string::npos);
@@ -257,12 +279,12 @@ TEST(AnalysisStudy, StaircaseReversalsAndQuestPosteriorsMatchTheProceduresOwn) {
                     if (t.track == tr.procedure_id) mine = &t;
             ASSERT_NE(mine, nullptr) << tr.procedure_id;
             if (mine->procedure == "quest") {
-                ASSERT_TRUE(mine->quest && mine->quest->mean && mine->quest->sd);
-                EXPECT_DOUBLE_EQ(*mine->quest->mean, tr.estimate.value) << tr.procedure_id;
-                EXPECT_DOUBLE_EQ(*mine->quest->sd, tr.estimate.sd) << tr.procedure_id;
-                ASSERT_TRUE(mine->quest->interval);
-                EXPECT_LT(mine->quest->interval->lower, *mine->quest->mean);
-                EXPECT_GT(mine->quest->interval->upper, *mine->quest->mean);
+                ASSERT_TRUE(mine->posterior && mine->posterior->mean && mine->posterior->sd);
+                EXPECT_DOUBLE_EQ(*mine->posterior->mean, tr.estimate.value) << tr.procedure_id;
+                EXPECT_DOUBLE_EQ(*mine->posterior->sd, tr.estimate.sd) << tr.procedure_id;
+                ASSERT_TRUE(mine->posterior->interval);
+                EXPECT_LT(mine->posterior->interval->lower, *mine->posterior->mean);
+                EXPECT_GT(mine->posterior->interval->upper, *mine->posterior->mean);
             } else {
                 ASSERT_TRUE(mine->reversals && mine->reversals->mean) << tr.procedure_id;
                 // Within 1e-12: the analysis takes the levels without the noise of
@@ -344,8 +366,8 @@ TEST(AnalysisCsv, TrialsCsvRoundTripGivesTheSameTrialsAndFits) {
         EXPECT_EQ(a.guess_rate, b.guess_rate);
         EXPECT_EQ(a.target_p, b.target_p);
         EXPECT_EQ(a.reversal, b.reversal);
-        EXPECT_EQ(a.quest_mean, b.quest_mean);
-        EXPECT_EQ(a.quest_upper, b.quest_upper);
+        EXPECT_EQ(a.posterior_mean, b.posterior_mean);
+        EXPECT_EQ(a.posterior_upper, b.posterior_upper);
     }
     AnalysisOptions o;
     o.bootstrap = 60;

@@ -307,7 +307,7 @@ TEST(AnalysisReport, SummaryJsonNumbersReadBackBitForBit) {
             same(at + "/headline/value", g.headline.value);
             same_interval(at + "/headline/ci", g.headline.ci);
             same(at + "/reversal_mean", g.reversal_mean);
-            same(at + "/quest_mean", g.quest_mean);
+            same(at + "/posterior_mean", g.posterior_mean);
             for (std::size_t l = 0; l < g.counts.size(); ++l)
                 same(fmt::format("{}/counts/{}/level", at, l), g.counts[l].level);
             if (g.fit && g.fit->estimate) {

@@ -58,13 +58,13 @@ TEST(AnalysisReversals, MeanAndSdOfTheLastK) {
 TEST(AnalysisQuest, GaussianPosteriorOnAGrid) {
     // N(0.3, 0.1^2) on a fine grid: mean 0.3, SD 0.1, mode 0.3, 95% interval
     // 0.3 -+ 1.959964 * 0.1 (to the grid's resolution).
-    an::QuestPosterior q;
+    an::StoredPosterior q;
     for (int i = -2000; i <= 2000; ++i) {
         const double t = 0.3 + i * 0.00025;
         q.grid.push_back(t);
         q.posterior.push_back(std::exp(-0.5 * std::pow((t - 0.3) / 0.1, 2)));
     }
-    const auto s = an::summarize_quest(q, 0.95);
+    const auto s = an::summarize_posterior(q, 0.95);
     ASSERT_TRUE(s.from_posterior);
     EXPECT_TRUE(s.reliable) << s.reason;
     EXPECT_NEAR(*s.mean, 0.3, 1e-9);
@@ -84,10 +84,10 @@ TEST(AnalysisQuest, AgreesWithTheProcedureItself) {
     p.n_trials = 40;
     pr::Quest quest(p);
     for (int i = 0; i < 30; ++i) quest.record(pr::binary(i % 3 != 0));
-    an::QuestPosterior q;
+    an::StoredPosterior q;
     q.grid = quest.grid();
     q.posterior = quest.posterior();
-    const auto s = an::summarize_quest(q, 0.9);
+    const auto s = an::summarize_posterior(q, 0.9);
     ASSERT_TRUE(s.mean && s.sd && s.interval);
     EXPECT_NEAR(*s.mean, quest.mean(), 1e-9);
     EXPECT_NEAR(*s.sd, quest.sd(), 1e-9);
@@ -97,11 +97,11 @@ TEST(AnalysisQuest, AgreesWithTheProcedureItself) {
 }
 
 TEST(AnalysisQuest, FromStoredValues) {
-    an::QuestPosterior q;
+    an::StoredPosterior q;
     q.mean = -0.8;
     q.sd = 0.15;
     q.quantiles = {{0.025, -1.1}, {0.975, -0.5}};
-    const auto s = an::summarize_quest(q, 0.95);
+    const auto s = an::summarize_posterior(q, 0.95);
     EXPECT_FALSE(s.from_posterior);
     EXPECT_TRUE(s.reliable) << s.reason;
     EXPECT_EQ(*s.mean, -0.8);
@@ -109,20 +109,20 @@ TEST(AnalysisQuest, FromStoredValues) {
     EXPECT_EQ(s.interval->upper, -0.5);
     EXPECT_FALSE(s.interval_is_normal_approximation);
     // No matching quantiles: mean -+ z sd, flagged.
-    const auto s90 = an::summarize_quest(q, 0.90);
+    const auto s90 = an::summarize_posterior(q, 0.90);
     ASSERT_TRUE(s90.interval);
     EXPECT_TRUE(s90.interval_is_normal_approximation);
     EXPECT_NEAR(s90.interval->upper, -0.8 + 1.6448536269514722 * 0.15, 1e-12);
     // Nothing stored: absent values, unreliable, no throw.
-    const auto empty = an::summarize_quest({}, 0.95);
+    const auto empty = an::summarize_posterior({}, 0.95);
     EXPECT_FALSE(empty.mean);
     EXPECT_FALSE(empty.interval);
     EXPECT_FALSE(empty.reliable);
     // A broken grid falls back to the stored values and says so.
-    an::QuestPosterior broken = q;
+    an::StoredPosterior broken = q;
     broken.grid = {0.0, 1.0};
     broken.posterior = {1.0};
-    const auto b = an::summarize_quest(broken, 0.95);
+    const auto b = an::summarize_posterior(broken, 0.95);
     EXPECT_FALSE(b.from_posterior);
     EXPECT_EQ(*b.mean, -0.8);
     EXPECT_FALSE(b.reliable);

@@ -46,7 +46,7 @@ std::unique_ptr<Procedure> make(const ProcedureParams& params, std::optional<dou
 }
 
 /// QuestDemo's final estimate (mean +- sd) and the 95% credible interval by
-/// QuestQuantile (analysis: thresholds.h summarize_quest reads them back).
+/// QuestQuantile (analysis: thresholds.h summarize_posterior reads them back).
 TrackState posterior_state(const Procedure& p) {
     TrackState s;
     if (const auto* quest = dynamic_cast<const Quest*>(&p)) {

@@ -97,7 +97,7 @@ struct Trial {
     std::optional<bool> reversal;
     /// QUEST: the posterior after this trial, log10 units: mean (QuestMean), SD
     /// (QuestSd) and the 2.5% and 97.5% quantiles (QuestQuantile).
-    std::optional<double> quest_mean, quest_sd, quest_lower, quest_upper;
+    std::optional<double> posterior_mean, posterior_sd, posterior_lower, posterior_upper;
 
     /// An adjustment trial that confirms a match (its level is the match).
     bool is_match() const noexcept { return task == protocols::Task::Adjust && (response == "confirm" || response == "match"); }

@@ -76,7 +76,8 @@ struct ConditionInfo {
     std::string level_unit() const;
     /// Glare on the test and not (or differently) on the reference: the glare-brightness question.
     bool compares_glare() const noexcept {
-        return task != protocols::Task::YesNo && !glare_test.empty() && glare_test != "none" && glare_test != glare_reference;
+        return task != protocols::Task::YesNo && !glare_test.empty() && glare_test != "none" &&
+               glare_test != glare_reference;
     }
     /// Both lights are known from the stored scene.
     bool lights_known() const noexcept { return !test_look.colour.empty() && !reference_look.colour.empty(); }
@@ -96,9 +97,9 @@ struct TrackResult {
     std::string session, observer, track, procedure;
     std::vector<double> levels;  ///< per trial, in order
     std::vector<std::optional<bool>> outcomes;
-    std::vector<bool> reversal;                ///< per trial; empty when unknown
-    std::optional<ReversalSummary> reversals;  ///< staircases
-    std::optional<QuestSummary> quest;         ///< QUEST
+    std::vector<bool> reversal;                 ///< per trial; empty when unknown
+    std::optional<ReversalSummary> reversals;   ///< staircases
+    std::optional<PosteriorSummary> posterior;  ///< a procedure with a posterior (QUEST)
 };
 
 /// A headline number with its interval: what the PSE figure and paired
@@ -135,7 +136,7 @@ struct GroupResult {
     std::optional<double> threshold_proportion;  ///< F at the threshold: (target_p - gamma) / (1 - gamma)
     std::vector<TrackResult> tracks;
     std::optional<double> reversal_mean;       ///< mean over tracks of their reversal means
-    std::optional<double> quest_mean;          ///< mean over tracks of QUEST's posterior means
+    std::optional<double> posterior_mean;      ///< mean over tracks of QUEST's posterior means
     std::optional<AdjustmentSummary> matches;  ///< adjustment: matched levels (mean, median, CIs)
     std::optional<MatchRatio> match_ratio;     ///< log10(match / test intensity)
     HeadlineEstimate headline;

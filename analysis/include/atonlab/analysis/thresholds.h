@@ -34,7 +34,7 @@ struct ReversalSummary {
 ReversalSummary summarize_reversals(std::span<const double> levels, std::span<const bool> reversal, int last_k);
 
 /// What is known about a finished QUEST, as stored by the procedure.
-struct QuestPosterior {
+struct StoredPosterior {
     std::optional<double> mean;  ///< posterior mean (QuestMean), log10 units
     std::optional<double> sd;    ///< posterior SD (QuestSd), log10 units
     /// Stored quantiles: (order, value), e.g. {0.05, t05}, {0.95, t95}.
@@ -46,11 +46,11 @@ struct QuestPosterior {
     std::vector<double> posterior;
 };
 
-struct QuestSummary {
+struct PosteriorSummary {
     std::optional<double> mean;                     ///< log10 units
     std::optional<double> sd;                       ///< log10 units
     std::optional<double> mode;                     ///< from the posterior grid only
-    std::optional<Interval> interval;               ///< at the requested level (see summarize_quest)
+    std::optional<Interval> interval;               ///< at the requested level (see summarize_posterior)
     bool from_posterior = false;                    ///< recomputed from the grid
     bool interval_is_normal_approximation = false;  ///< mean +- z sd, no quantiles available
     bool reliable = false;
@@ -63,6 +63,6 @@ struct QuestSummary {
 /// at `level` comes from the grid, else from stored quantiles of orders
 /// (1 -+ level)/2 (within 1e-9), else as mean -+ z sd (normal approximation,
 /// flagged). Never throws; absent values where nothing can be said.
-QuestSummary summarize_quest(const QuestPosterior& q, double level = 0.95);
+PosteriorSummary summarize_posterior(const StoredPosterior& q, double level = 0.95);
 
 }  // namespace atonlab::analysis
