@@ -17,7 +17,7 @@
 
 namespace {
 
-using namespace atonlab::protocols;  // NOLINT: the test exercises the whole namespace
+using namespace atonlab::protocols;                      // NOLINT: the test exercises the whole namespace
 using namespace atonlab::protocols::protocol_file_test;  // NOLINT: the shared examples and readers
 namespace fs = std::filesystem;
 

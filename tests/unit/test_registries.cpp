@@ -79,7 +79,7 @@ std::vector<Registry> registries() {
 
 /// The folders scanned: the libraries, the command line, the Python module, the
 /// bench and the presentation layer (not docs, tests, examples or scenes).
-constexpr const char* kScannedFolders[] = {"stimuli", "display", "runner",  "protocols", "analysis",
+constexpr const char* kScannedFolders[] = {"stimuli", "display", "runner", "protocols", "analysis",
                                            "common",  "store",   "python", "bench",     "present"};
 
 struct Literal {
@@ -256,11 +256,11 @@ std::vector<HowToAdd> how_to_adds() {
     HowToAdd encoding{"How to add a display encoding", {}};
     for (const display::DisplayEncoding& e : display::display_encodings()) {
         const std::string name(e.name);  // TransferKind::pq, DisplayModel::pq, transfer_law::pq_luminance
-        encoding.entries.push_back({name,
-                                    name,
-                                    {name, name + "_luminance", name + "_drive", name + "_display",
-                                     std::string(e.glsl_drive_function)},
-                                    {name}});
+        encoding.entries.push_back(
+            {name,
+             name,
+             {name, name + "_luminance", name + "_drive", name + "_display", std::string(e.glsl_drive_function)},
+             {name}});
     }
     out.push_back(encoding);
     HowToAdd procedure{"How to add a procedure", {}};
@@ -270,7 +270,8 @@ std::vector<HowToAdd> how_to_adds() {
         for (std::size_t i = 0; i < file.size(); ++i)
             if (file[i] != '_')
                 camel += i == 0 || file[i - 1] == '_' ? static_cast<char>(std::toupper(file[i])) : file[i];
-        procedure.entries.push_back({std::string(t->name), file, {camel, camel + "Params"}, {std::string(t->name), file}});
+        procedure.entries.push_back(
+            {std::string(t->name), file, {camel, camel + "Params"}, {std::string(t->name), file}});
     }
     out.push_back(procedure);
     return out;
@@ -284,8 +285,8 @@ const std::map<std::string, Scanned>& scanned_sources() {
         for (const char* folder : kScannedFolders)
             for (const auto& entry : fs::recursive_directory_iterator(root / folder)) {
                 const std::string ext = entry.path().extension().string();
-                if (!entry.is_regular_file() ||
-                    (ext != ".cpp" && ext != ".h" && ext != ".glsl" && ext != ".comp" && ext != ".frag" && ext != ".vert"))
+                if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".h" && ext != ".glsl" && ext != ".comp" &&
+                                                 ext != ".frag" && ext != ".vert"))
                     continue;
                 out[entry.path().lexically_relative(root).generic_string()] = scan_source(read_text(entry.path()));
             }
@@ -382,8 +383,8 @@ TEST(Registries, HowToAddCountsAreTheFilesTheTreeMakesANewEntryTouch) {
         }
         EXPECT_EQ(fewest, static_cast<std::size_t>(d.count))
             << "docs/architecture.md's \"" << h.section << "\" says " << d.count
-            << " files; the entry spelled in the fewest files (the one a new entry is like) is in " << fewest
-            << ":" << table;
+            << " files; the entry spelled in the fewest files (the one a new entry is like) is in " << fewest << ":"
+            << table;
         for (const Entry& e : h.entries) {
             if (files[e.name].size() != fewest) continue;
             std::set<std::string> expected;

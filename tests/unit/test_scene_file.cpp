@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
-#include "atonlab/common/input_error.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "scene_file_test_support.h"
 

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "scene_file_test_support.h"
 
