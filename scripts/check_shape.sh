@@ -4,7 +4,8 @@
 # repository). CTest runs it as unit.source_shape. It fails when
 #   - a source file under the libraries (common/ display/ stimuli/ protocols/
 #     store/ analysis/ bench/ present/ runner/ python/) is longer than 800 lines, unless it is
-#     in OVERSIZED_ALLOWED below;
+#     in OVERSIZED_ALLOWED below; so is a test file under tests/ (its C++,
+#     GLSL, Python and shell; tests/data/ holds inputs, not code);
 #   - a library includes the public headers (atonlab/<lib>/) of a library it
 #     does not depend on (docs/architecture.md, "Dependencies point one way";
 #     INCLUDES_ALLOWED below), e.g. present/ a header of the runner's;
@@ -27,6 +28,9 @@ import sys
 root = sys.argv[1]
 LIBRARIES = ["common", "display", "stimuli", "protocols", "store", "analysis", "bench", "present", "runner", "python"]
 SOURCE_SUFFIXES = (".cpp", ".cc", ".c", ".h", ".hpp", ".comp", ".frag", ".vert", ".geom", ".glsl")
+# The tests: held to the file length only (split by topic, docs/architecture.md "Rules").
+TEST_FOLDER = "tests"
+TEST_SUFFIXES = SOURCE_SUFFIXES + (".py", ".sh")
 MAX_FILE_LINES = 800
 MAX_FUNCTION_LINES = 150
 
@@ -66,6 +70,20 @@ def library_sources():
                 if name.endswith(SOURCE_SUFFIXES):
                     path = os.path.join(dirpath, name)
                     yield os.path.relpath(path, root), path
+
+
+def test_sources():
+    top = os.path.join(root, TEST_FOLDER)
+    for dirpath, dirnames, filenames in os.walk(top):
+        dirnames[:] = sorted(d for d in dirnames if not (dirpath == top and d == "data"))
+        for name in sorted(filenames):
+            if name.endswith(TEST_SUFFIXES):
+                path = os.path.join(dirpath, name)
+                yield os.path.relpath(path, root), path
+
+
+def line_count(text):
+    return text.count("\n") + (0 if text.endswith("\n") or text == "" else 1)
 
 
 def blank_comments_and_literals(text):
@@ -213,7 +231,7 @@ for rel, path in library_sources():
                 line = text.count("\n", 0, m.start()) + 1
                 findings.append(f"{rel}:{line}: {lib}/ includes atonlab/{m.group(1)}/, a library it does not "
                                 f"depend on (docs/architecture.md, \"Dependencies point one way\")")
-    n_lines = text.count("\n") + (0 if text.endswith("\n") or text == "" else 1)
+    n_lines = line_count(text)
     if n_lines > MAX_FILE_LINES and rel not in OVERSIZED_ALLOWED:
         findings.append(f"{rel}:1: {n_lines} lines, more than {MAX_FILE_LINES}: split it along its parts")
     if rel.endswith((".cpp", ".cc", ".c", ".h", ".hpp")):
@@ -229,6 +247,13 @@ for rel, path in library_sources():
                 continue
             findings.append(f"{rel}:{first}: {name} is {length} lines, more than {MAX_FUNCTION_LINES}, and no "
                             f"comment in the 3 lines above says why it must be one piece")
+
+for rel, path in test_sources():
+    with open(path, encoding="utf-8", errors="replace") as f:
+        n_lines = line_count(f.read())
+    if n_lines > MAX_FILE_LINES:
+        findings.append(f"{rel}:1: {n_lines} lines, more than {MAX_FILE_LINES}: split it by topic "
+                        f"(a shared helper goes in a small header beside it)")
 
 for rel in sorted(OVERSIZED_ALLOWED):
     path = os.path.join(root, rel)

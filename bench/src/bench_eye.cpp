@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "atonlab/stimuli/cie_glare.h"
+#include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/psf.h"
 #include "bench_common.h"
 
@@ -138,9 +139,9 @@ void bench_eye_validation(Bench& b) {
         "for the monochromatic columns. The halo columns: the same eye with its particles off (their scatter is "
         "brighter than the halo at 4°), D65 with 30 samples, the largest azimuthal mean beyond 2°. CIE (sr⁻¹, age "
         "{} years, pigmentation {}): GSF, the CIE glare spread function of Vos & van den Berg (CIE 135/1-1999), "
-        "the `cie` model's equation; General, the CIE 146:2002 General Disability Glare equation (valid 0.1° … "
+        "the `{}` model's equation; General, the CIE 146:2002 General Disability Glare equation (valid 0.1° … "
         "100°).\n\n",
-        n, n_far, kObserver.age_years, kObserver.pigmentation);
+        n, n_far, kObserver.age_years, kObserver.pigmentation, glare_model_name(GlareModel::cie));
     md +=
         "| pupil | core FWHM (arcmin) | diffraction limit 1.029 λ/D | ratio | core share | EE 0.1° | EE 0.5° | "
         "EE 1° | halo peak (luminance, gratings) | red / blue peak | colour order "

@@ -220,9 +220,9 @@ void bench_cie_veil_methods(Bench& b) {
     }
     const double slope = (times.back() - times.front()) / (counts.back() - counts.front());
     b.scaling_notes.push_back(fmt::format(
-        "cie veil, {}×{} px: the direct sum costs {:.2f} ms per lit pixel (+{:.0f} ms), the FFT {:.0f} ms per frame: "
+        "{} veil, {}×{} px: the direct sum costs {:.2f} ms per lit pixel (+{:.0f} ms), the FFT {:.0f} ms per frame: "
         "crossover at {:.0f} lit pixels (kVeilDirectMaxLitPixels = {}).",
-        w, h, slope, times.front() - slope * counts.front(), fft_ms,
+        glare_model_name(GlareModel::cie), w, h, slope, times.front() - slope * counts.front(), fft_ms,
         slope > 0 ? (fft_ms - (times.front() - slope * counts.front())) / slope : 0.0, kVeilDirectMaxLitPixels));
 }
 

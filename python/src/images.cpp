@@ -15,6 +15,7 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/toml_value.h"
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/image_io.h"
 #include "bindings.h"
@@ -381,19 +382,23 @@ std::string toml_value(const py::handle& value, const std::string& key) {
 }
 
 void bind_images(py::module_& m) {
+    // The display names from the registry (display_encodings.h), as `atonlab tonemap --display`'s help.
+    static const std::string tonemap_doc = fmt::format(
+        "Tone-maps and display-encodes an H×W×3 (or ×4) scene-referred array (linear Rec.709, cd/m², or "
+        "cd/m² = value × scale) as `atonlab tonemap` does, on the CPU in double precision; returns the H×W×3 "
+        "uint8 codes an 8-bit display is sent. operator: empirical (default), perceptual, reinhard, kakimoto, "
+        "linear, clamp; adaptation_cd_m2: L_wa (default: the log-average, K2012 eq 4.15); display: {} (default "
+        "{}), with peak_cd_m2 (100) and black_cd_m2 (0.1); dither, blueshift: bools; "
+        "hue_preservation: none, xyY, rgb; key, reinhard_white (a number or \"max\"): reinhard; white_cd_m2: "
+        "linear and clamp; scene: take [display] and [tonemap] from a scene file. The GIL is released.",
+        display::display_encoding_choices(""), display::display_encoding(display::TransferKind::srgb).name);
     m.def("tonemap", &tonemap, py::arg("hdr"), py::kw_only(), py::arg("operator") = py::none(),
           py::arg("adaptation_cd_m2") = py::none(), py::arg("display") = py::none(),
           py::arg("peak_cd_m2") = py::none(), py::arg("black_cd_m2") = py::none(), py::arg("dither") = py::none(),
           py::arg("blueshift") = py::none(), py::arg("hue_preservation") = py::none(), py::arg("key") = py::none(),
           py::arg("reinhard_white") = py::none(), py::arg("white_cd_m2") = py::none(),
           py::arg("epsilon_cd_m2") = py::none(), py::arg("scale") = py::none(), py::arg("scene") = py::none(),
-          "Tone-maps and display-encodes an H×W×3 (or ×4) scene-referred array (linear Rec.709, cd/m², or "
-          "cd/m² = value × scale) as `atonlab tonemap` does, on the CPU in double precision; returns the H×W×3 "
-          "uint8 codes an 8-bit display is sent. operator: empirical (default), perceptual, reinhard, kakimoto, "
-          "linear, clamp; adaptation_cd_m2: L_wa (default: the log-average, K2012 eq 4.15); display: srgb "
-          "(default) or pq, with peak_cd_m2 (100) and black_cd_m2 (0.1); dither, blueshift: bools; "
-          "hue_preservation: none, xyY, rgb; key, reinhard_white (a number or \"max\"): reinhard; white_cd_m2: "
-          "linear and clamp; scene: take [display] and [tonemap] from a scene file. The GIL is released.");
+          tonemap_doc.c_str());
     static const std::string glare_doc = glare_docstring();
     m.def("glare", &glare, py::arg("hdr"), py::arg("deg_per_px"), py::kw_only(), py::arg("model") = py::none(),
           py::arg("adaptation_cd_m2") = py::none(), py::arg("pupil_mm") = py::none(),

@@ -3,6 +3,7 @@
 // render` (runner/src/render_frame.h), its HDR image returned as a numpy view
 // of the frame's memory and its display codes as the display gets them.
 #include <epoxy/egl.h>
+#include <fmt/format.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
@@ -12,9 +13,11 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
@@ -189,6 +192,13 @@ GlUse::~GlUse() {
 }
 
 void bind_render(py::module_& m) {
+    // The laws' names from the registry (display_encodings.h).
+    static const std::string display_doc = fmt::format(
+        "The display as numbers: name, peak_cd_m2, black_cd_m2, transfer (the channels' law: {}; a list of three "
+        "where they differ), channel_white_cd_m2 and channel_black_cd_m2 (R, G, B), bits, primaries_xy (red, "
+        "green, blue and white CIE 1931 xy: Rec.709 with D65), width_px, height_px, width_m, viewing_distance_m "
+        "and focal_px (the viewing distance in pixel pitches).",
+        display::display_encoding_choices("\"", true));
     py::class_<PyFrame>(m, "Frame", "One rendered frame: the scene-referred image and what the display is sent.")
         .def_readonly("hdr", &PyFrame::hdr,
                       "H×W×3 float32: linear Rec.709 (sRGB primaries, D65), absolute cd/m² (Y = 0.2126 R + 0.7152 G "
@@ -207,12 +217,7 @@ void bind_render(py::module_& m) {
             "metadata", &PyFrame::metadata,
             "What `atonlab render`'s EXR header carries: units, degreesPerPixel, adaptationLuminance (cd/m²), "
             "camera, scene, time_s, software, glare, tonemap, ...")
-        .def_readonly("display", &PyFrame::display,
-                      "The display as numbers: name, peak_cd_m2, black_cd_m2, transfer (the channels' law: "
-                      "\"srgb\", \"pq\", \"gog\", \"lut\"; a list of three where they differ), "
-                      "channel_white_cd_m2 and channel_black_cd_m2 (R, G, B), bits, primaries_xy (red, green, blue "
-                      "and white CIE 1931 xy: Rec.709 with D65), width_px, height_px, width_m, viewing_distance_m "
-                      "and focal_px (the viewing distance in pixel pitches).")
+        .def_readonly("display", &PyFrame::display, display_doc.c_str())
         .def_property_readonly(
             "displayed_cd_m2",
             [](PyFrame& f) {

@@ -5,7 +5,7 @@
 // claims, for several seeds (issue 5: "each example protocol converges on the
 // observer's true PSE/threshold within its confidence interval").
 //
-// tests/unit/test_protocol_file.cpp holds the same check on a toy renderer;
+// tests/unit/test_protocol_file_convergence.cpp holds the same check on a toy renderer;
 // this one is the real thing: tone mapping, display clipping, dithering and
 // glare included, at a quarter of the example display's resolution (below).
 // The suite runs seed 1 (its bounded form: a whole run of each example against
@@ -172,7 +172,7 @@ void expect_convergence(const std::string& name) {
             double estimate = sum / k;
             const double sd = std::sqrt(var / k);
             const double root_n = std::sqrt(static_cast<double>(std::max<std::size_t>(n, 1)));
-            // A 99.7% interval for the estimate, as test_protocol_file.cpp
+            // A 99.7% interval for the estimate, as test_protocol_file_convergence.cpp
             // argues for each method: 3 standard errors plus the quantisation
             // each procedure adds (its last step; a quarter level spacing for
             // the interpolated constant-stimuli PSE).

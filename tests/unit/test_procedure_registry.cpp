@@ -2,9 +2,10 @@
 // name and its enum, its parameters are its own alternative of
 // ProcedureParams, it declares what analysis follows in its tracks as the
 // literature describes the method, and its name is spelled once: a scan of
-// protocols/, analysis/ and runner/ finds no string literal naming a kind
-// outside the files listed below. docs/architecture.md "How to add a
-// procedure" names the files a new kind touches; the last test holds it to them.
+// protocols/, analysis/, runner/, python/, bench/ and present/ finds no string
+// literal naming a kind outside the files listed below. docs/architecture.md
+// "How to add a procedure" names the files a new kind touches; the last test
+// holds it to them (and tests/unit/test_registries.cpp to the tree).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -226,7 +227,7 @@ TEST(ProcedureRegistry, NamesAreSpelledOnlyInTheRegistry) {
 
     std::vector<std::string> found;
     std::size_t scanned = 0;
-    for (const char* dir : {"protocols", "analysis", "runner"}) {
+    for (const char* dir : {"protocols", "analysis", "runner", "python", "bench", "present"}) {
         for (const auto& e : fs::recursive_directory_iterator(root / dir)) {
             const std::string ext = e.path().extension().string();
             if (!e.is_regular_file() || (ext != ".h" && ext != ".cpp")) continue;
