@@ -1241,7 +1241,7 @@ procedure = { kind = "staircase", start = 1.0, step_sizes = [0.1], step_type = "
         return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
     };
     std::map<std::string, atonlab::SourceLocation> origin;
-    for (const Override& o : s.frames[0].overrides) origin[o.key] = o.origin;
+    for (const atonlab::SceneOverride& o : s.frames[0].overrides) origin[o.key] = o.origin;
     for (const char* key : {"width_px", "height_px", "width_m", "viewing_distance_m"}) {
         const atonlab::SourceLocation& w = origin["display." + std::string(key)];
         EXPECT_EQ(w.file, "inline.toml") << key;
@@ -1279,7 +1279,7 @@ conditions_file = "c.csv"
 )";
     }
     const Protocol from_csv = load_protocol(dir / "p.toml");
-    const std::vector<Override>& set = from_csv.blocks.at(0).conditions.at(0).set;
+    const std::vector<atonlab::SceneOverride>& set = from_csv.blocks.at(0).conditions.at(0).set;
     ASSERT_EQ(set.size(), 1u);
     EXPECT_EQ(set[0].origin.file, (dir / "c.csv").string());
     EXPECT_EQ(set[0].origin.line, 2);
@@ -1302,8 +1302,8 @@ TEST(ConditionsFile, TheStoredTextCarriesTheCsvSoThatItParsesWithoutIt) {
         ASSERT_EQ(p.blocks[b].conditions.size(), twin.blocks[b].conditions.size());
         for (std::size_t c = 0; c < p.blocks[b].conditions.size(); ++c) {
             std::vector<std::string> a, t;
-            for (const Override& o : p.blocks[b].conditions[c].set) a.push_back(o.text());
-            for (const Override& o : twin.blocks[b].conditions[c].set) t.push_back(o.text());
+            for (const atonlab::SceneOverride& o : p.blocks[b].conditions[c].set) a.push_back(o.text());
+            for (const atonlab::SceneOverride& o : twin.blocks[b].conditions[c].set) t.push_back(o.text());
             EXPECT_EQ(a, t);
         }
     }
