@@ -26,7 +26,7 @@
 #include "check_command.h"
 #include "displayability.h"
 #include "run_command.h"
-#include "run_session.h"
+#include "session/run_session.h"
 #include "session/session_inputs.h"
 #include "session/stop_signals.h"
 #include "session/summary.h"

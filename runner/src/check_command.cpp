@@ -25,7 +25,7 @@
 #include "calibrate/calibration_policy.h"
 #include "check_command.h"
 #include "displayability.h"
-#include "run_session.h"
+#include "session/run_session.h"
 
 namespace atonlab::runner {
 

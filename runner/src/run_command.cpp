@@ -14,7 +14,7 @@
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/store/error.h"
 #include "run_command.h"
-#include "run_session.h"
+#include "session/run_session.h"
 
 namespace atonlab::runner {
 

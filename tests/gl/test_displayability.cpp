@@ -45,7 +45,7 @@
 #include "atonlab/store/store.h"
 #include "displayability.h"
 #include "gl_test_support.h"
-#include "run_session.h"
+#include "session/run_session.h"
 #include "../support/skip.h"
 #include "text_contains.h"
 

@@ -32,7 +32,7 @@
 #include "atonlab/protocols/protocol_schedule.h"
 #include "gl_test_support.h"
 #include "long_tests.h"
-#include "run_session.h"
+#include "session/run_session.h"
 #include "../support/skip.h"
 
 namespace {

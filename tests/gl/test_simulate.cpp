@@ -20,7 +20,7 @@
 #include "../support/gl_test_support.h"
 #include "atonlab/protocols/rng.h"
 #include "atonlab/store/store.h"
-#include "run_session.h"
+#include "session/run_session.h"
 #include "session/session_inputs.h"
 #include "session/true_value.h"
 #include "simulate/decision_table.h"

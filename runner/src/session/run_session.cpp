@@ -1,6 +1,6 @@
 // The engine of `atonlab run` (run_session.h; docs/running.md): the driver
 // over the parts in session/.
-#include "run_session.h"
+#include "session/run_session.h"
 
 #include <fmt/format.h>
 
