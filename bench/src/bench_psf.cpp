@@ -213,7 +213,7 @@ void bench_spectral_samples(Bench& b) {
 void bench_fft(Bench& b) {
     const std::vector<int> sizes = b.quick() ? std::vector<int>{128} : std::vector<int>{512, 1024, 2048};
     const EyeModel eye = bench_eye();
-    const bool software = GpuPsfGenerator(kGpuFftMinSize).fft_placement() == PsfFftPlacement::cpu;
+    const bool software = GpuPsfGenerator(kGpuFftMinSize).fft_placement() == ComputePlacement::cpu;
     for (int n : sizes) {
         // The default eye's pupil plane, rounded to float: what the GPU transforms.
         const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
@@ -248,7 +248,7 @@ void bench_fft(Bench& b) {
             r.bench = bench;
             const bool table = tw == TwiddleSource::table_from_double;
             r.setting = table ? "GPU fp32, twiddle table" : "GPU fp32, shader sin/cos";
-            // The PSF generator's FFT (PsfFftPlacement::automatic): the GPU's, unless
+            // The PSF generator's FFT (ComputePlacement::automatic): the GPU's, unless
             // the renderer is software, where it is FFTW double on the CPU.
             r.is_default = table && !software;
             r.time = t;

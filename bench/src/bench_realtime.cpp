@@ -258,7 +258,7 @@ void bench_psf_rebuild(Bench& b) {
     // The GPU placement (GpuPsfGenerator::generate_anchored: pupil planes on
     // the CPU, the rest in compute shaders with the GPU's fp32 FFT), read
     // back; its error against the CPU's PSF is the placement's (issue 27: ≤ 1e-5).
-    GpuPsfGenerator gen(n, TwiddleSource::table_from_double, PsfFftPlacement::gpu);
+    GpuPsfGenerator gen(n, TwiddleSource::table_from_double, ComputePlacement::gpu);
     RgbPsf psf;
     const Timing t = measure(
         [&] {

@@ -72,7 +72,7 @@ std::string position_text(const std::array<double, 3>& p) {
     return fmt::format("[{}, {}, {}]", number_text(p[0]), number_text(p[1]), number_text(p[2]));
 }
 
-void append(std::vector<Override>& out, const std::vector<Override>& overrides) {
+void append(std::vector<SceneOverride>& out, const std::vector<SceneOverride>& overrides) {
     out.insert(out.end(), overrides.begin(), overrides.end());
 }
 
@@ -219,16 +219,16 @@ const Condition* Protocol::find_condition(std::string_view condition_name) const
     return nullptr;
 }
 
-std::vector<Override> Protocol::display_overrides() const {
+std::vector<SceneOverride> Protocol::display_overrides() const {
     // Each at its [display] line; a value with no line there came from the
     // command line (`atonlab check --set display.KEY=VALUE`).
     const auto at_line = [&](const std::string& key, std::string value) {
         const std::string scene_key = "display." + key;
         const auto it = display.lines.find(key);
         SourceLocation origin = it == display.lines.end()
-                                    ? SourceLocation::command_line(std::string(Override::kSetOption), scene_key)
+                                    ? SourceLocation::command_line(std::string(SceneOverride::kSetOption), scene_key)
                                     : SourceLocation{file, it->second, 0, scene_key};
-        return Override{scene_key, std::move(value), std::move(origin)};
+        return SceneOverride{scene_key, std::move(value), std::move(origin)};
     };
     return {at_line("width_px", fmt::format("{}", display.width_px)),
             at_line("height_px", fmt::format("{}", display.height_px)),
@@ -239,7 +239,7 @@ std::vector<Override> Protocol::display_overrides() const {
 std::vector<std::string> Frame::override_texts() const {
     std::vector<std::string> texts;
     texts.reserve(overrides.size());
-    for (const Override& o : overrides) texts.push_back(o.text());
+    for (const SceneOverride& o : overrides) texts.push_back(o.text());
     return texts;
 }
 
@@ -272,10 +272,10 @@ Stimulus make_stimulus(const Protocol& protocol, const Condition& condition, con
     s.scene_value = condition.scene_value(proposal.level);
     // The values the protocol makes for the condition stand at its line.
     const auto made = [&](std::string key, std::string value, std::string_view from) {
-        return Override{std::move(key), std::move(value),
-                        SourceLocation{protocol.file, condition.line, 0, std::string(from)}};
+        return SceneOverride{std::move(key), std::move(value),
+                             SourceLocation{protocol.file, condition.line, 0, std::string(from)}};
     };
-    const Override level_override = made(condition.level_key, number_text(s.scene_value), "level_key");
+    const SceneOverride level_override = made(condition.level_key, number_text(s.scene_value), "level_key");
     const bool test_first = proposal.test_on_left.value_or(true);
 
     auto frame_for = [&](Role role) {

@@ -261,8 +261,8 @@ private:
 
         // Every override with where it was written, for the conflict check below.
         std::vector<Written> written;
-        auto take = [&](const Found& f, Scope scope, std::vector<Override>& into) {
-            std::vector<Override> list = doc_.scene_overrides(f.node, f.key, r.context());
+        auto take = [&](const Found& f, Scope scope, std::vector<SceneOverride>& into) {
+            std::vector<SceneOverride> list = doc_.scene_overrides(f.node, f.key, r.context());
             for (std::size_t i = 0; i < list.size(); ++i)
                 written.push_back(Written{list[i], scope, layer_of(f.key),
                                           f.node->is_string() ? f.key : fmt::format("{}[{}]", f.key, i)});
@@ -374,7 +374,7 @@ private:
     /// Where it was written, general to specific.
     enum class Origin : std::uint8_t { defaults, block, condition };
     struct Written {
-        Override o;
+        SceneOverride o;
         Scope scope = Scope::every_frame;
         Origin layer = Origin::defaults;
         std::string path;  ///< "block[0].test_set[1]"
@@ -547,7 +547,7 @@ private:
         }
     }
 
-    static void append(std::vector<Override>& to, std::vector<Override> from) {
+    static void append(std::vector<SceneOverride>& to, std::vector<SceneOverride> from) {
         to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
     }
 

@@ -77,7 +77,7 @@ std::string Document::scene_key(const toml::node* n, const std::string& key, con
     return k;
 }
 
-Override Document::scene_override(const toml::node* n, const std::string& key, const std::string& context) const {
+SceneOverride Document::scene_override(const toml::node* n, const std::string& key, const std::string& context) const {
     const std::string text = string(n, key, context);
     // The one reader of "key=value" (common/scene_override.h).
     const std::optional<KeyValue> kv = read_key_value(text);
@@ -92,7 +92,7 @@ Override Document::scene_override(const toml::node* n, const std::string& key, c
     std::string no_message;
     relocate(origin, no_message);
     // The value is parsed here, once (SceneOverride's constructor).
-    Override o(kv->key, kv->text, std::move(origin));
+    SceneOverride o(kv->key, kv->text, std::move(origin));
     if (!is_scene_key(o.key))
         fail(n, key,
              context + fmt::format("\"{}\" is not a scene key: write section.key as in the scene file, e.g. "
@@ -107,14 +107,14 @@ Override Document::scene_override(const toml::node* n, const std::string& key, c
     return o;
 }
 
-std::vector<Override> Document::scene_overrides(const toml::node* n, const std::string& key,
-                                                const std::string& context) const {
+std::vector<SceneOverride> Document::scene_overrides(const toml::node* n, const std::string& key,
+                                                     const std::string& context) const {
     if (n->is_string()) return {scene_override(n, key, context)};
     if (!n->is_array())
         fail(n, key,
              context +
                  fmt::format("expected an array of \"section.key=value\" strings, got {}.", text::type_phrase(n->type())));
-    std::vector<Override> out;
+    std::vector<SceneOverride> out;
     const toml::array& a = *n->as_array();
     for (std::size_t i = 0; i < a.size(); ++i)
         out.push_back(scene_override(a.get(i), fmt::format("{}[{}]", key, i), context));

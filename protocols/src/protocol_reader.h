@@ -41,10 +41,10 @@ protected:
 public:
 
     /// One "section.key=value" scene override (value: one TOML value).
-    Override scene_override(const toml::node* n, const std::string& key, const std::string& context = {}) const;
+    SceneOverride scene_override(const toml::node* n, const std::string& key, const std::string& context = {}) const;
     /// An array of overrides (a single string is one override).
-    std::vector<Override> scene_overrides(const toml::node* n, const std::string& key,
-                                          const std::string& context = {}) const;
+    std::vector<SceneOverride> scene_overrides(const toml::node* n, const std::string& key,
+                                               const std::string& context = {}) const;
     /// A dotted scene key ("light.reference.intensity_cd").
     std::string scene_key(const toml::node* n, const std::string& key, const std::string& context = {}) const;
 

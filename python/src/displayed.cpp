@@ -13,10 +13,10 @@
 #include "atonlab/display/colour.h"
 #include "atonlab/display/display_encodings.h"
 #include "atonlab/protocols/observer.h"
+#include "atonlab/runner/session/scene_queries.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 #include "atonlab/stimuli/signal_colour.h"
 #include "bindings.h"
-#include "session/scene_queries.h"
-#include "session/stimulus_renderer.h"
 
 namespace atonlab::python {
 

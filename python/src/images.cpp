@@ -16,12 +16,12 @@
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/toml_value.h"
 #include "atonlab/display/display_encodings.h"
+#include "atonlab/runner/image_commands.h"
+#include "atonlab/runner/light_command.h"
+#include "atonlab/runner/psf_command.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/image_io.h"
 #include "bindings.h"
-#include "psf_command.h"
-#include "image_commands.h"
-#include "light_command.h"
 
 namespace atonlab::python {
 

@@ -1,6 +1,6 @@
 // atonlab.Scene and atonlab.Frame (docs/python.md "Rendering"): a scene file
 // loaded with typed overrides, rendered headless by the same core as `atonlab
-// render` (runner/src/render_frame.h), its HDR image returned as a numpy view
+// render` (atonlab/runner/render_frame.h), its HDR image returned as a numpy view
 // of the frame's memory and its display codes as the display gets them.
 #include <epoxy/egl.h>
 #include <fmt/format.h>
@@ -18,11 +18,11 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/display_encodings.h"
+#include "atonlab/runner/render_frame.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "bindings.h"
-#include "render_frame.h"
 
 namespace atonlab::python {
 

@@ -16,20 +16,20 @@
 #include <tuple>
 #include <vector>
 
-#include "analyze_command.h"
 #include "atonlab/analysis/dataset.h"
 #include "atonlab/analysis/psychometric.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/analyze_command.h"
+#include "atonlab/runner/check_command.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/run_command.h"
+#include "atonlab/runner/session/run_session.h"
+#include "atonlab/runner/session/session_inputs.h"
+#include "atonlab/runner/session/stop_signals.h"
+#include "atonlab/runner/session/summary.h"
 #include "bindings.h"
-#include "check_command.h"
-#include "displayability.h"
-#include "run_command.h"
-#include "run_session.h"
-#include "session/session_inputs.h"
-#include "session/stop_signals.h"
-#include "session/summary.h"
 
 namespace atonlab::python {
 

@@ -33,11 +33,11 @@
 #include "atonlab/analysis/study_analysis.h"
 #include "atonlab/display/colour.h"
 #include "atonlab/display/tonemap.h"
+#include "atonlab/runner/analyze_command.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
-#include "analyze_command.h"
 
 namespace atonlab::runner {
 

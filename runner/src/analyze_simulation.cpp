@@ -13,10 +13,10 @@
 #include <cstdio>
 #include <thread>
 
-#include "analyze_command.h"
 #include "atonlab/analysis/simulation.h"
 #include "atonlab/analysis/simulation_report.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/runner/analyze_command.h"
 
 namespace atonlab::runner {
 

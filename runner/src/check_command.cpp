@@ -14,18 +14,18 @@
 #include <string>
 #include <system_error>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/read_file.h"
 #include "atonlab/common/scene_override.h"
 #include "atonlab/protocols/protocol_file.h"
-#include "atonlab/common/input_error.h"
+#include "atonlab/runner/check_command.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/session/run_session.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/error.h"
 #include "atonlab/store/store.h"
 #include "calibrate/calibration_policy.h"
-#include "check_command.h"
-#include "displayability.h"
-#include "run_session.h"
 
 namespace atonlab::runner {
 

@@ -1,6 +1,6 @@
 // Displayability of a protocol's stimuli on its display (displayability.h;
 // docs/running.md, "Displayability").
-#include "displayability.h"
+#include "atonlab/runner/displayability.h"
 
 #include <fmt/format.h>
 

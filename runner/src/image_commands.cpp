@@ -4,7 +4,7 @@
 // images in and out"). Both run on the CPU in double precision (tonemap_pixel,
 // encode_pixel and the glare kernels are the pipeline's CPU references), so
 // they need no GL and take images of any size.
-#include "image_commands.h"
+#include "atonlab/runner/image_commands.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

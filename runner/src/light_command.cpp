@@ -3,7 +3,7 @@
 // Allard's law (K2012 eq 2.1; IALA E200-2) for one light: the range from the
 // intensity or the intensity from the range, the IALA nominal range and its
 // band, and the illuminance at given distances. docs/light.md.
-#include "light_command.h"
+#include "atonlab/runner/light_command.h"
 
 #include <CLI/CLI.hpp>
 #include <array>

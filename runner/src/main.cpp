@@ -9,18 +9,18 @@
 #include <CLI/CLI.hpp>
 
 #include "atonlab/common/read_file.h"
+#include "atonlab/runner/analyze_command.h"
+#include "atonlab/runner/check_command.h"
+#include "atonlab/runner/image_commands.h"
+#include "atonlab/runner/light_command.h"
+#include "atonlab/runner/psf_command.h"
+#include "atonlab/runner/run_command.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/gl/context.h"
-#include "calibrate/calibrate_command.h"
-#include "analyze_command.h"
 #include "bench_command.h"
-#include "check_command.h"
-#include "psf_command.h"
+#include "calibrate/calibrate_command.h"
 #include "render_command.h"
-#include "run_command.h"
 #include "simulate_command.h"
-#include "image_commands.h"
-#include "light_command.h"
 #include "view_command.h"
 
 int main(int argc, char** argv) {

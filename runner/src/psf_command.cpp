@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "atonlab/display/colour.h"
+#include "atonlab/runner/psf_command.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/eye_model.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -19,7 +20,6 @@
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "atonlab/stimuli/spectral_path.h"
-#include "psf_command.h"
 
 namespace atonlab::runner {
 

@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "atonlab/display/colour.h"
+#include "atonlab/runner/render_frame.h"
 #include "atonlab/stimuli/error.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/gl/context.h"
@@ -19,7 +20,6 @@
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "render_command.h"
-#include "render_frame.h"
 
 namespace atonlab::runner {
 

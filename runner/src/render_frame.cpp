@@ -1,6 +1,6 @@
 // One frame with its EXR metadata (render_frame.h): moved here from
 // render_command.cpp so that `atonlab render` and the Python module share it.
-#include "render_frame.h"
+#include "atonlab/runner/render_frame.h"
 
 #include <fmt/format.h>
 

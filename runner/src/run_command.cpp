@@ -12,9 +12,9 @@
 
 #include "atonlab/present/screen_presenter.h"
 #include "atonlab/protocols/protocol.h"
+#include "atonlab/runner/run_command.h"
+#include "atonlab/runner/session/run_session.h"
 #include "atonlab/store/error.h"
-#include "run_command.h"
-#include "run_session.h"
 
 namespace atonlab::runner {
 

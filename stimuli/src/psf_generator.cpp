@@ -31,8 +31,8 @@ unsigned groups_for(std::size_t count) {
 /// field itself rounded to float (the GPU transforms it), or its spectrum by
 /// FFTW in double rounded once to float (as fast as FFTW float on the machines
 /// measured, bench fft_nN, and exact).
-ComplexImage<float> field_as_uploaded(ComplexImage<double> f, PsfFftPlacement fft) {
-    if (fft == PsfFftPlacement::cpu) fftw_forward(f);
+ComplexImage<float> field_as_uploaded(ComplexImage<double> f, ComputePlacement fft) {
+    if (fft == ComputePlacement::cpu) fftw_forward(f);
     ComplexImage<float> packed(f.n);
     for (std::size_t i = 0; i < f.data.size(); ++i) packed.data[i] = std::complex<float>(f.data[i]);
     return packed;
@@ -41,7 +41,7 @@ ComplexImage<float> field_as_uploaded(ComplexImage<double> f, PsfFftPlacement ff
 
 struct GpuPsfGenerator::Impl {
     int n;
-    PsfFftPlacement placement;
+    ComputePlacement placement;
     std::optional<GpuFft> fft;  // empty when the FFT runs on the CPU
     gl::Program magnitude = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_MAGNITUDE"});
     gl::Program scale_mono = gl::Program::build({{gl::ShaderStage::compute, "psf_ops.comp"}}, {"OP_SCALE_MONO"});
@@ -60,8 +60,8 @@ struct GpuPsfGenerator::Impl {
     PsfGpuTimings last;
     double degrees_per_texel = 0;
 
-    Impl(int size, TwiddleSource twiddles, PsfFftPlacement where) : n(size), placement(resolve_placement(where)) {
-        if (placement == PsfFftPlacement::gpu)
+    Impl(int size, TwiddleSource twiddles, ComputePlacement where) : n(size), placement(resolve_placement(where)) {
+        if (placement == ComputePlacement::gpu)
             fft.emplace(size, twiddles);
         else if (!is_power_of_two(n) || n < kGpuFftMinSize || n > kGpuFftMaxSize)  // the GPU path's sizes either way
             throw InputError(SourceLocation{"", 0, 0, "size"},
@@ -103,7 +103,7 @@ struct GpuPsfGenerator::Impl {
     /// to float), or uploaded as float for the GPU's FFT (transform_on_gpu()).
     void upload_field(const ComplexImage<double>& field, gl::Buffer& out) const;
     void transform_on_gpu(gl::Buffer& data) {
-        if (placement == PsfFftPlacement::gpu) fft->forward(data);
+        if (placement == ComputePlacement::gpu) fft->forward(data);
     }
     /// |F|² of `spectrum`, centred, into `power` and its sum into `sum`.
     void power_and_sum(const gl::Buffer& spectrum, const gl::Buffer& power, const gl::Buffer& sum);
@@ -245,7 +245,7 @@ void GpuPsfGenerator::Impl::normalise_rgb() {
     barrier();
 }
 
-GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles, PsfFftPlacement fft)
+GpuPsfGenerator::GpuPsfGenerator(int n, TwiddleSource twiddles, ComputePlacement fft)
     : impl_(std::make_unique<Impl>(n, twiddles, fft)) {}
 GpuPsfGenerator::~GpuPsfGenerator() = default;
 GpuPsfGenerator::GpuPsfGenerator(GpuPsfGenerator&&) noexcept = default;
@@ -257,7 +257,7 @@ int GpuPsfGenerator::size() const {
 PsfGpuTimings GpuPsfGenerator::timings() const {
     return impl_->last;
 }
-PsfFftPlacement GpuPsfGenerator::fft_placement() const {
+ComputePlacement GpuPsfGenerator::fft_placement() const {
     return impl_->placement;
 }
 
@@ -273,7 +273,7 @@ void GpuPsfGenerator::generate(const ComplexImage<double>& pupil, double degrees
     const auto texels = static_cast<std::size_t>(m.n) * static_cast<std::size_t>(m.n);
     const auto n = static_cast<unsigned>(m.n);
 
-    const bool cpu_fft = m.placement == PsfFftPlacement::cpu;
+    const bool cpu_fft = m.placement == ComputePlacement::cpu;
     double cpu_fft_ms = 0;
     m.timers[0].begin();
     const auto t0 = std::chrono::steady_clock::now();
@@ -340,9 +340,9 @@ void GpuPsfGenerator::generate(const EyeModel& eye, const SpectralSamples& sampl
     impl_->last.fft_ms = cpu_ms;  // the CPU's pupil planes, FFTs and binning
 }
 
-AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples,
-                                          int anchor_count, double time_s, PsfFftPlacement fft) {
-    if (fft == PsfFftPlacement::automatic)
+AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples, int anchor_count,
+                                          double time_s, ComputePlacement fft) {
+    if (fft == ComputePlacement::automatic)
         throw std::invalid_argument("anchored_pupil_planes: the FFT placement must be resolved (gpu or cpu)");
     eye.validate(n);
     AnchoredPupilPlanes out;

@@ -1,4 +1,4 @@
-// The displayability check (runner/src/displayability.h; docs/running.md,
+// The displayability check (atonlab/runner/displayability.h; docs/running.md,
 // "Displayability"):
 //  - every example protocol (protocols/examples/*.toml) can produce a match at
 //    1920×1080 px on 0.598 m, 3840×2160 px on 0.60 m and 1280×720 px on 0.30 m,
@@ -40,13 +40,13 @@
 
 #include "../store/store_test_support.h"
 #include "../support/child_process.h"
+#include "../support/skip.h"
 #include "atonlab/protocols/protocol_file.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/session/run_session.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
-#include "displayability.h"
 #include "gl_test_support.h"
-#include "run_session.h"
-#include "../support/skip.h"
 #include "text_contains.h"
 
 #ifndef ATONLAB_BINARY

@@ -26,14 +26,14 @@
 #include <string>
 #include <vector>
 
+#include "../support/skip.h"
 #include "atonlab/analysis/psychometric.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_file.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/session/run_session.h"
 #include "gl_test_support.h"
 #include "long_tests.h"
-#include "run_session.h"
-#include "../support/skip.h"
 
 namespace {
 

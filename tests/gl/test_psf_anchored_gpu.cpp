@@ -30,7 +30,7 @@ struct Compared {
 };
 
 Compared compare(const EyeModel& eye, int n, const display::Spectrum& spd, double time_s = 0.0,
-                 PsfFftPlacement fft = PsfFftPlacement::gpu) {
+                 ComputePlacement fft = ComputePlacement::gpu) {
     const GlareSettings defaults;
     const SpectralSamples samples = spectral_samples(spd, defaults.spectral_samples);
     GpuPsfGenerator gen(n, TwiddleSource::table_from_double, fft);
@@ -87,7 +87,7 @@ TEST_F(PsfAnchoredGpu, TheCpuPlacedTransformGivesTheSamePsf) {
     // spectral sum alone against the CPU's.
     EyeModel eye;
     eye.pupil_diameter_mm = 6.0;
-    const Compared c = compare(eye, 64, display::d65_spectrum(), 0.0, PsfFftPlacement::cpu);
+    const Compared c = compare(eye, 64, display::d65_spectrum(), 0.0, ComputePlacement::cpu);
     EXPECT_LT(c.relative_l2, kBound);
 }
 
@@ -138,7 +138,7 @@ TEST_F(PsfAnchoredGpu, PupilPlanesDrawnAheadOnAWorkerGiveTheSameKernelBitForBit)
     s.glare.psf_size = 64;
     s.glare.placement = ComputePlacement::gpu;
     const SpectralSamples samples = spectral_samples(display::d65_spectrum(), s.glare.spectral_samples);
-    GpuPsfGenerator gen(64, TwiddleSource::table_from_double, PsfFftPlacement::gpu);
+    GpuPsfGenerator gen(64, TwiddleSource::table_from_double, ComputePlacement::gpu);
     auto gpu = [&](int) -> GpuPsfGenerator& { return gen; };
     const GlareModelType& type = glare_model_type(GlareModel::wave_optics);
     const GlareKernelRequest request{s.glare, s, samples, 20.0, 5.35, 1.5, gpu};
@@ -163,10 +163,10 @@ TEST_F(PsfAnchoredGpu, PupilPlanesDrawnAheadOnAWorkerGiveTheSameKernelBitForBit)
     EXPECT_THROW(gen.generate_anchored(eye, samples, s.glare.spectral_anchors, 0.0, &small), std::invalid_argument);
     // Spectra made for a generator whose FFT runs on the CPU are not this generator's fields.
     const AnchoredPupilPlanes spectra =
-        anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, PsfFftPlacement::cpu);
+        anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, ComputePlacement::cpu);
     EXPECT_THROW(gen.generate_anchored(eye, samples, s.glare.spectral_anchors, 0.0, &spectra), std::invalid_argument);
     // A worker has no GL context to resolve automatic by.
-    EXPECT_THROW(anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, PsfFftPlacement::automatic),
+    EXPECT_THROW(anchored_pupil_planes(eye, 64, samples, s.glare.spectral_anchors, 0.0, ComputePlacement::automatic),
                  std::invalid_argument);
     // On the CPU placement there is nothing to do ahead: its build keeps the cores busy in the frame.
     s.glare.placement = ComputePlacement::cpu;

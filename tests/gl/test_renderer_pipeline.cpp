@@ -11,16 +11,16 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/common/read_file.h"
+#include "atonlab/display/tonemap.h"
 #include "atonlab/protocols/protocol.h"
+#include "atonlab/runner/session/session_inputs.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/pipeline.h"
-#include "atonlab/display/tonemap.h"
-#include "atonlab/common/read_file.h"
 #include "gl_test_support.h"
-#include "session/stimulus_renderer.h"
-#include "session/session_inputs.h"
 
 namespace atonlab {
 namespace {

@@ -19,10 +19,10 @@
 
 #include "../support/gl_test_support.h"
 #include "atonlab/protocols/rng.h"
+#include "atonlab/runner/session/run_session.h"
+#include "atonlab/runner/session/session_inputs.h"
+#include "atonlab/runner/session/true_value.h"
 #include "atonlab/store/store.h"
-#include "run_session.h"
-#include "session/session_inputs.h"
-#include "session/true_value.h"
 #include "simulate/decision_table.h"
 #include "simulate/simulation_designs.h"
 

@@ -351,23 +351,23 @@ TEST_F(Skips, StagesThatAreSwitchedOffDoNoWork) {
 TEST_F(Skips, PsfWithItsFftOnTheCpuMatchesTheGpuFft) {
     // A software rasteriser transforms the pupil plane with FFTW (double,
     // rounded to float) instead of the fp32 compute shaders
-    // (PsfFftPlacement::automatic): the PSFs agree to fp32 rounding.
+    // (ComputePlacement::automatic): the PSFs agree to fp32 rounding.
     EyeModel eye = grid_scene(GlareModel::wave_optics).glare.eye;
     eye.pupil_diameter_mm = 5.0;
     const int n = 128;
     const SpectralSamples samples = spectral_samples(d65_spectrum(), 8);
     const auto field = pupil_plane(eye, n, kReferenceWavelengthNm, eye.plane_width_mm);
-    GpuPsfGenerator gpu(n, TwiddleSource::table_from_double, PsfFftPlacement::gpu);
-    GpuPsfGenerator cpu(n, TwiddleSource::table_from_double, PsfFftPlacement::cpu);
-    EXPECT_EQ(gpu.fft_placement(), PsfFftPlacement::gpu);
-    EXPECT_EQ(cpu.fft_placement(), PsfFftPlacement::cpu);
+    GpuPsfGenerator gpu(n, TwiddleSource::table_from_double, ComputePlacement::gpu);
+    GpuPsfGenerator cpu(n, TwiddleSource::table_from_double, ComputePlacement::cpu);
+    EXPECT_EQ(gpu.fft_placement(), ComputePlacement::gpu);
+    EXPECT_EQ(cpu.fft_placement(), ComputePlacement::cpu);
     gpu.generate(field, psf_degrees_per_texel(eye), samples);
     cpu.generate(field, psf_degrees_per_texel(eye), samples);
     const double err = relative_l2(cpu.read_rgb(), gpu.read_rgb());
     std::printf("PSF with the FFT on the CPU vs on the GPU: relative L2 %.3g\n", err);
     EXPECT_LT(err, 1e-5);
     const bool software = gl_context()->info().software;
-    EXPECT_EQ(GpuPsfGenerator(n).fft_placement(), software ? PsfFftPlacement::cpu : PsfFftPlacement::gpu);
+    EXPECT_EQ(GpuPsfGenerator(n).fft_placement(), software ? ComputePlacement::cpu : ComputePlacement::gpu);
 }
 
 TEST_F(Skips, PreExposedHalfFloatTargetMatchesTheFloatTarget) {

@@ -1,5 +1,5 @@
-// runner/src/session/lru_cache.h: the renderer's LRU cache.
-#include "session/lru_cache.h"
+// atonlab/runner/session/lru_cache.h: the renderer's LRU cache.
+#include "atonlab/runner/session/lru_cache.h"
 
 #include <gtest/gtest.h>
 

@@ -8,10 +8,10 @@
 #include <optional>
 #include <vector>
 
-#include "atonlab/protocols/procedure.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/tonemap.h"
-#include "session/scene_queries.h"
+#include "atonlab/protocols/procedure.h"
+#include "atonlab/runner/session/scene_queries.h"
 
 namespace atonlab::runner {
 

@@ -11,8 +11,8 @@
 
 #include "atonlab/present/presenter.h"
 #include "atonlab/protocols/protocol.h"
-#include "displayability.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

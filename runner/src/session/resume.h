@@ -12,9 +12,9 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/session/run_options.h"
+#include "atonlab/runner/session/session_observer.h"
 #include "atonlab/store/store.h"
-#include "session/run_options.h"
-#include "session/session_observer.h"
 
 namespace atonlab::runner {
 

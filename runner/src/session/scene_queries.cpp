@@ -1,4 +1,4 @@
-#include "session/scene_queries.h"
+#include "atonlab/runner/session/scene_queries.h"
 
 #include <fmt/format.h>
 

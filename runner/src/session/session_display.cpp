@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "atonlab/present/screen_presenter.h"
-#include "atonlab/display/display_model.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/display_model.h"
+#include "atonlab/present/screen_presenter.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 #include "atonlab/stimuli/image_io.h"
-#include "session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

@@ -15,8 +15,8 @@
 #include "atonlab/present/text.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/session/run_options.h"
 #include "atonlab/stimuli/scene.h"
-#include "session/run_options.h"
 
 namespace atonlab::present {
 class ScreenPresenter;

@@ -1,5 +1,5 @@
 // A session's inputs, read and checked (session_inputs.h).
-#include "session/session_inputs.h"
+#include "atonlab/runner/session/session_inputs.h"
 
 #include <fmt/format.h>
 

@@ -1,10 +1,10 @@
 // The session's observer and what it is shown (session_observer.h).
-#include "session/session_observer.h"
+#include "atonlab/runner/session/session_observer.h"
 
 #include <fmt/format.h>
 
 #include "atonlab/protocols/rng.h"
-#include "session/scene_queries.h"
+#include "atonlab/runner/session/scene_queries.h"
 
 namespace atonlab::runner {
 

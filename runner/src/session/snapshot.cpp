@@ -11,8 +11,8 @@
 #include <system_error>
 
 #include "atonlab/common/read_file.h"
-#include "session/scene_queries.h"
-#include "session/session_inputs.h"
+#include "atonlab/runner/session/scene_queries.h"
+#include "atonlab/runner/session/session_inputs.h"
 
 namespace atonlab::runner {
 

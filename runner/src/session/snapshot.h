@@ -6,7 +6,7 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

@@ -1,6 +1,6 @@
 // StimulusRenderer (stimulus_renderer.h): frames rendered through the display
 // pipeline, cached, and cut into the windows the observer looks at.
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 #include <fmt/format.h>
 
@@ -14,11 +14,11 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/display/tonemap.h"
+#include "atonlab/runner/session/scene_queries.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/scene_file.h"
 #include "calibrate/calibration_policy.h"
 #include "session/progress.h"
-#include "session/scene_queries.h"
 
 namespace atonlab::runner {
 

@@ -1,4 +1,4 @@
-#include "session/stop_signals.h"
+#include "atonlab/runner/session/stop_signals.h"
 
 namespace atonlab::runner {
 

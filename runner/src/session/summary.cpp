@@ -1,5 +1,5 @@
 // The session's closing summary (summary.h).
-#include "session/summary.h"
+#include "atonlab/runner/session/summary.h"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "session/true_value.h"
+#include "atonlab/runner/session/true_value.h"
 
 namespace atonlab::runner {
 

@@ -8,9 +8,9 @@
 #include <set>
 #include <string>
 
+#include "atonlab/runner/session/stop_signals.h"
 #include "atonlab/stimuli/error.h"
 #include "session/snapshot.h"
-#include "session/stop_signals.h"
 #include "session/trial_record.h"
 
 namespace atonlab::runner {

@@ -9,12 +9,12 @@
 #include "atonlab/present/screen_presenter.h"
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/session/run_options.h"
+#include "atonlab/runner/session/session_observer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 #include "atonlab/store/store.h"
 #include "session/missed_bound.h"
-#include "session/run_options.h"
 #include "session/progress.h"
-#include "session/session_observer.h"
-#include "session/stimulus_renderer.h"
 #include "session/session_display.h"
 
 namespace atonlab::runner {

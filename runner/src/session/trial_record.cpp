@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "atonlab/runner/session/scene_queries.h"
 #include "atonlab/stimuli/glare_stage.h"
-#include "session/scene_queries.h"
 
 namespace atonlab::runner {
 

@@ -11,11 +11,11 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
+#include "atonlab/runner/session/session_observer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/store/records.h"
-#include "session/session_observer.h"
-#include "session/stimulus_renderer.h"
 #include "session/session_display.h"
 
 namespace atonlab::runner {

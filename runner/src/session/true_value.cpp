@@ -1,13 +1,13 @@
 // The model observer's true value (true_value.h): a root of the model's
 // choice probability against the level, each level rendered.
-#include "session/true_value.h"
+#include "atonlab/runner/session/true_value.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
 #include <exception>
 
-#include "session/scene_queries.h"
+#include "atonlab/runner/session/scene_queries.h"
 
 namespace atonlab::runner {
 

@@ -15,8 +15,8 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/protocols/simulated_observer.h"
+#include "atonlab/runner/session/session_observer.h"
 #include "atonlab/store/sha256.h"
-#include "session/session_observer.h"
 
 namespace atonlab::runner {
 

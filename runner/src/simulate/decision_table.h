@@ -13,7 +13,7 @@
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

@@ -12,12 +12,12 @@
 #include "atonlab/common/read_file.h"
 #include "atonlab/common/scene_override.h"
 #include "atonlab/common/toml_value.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/session/scene_queries.h"
+#include "atonlab/runner/session/session_inputs.h"
+#include "atonlab/runner/session/true_value.h"
 #include "atonlab/stimuli/gl/context.h"
-#include "displayability.h"
-#include "session/scene_queries.h"
-#include "session/session_inputs.h"
 #include "session/trial_record.h"
-#include "session/true_value.h"
 #include "simulate/protocol_variant.h"
 
 namespace atonlab::runner {

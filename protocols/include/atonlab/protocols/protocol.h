@@ -66,11 +66,6 @@ std::optional<Role> parse_role(std::string_view text) noexcept;
 std::string_view to_string(ProcedureKind k) noexcept;
 std::optional<ProcedureKind> parse_procedure_kind(std::string_view text) noexcept;
 
-/// One scene override, "key=value" with a TOML value, and where the protocol
-/// wrote it (origin: the file, line and key path "block[0].condition[1].set[0]",
-/// or a conditions file's row and column).
-using Override = ::atonlab::SceneOverride;
-
 struct ProcedureSpec {
     ProcedureKind kind = ProcedureKind::Staircase;
     ProcedureParams params;
@@ -118,10 +113,12 @@ struct Condition {
     /// Applied in order to every frame of the condition ([defaults], then the
     /// block's, then the condition's own), then test_set to the test's frame and
     /// reference_set to the reference's (both, in that order, to a side-by-side
-    /// frame), then the level.
-    std::vector<Override> set;
-    std::vector<Override> test_set;
-    std::vector<Override> reference_set;
+    /// frame), then the level. Each override's origin is where the protocol
+    /// wrote it: the file, line and key path "block[0].condition[1].set[0]",
+    /// or a conditions file's row and column.
+    std::vector<SceneOverride> set;
+    std::vector<SceneOverride> test_set;
+    std::vector<SceneOverride> reference_set;
     std::string level_key;  ///< the scene key the procedure's level sets, e.g. "light.reference.intensity_cd"
     LevelScale level_scale = LevelScale::Log10;
     Role level_on = Role::Reference;                       ///< which stimulus the level is applied to
@@ -289,7 +286,7 @@ struct Protocol {
     /// The display as scene overrides ("display.width_px=1920", ...), each at
     /// its [display] line: a limit the scene derives from the display (a glare
     /// billboard too wide for it) names the protocol's line.
-    std::vector<Override> display_overrides() const;
+    std::vector<SceneOverride> display_overrides() const;
 };
 
 /// Track `track` of a condition's procedure: the procedure built from its
@@ -309,7 +306,7 @@ std::unique_ptr<Procedure> make_procedure(const Condition& condition, std::uint6
 /// condition's line).
 struct Frame {
     std::optional<Role> role;  ///< whose frame it is; nullopt: side-by-side (both)
-    std::vector<Override> overrides;
+    std::vector<SceneOverride> overrides;
     /// The overrides as "key=value" text, in order (what the study file stores).
     std::vector<std::string> override_texts() const;
 };

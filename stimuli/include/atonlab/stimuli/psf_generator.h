@@ -24,14 +24,6 @@ struct PsfGpuTimings {
     double upload_ms = 0, fft_ms = 0, mono_ms = 0, spectral_ms = 0;
 };
 
-/// Where the generator's FFT runs (placement.h). The pupil plane is drawn on
-/// the CPU anyway, so transforming it there (FFTW double, rounded once to
-/// float) and uploading the spectrum replaces the compute-shader FFT: far
-/// cheaper where the "GPU" is the CPU (a software rasteriser; `atonlab bench`,
-/// fft_n512 on llvmpipe: 18 ms against 190 ms, and exact), far dearer than a
-/// real GPU's. automatic: the CPU on a software rasteriser, else the GPU.
-using PsfFftPlacement = ComputePlacement;
-
 /// The CPU's share of GpuPsfGenerator::generate_anchored(): each anchor's
 /// pupil plane drawn in double (a two-scale eye: its scatter and core fields,
 /// pupil_parts) over W·λk/λ0, so that its FFT lands on λ0's grid, and rounded
@@ -45,7 +37,7 @@ struct AnchoredPupilPlanes {
     bool two_scales = false;
     /// The generator's FFT placement they are for: gpu, the planes
     /// themselves; cpu, their spectra by FFTW in double.
-    PsfFftPlacement fft = PsfFftPlacement::gpu;
+    ComputePlacement fft = ComputePlacement::gpu;
     /// Anchor i: [i·parts] the scatter (a one-scale eye: the whole plane), [i·parts + 1] the core (parts = 2).
     std::vector<ComplexImage<float>> fields;
 };
@@ -55,13 +47,20 @@ struct AnchoredPupilPlanes {
 /// (gpu or cpu; std::invalid_argument for automatic, which only a GL
 /// context can resolve). Throws as pupil_plane() does.
 AnchoredPupilPlanes anchored_pupil_planes(const EyeModel& eye, int n, const SpectralSamples& samples, int anchors,
-                                          double time_s = 0.0, PsfFftPlacement fft = PsfFftPlacement::gpu);
+                                          double time_s = 0.0, ComputePlacement fft = ComputePlacement::gpu);
 
 class GpuPsfGenerator {
 public:
     /// n: a power of two in [kGpuFftMinSize, kGpuFftMaxSize] (InputError, key "size", otherwise).
+    /// fft: where the generator's FFT runs (placement.h). The pupil plane is
+    /// drawn on the CPU anyway, so transforming it there (FFTW double, rounded
+    /// once to float) and uploading the spectrum replaces the compute-shader
+    /// FFT: far cheaper where the "GPU" is the CPU (a software rasteriser;
+    /// `atonlab bench`, fft_n512 on llvmpipe: 18 ms against 190 ms, and exact),
+    /// far dearer than a real GPU's. automatic: the CPU on a software
+    /// rasteriser, else the GPU.
     explicit GpuPsfGenerator(int n, TwiddleSource twiddles = TwiddleSource::table_from_double,
-                             PsfFftPlacement fft = PsfFftPlacement::automatic);
+                             ComputePlacement fft = ComputePlacement::automatic);
     ~GpuPsfGenerator();
     GpuPsfGenerator(GpuPsfGenerator&&) noexcept;
     GpuPsfGenerator& operator=(GpuPsfGenerator&&) noexcept;
@@ -97,7 +96,7 @@ public:
     RgbPsf read_rgb() const;
     PsfGpuTimings timings() const;
     /// Where the FFT runs (automatic resolved).
-    PsfFftPlacement fft_placement() const;
+    ComputePlacement fft_placement() const;
 
 private:
     struct Impl;

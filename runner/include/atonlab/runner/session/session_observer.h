@@ -10,8 +10,8 @@
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "session/run_options.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/session/run_options.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

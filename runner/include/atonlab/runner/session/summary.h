@@ -8,8 +8,8 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_schedule.h"
-#include "session/session_observer.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/session/session_observer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

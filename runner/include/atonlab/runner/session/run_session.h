@@ -11,10 +11,10 @@
 // true_value.h, progress.h, summary.h. run_session() drives them: load and
 // validate everything, open the store, begin or resume a session, run the
 // trials, summarise.
-#include "session/run_options.h"
-#include "session/session_observer.h"
-#include "session/stimulus_renderer.h"
-#include "session/true_value.h"
+#include "atonlab/runner/session/run_options.h"
+#include "atonlab/runner/session/session_observer.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
+#include "atonlab/runner/session/true_value.h"
 
 namespace atonlab::runner {
 

@@ -44,8 +44,8 @@
 #include <vector>
 
 #include "atonlab/protocols/protocol.h"
-#include "check_command.h"
-#include "session/stimulus_renderer.h"
+#include "atonlab/runner/check_command.h"
+#include "atonlab/runner/session/stimulus_renderer.h"
 
 namespace atonlab::runner {
 

@@ -2,7 +2,7 @@
 // `atonlab run` (docs/running.md): the command line around the session engine
 // (run_session.h), its options in session/run_options.h.
 
-#include "session/run_options.h"
+#include "atonlab/runner/session/run_options.h"
 
 namespace CLI {
 class App;

@@ -8,13 +8,13 @@
 #include <string>
 #include <string_view>
 
+#include "atonlab/common/input_error.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
-#include "atonlab/common/input_error.h"
+#include "atonlab/runner/session/run_options.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "session/run_options.h"
 
 namespace atonlab::runner {
 

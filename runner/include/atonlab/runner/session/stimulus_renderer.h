@@ -15,13 +15,13 @@
 
 #include "atonlab/protocols/observer.h"
 #include "atonlab/protocols/protocol.h"
+#include "atonlab/runner/session/lru_cache.h"
 #include "atonlab/stimuli/display_pipeline.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "session/lru_cache.h"
 
 namespace atonlab::runner {
 

@@ -1,6 +1,6 @@
 // The engine of `atonlab run` (run_session.h; docs/running.md): the driver
 // over the parts in session/.
-#include "run_session.h"
+#include "atonlab/runner/session/run_session.h"
 
 #include <fmt/format.h>
 
@@ -18,19 +18,19 @@
 #include "atonlab/present/text.h"
 #include "atonlab/protocols/protocol_schedule.h"
 #include "atonlab/protocols/simulated_observer.h"
+#include "atonlab/runner/displayability.h"
+#include "atonlab/runner/session/session_inputs.h"
+#include "atonlab/runner/session/stop_signals.h"
+#include "atonlab/runner/session/summary.h"
 #include "atonlab/stimuli/gl/context.h"
 #include "atonlab/store/store.h"
 #include "calibrate/calibration_policy.h"
 #include "calibrate/profile_location.h"
-#include "displayability.h"
 #include "session/display_record.h"
 #include "session/presentation_margin.h"
 #include "session/progress.h"
 #include "session/resume.h"
 #include "session/session_display.h"
-#include "session/session_inputs.h"
-#include "session/stop_signals.h"
-#include "session/summary.h"
 #include "session/trial_loop.h"
 
 namespace atonlab::runner {
