@@ -97,11 +97,11 @@ std::string glare_docstring() {
     return fmt::format(
         "Adds the eye's glare to an H×W×3 (or ×4) scene-referred array (cd/m²) as `atonlab glare` does: the image "
         "convolved with a glare model's PSF, energy conserved. deg_per_px: degrees of visual angle per pixel; "
-        "model: {} (default spencer); adaptation_cd_m2 (cd/m²): the pupil (K2012 eq 3.15) and Spencer's vision "
+        "model: {} (default {}); adaptation_cd_m2 (cd/m²): the pupil (K2012 eq 3.15) and Spencer's vision "
         "class (default: the image's log-average); pupil_mm, radius_deg, window (silverman, epanechnikov, none), "
         "psf_size; scene: take [glare] from a scene file. Returns H×W×3 float32 cd/m². The GIL is released. Any "
         "other keyword is a model's own setting, as the scene file's key of that name:{}",
-        models, keys);
+        models, stimuli::glare_model_name(runner::kDefaultImageGlareModel), keys);
 }
 
 py::array glare(const py::array& hdr, double deg_per_px, const std::optional<std::string>& model,
@@ -246,17 +246,15 @@ py::array rgb_view(stimuli::ImageRGBA32F&& image) {
     auto* owned = new stimuli::ImageRGBA32F(std::move(image));
     py::capsule base(owned, [](void* p) { delete static_cast<stimuli::ImageRGBA32F*>(p); });
     const py::ssize_t h = owned->height, w = owned->width, f = sizeof(float);
-    return py::array(py::dtype::of<float>(), {h, w, py::ssize_t{3}}, {w * 4 * f, 4 * f, f}, owned->rgba.data(),
-                     base);
+    return py::array(py::dtype::of<float>(), {h, w, py::ssize_t{3}}, {w * 4 * f, 4 * f, f}, owned->rgba.data(), base);
 }
 
 stimuli::ImageRGBA32F image_from_array(const py::array& array, const char* name) {
-    if (array.ndim() != 3 || (array.shape(2) != 3 && array.shape(2) != 4) || array.shape(0) < 1 ||
-        array.shape(1) < 1)
-        throw InputError(SourceLocation::command_line(name),
-                         fmt::format("the image must be an H×W×3 (RGB) or H×W×4 (RGBA) array, not {} dimensions{}",
-                                     array.ndim(), array.ndim() == 3 ? fmt::format(" of {} channels", array.shape(2))
-                                                                     : std::string()));
+    if (array.ndim() != 3 || (array.shape(2) != 3 && array.shape(2) != 4) || array.shape(0) < 1 || array.shape(1) < 1)
+        throw InputError(
+            SourceLocation::command_line(name),
+            fmt::format("the image must be an H×W×3 (RGB) or H×W×4 (RGBA) array, not {} dimensions{}", array.ndim(),
+                        array.ndim() == 3 ? fmt::format(" of {} channels", array.shape(2)) : std::string()));
     const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(array);
     if (!a) throw InputError(SourceLocation::command_line(name), "the image must hold real numbers (cd/m²)");
     stimuli::ImageRGBA32F image;
@@ -393,12 +391,11 @@ void bind_images(py::module_& m) {
         "linear and clamp; scene: take [display] and [tonemap] from a scene file. The GIL is released.",
         display::display_encoding_choices(""), display::display_encoding(display::TransferKind::srgb).name);
     m.def("tonemap", &tonemap, py::arg("hdr"), py::kw_only(), py::arg("operator") = py::none(),
-          py::arg("adaptation_cd_m2") = py::none(), py::arg("display") = py::none(),
-          py::arg("peak_cd_m2") = py::none(), py::arg("black_cd_m2") = py::none(), py::arg("dither") = py::none(),
-          py::arg("blueshift") = py::none(), py::arg("hue_preservation") = py::none(), py::arg("key") = py::none(),
-          py::arg("reinhard_white") = py::none(), py::arg("white_cd_m2") = py::none(),
-          py::arg("epsilon_cd_m2") = py::none(), py::arg("scale") = py::none(), py::arg("scene") = py::none(),
-          tonemap_doc.c_str());
+          py::arg("adaptation_cd_m2") = py::none(), py::arg("display") = py::none(), py::arg("peak_cd_m2") = py::none(),
+          py::arg("black_cd_m2") = py::none(), py::arg("dither") = py::none(), py::arg("blueshift") = py::none(),
+          py::arg("hue_preservation") = py::none(), py::arg("key") = py::none(), py::arg("reinhard_white") = py::none(),
+          py::arg("white_cd_m2") = py::none(), py::arg("epsilon_cd_m2") = py::none(), py::arg("scale") = py::none(),
+          py::arg("scene") = py::none(), tonemap_doc.c_str());
     static const std::string glare_doc = glare_docstring();
     m.def("glare", &glare, py::arg("hdr"), py::arg("deg_per_px"), py::kw_only(), py::arg("model") = py::none(),
           py::arg("adaptation_cd_m2") = py::none(), py::arg("pupil_mm") = py::none(),
@@ -412,9 +409,8 @@ void bind_images(py::module_& m) {
           "Writes an H×W×3 (or ×4) array as a 32-bit float EXR with atonlab's header attributes (units, "
           "degreesPerPixel, adaptationLuminance in cd/m², extra strings), whole or not at all.");
     m.def("psf", &psf, py::kw_only(), py::arg("pupil_mm") = py::none(), py::arg("adaptation_cd_m2") = py::none(),
-          py::arg("eye_preset") = py::none(), py::arg("clear") = false, py::arg("spd") = "d65",
-          py::arg("size") = 512, py::arg("samples") = 30, py::arg("seed") = py::none(), py::arg("time_s") = 0.0,
-          py::arg("scene") = py::none(),
+          py::arg("eye_preset") = py::none(), py::arg("clear") = false, py::arg("spd") = "d65", py::arg("size") = 512,
+          py::arg("samples") = 30, py::arg("seed") = py::none(), py::arg("time_s") = 0.0, py::arg("scene") = py::none(),
           "The eye's glare PSF alone, as `atonlab psf` computes it on the GPU (docs/glare.md): returns (H×W×3 "
           "float32 RGB PSF, relative, its luminance summing to 1; metadata dict with degreesPerPixel per texel). "
           "pupil_mm: the pupil diameter (default: from adaptation_cd_m2, K2012 eq 3.15, 0.001 cd/m²); eye_preset, "

@@ -143,14 +143,15 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
             throw InputError(option("--black-cd-m2"), "the black must be at least 0 and below the peak (cd/m²)");
         // The scene's law when a name alone makes it (display_encodings.h), else sRGB.
         const display::DisplayEncoding* own = display::display_encoding_of(out.display);
-        const std::string transfer = o.display.value_or(std::string(
-            own != nullptr && own->from_peak_black != nullptr ? own->name
-                                                              : display::display_encoding(display::TransferKind::srgb).name));
+        const std::string transfer =
+            o.display.value_or(std::string(own != nullptr && own->from_peak_black != nullptr
+                                               ? own->name
+                                               : display::display_encoding(display::TransferKind::srgb).name));
         if (auto d = display::display_from_transfer(transfer, peak, black))
             out.display = std::move(*d);
         else
-            throw InputError(option("--display"), fmt::format("must be {}, not '{}'",
-                                                              display::display_encoding_choices(""), transfer));
+            throw InputError(option("--display"),
+                             fmt::format("must be {}, not '{}'", display::display_encoding_choices(""), transfer));
         tm.display_peak_cd_m2 = peak;
     }
     out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == display::Dither::spatiotemporal)
@@ -168,9 +169,9 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
     if (o.out_of_gamut) {
         const auto g = display::out_of_gamut_from_name(*o.out_of_gamut);
         if (!g)
-            throw InputError(option("--out-of-gamut"), fmt::format("must be {}, not '{}'",
-                                                                   fmt::join(display::out_of_gamut_names(), ", "),
-                                                                   *o.out_of_gamut));
+            throw InputError(
+                option("--out-of-gamut"),
+                fmt::format("must be {}, not '{}'", fmt::join(display::out_of_gamut_names(), ", "), *o.out_of_gamut));
         out.encode.out_of_gamut = *g;
     }
     tm.out_of_gamut = out.encode.out_of_gamut;  // one choice for both (ToneMapSettings::out_of_gamut)
@@ -232,16 +233,16 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
     result.adaptation_cd_m2 = adaptation;
     result.clipped = clipped;
     // What was applied, as `atonlab tonemap` prints it (two lines).
-    result.settings = fmt::format(
-        "  adaptation_cd_m2={:.6g} ({}) operator={}{} hue_preservation={} blueshift={}\n", adaptation,
-        o.adaptation_cd_m2 ? "given"
-        : scene_adaptation ? "the scene's fixed level"
-                           : "log-average, K2012 eq 4.15",
-        display::tone_operator_name(tm.tone_operator),
-        tm.tone_operator == display::ToneOperator::reinhard
-            ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative)
-            : std::string(),
-        display::hue_preservation_name(tm.hue_preservation), tm.blueshift ? "on" : "off");
+    result.settings =
+        fmt::format("  adaptation_cd_m2={:.6g} ({}) operator={}{} hue_preservation={} blueshift={}\n", adaptation,
+                    o.adaptation_cd_m2 ? "given"
+                    : scene_adaptation ? "the scene's fixed level"
+                                       : "log-average, K2012 eq 4.15",
+                    display::tone_operator_name(tm.tone_operator),
+                    tm.tone_operator == display::ToneOperator::reinhard
+                        ? fmt::format(" key={} white_relative={:.6g}", tm.reinhard_key, tm.reinhard_white_relative)
+                        : std::string(),
+                    display::hue_preservation_name(tm.hue_preservation), tm.blueshift ? "on" : "off");
     result.settings += fmt::format(
         "  display={} peak_cd_m2={:g} black_cd_m2={:g} bits=8 dither={} out_of_gamut={}; {} pixels above display "
         "white (clipped)\n",
@@ -267,8 +268,6 @@ int run_tonemap(const TonemapOptions& o) {
 
 namespace {
 
-constexpr stimuli::GlareModel kDefaultImageModel = stimuli::GlareModel::spencer;
-
 // The models `atonlab glare` takes (those with a CPU kernel), as "a, b or c".
 std::string image_models(std::string_view quote) {
     return stimuli::glare_model_choices(quote, [](const stimuli::GlareModelType& m) { return m.on_images(); });
@@ -286,7 +285,8 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
     cmd->add_option("--scene", o.scene, "Take [glare] (and the adaptation) from this scene file; options override");
     // The models' names from their registry (glare_models/glare_model_list.h).
     const auto name = [](stimuli::GlareModel m) { return std::string(stimuli::glare_model_name(m)); };
-    cmd->add_option("--model", o.model, fmt::format("{} (default {})", image_models(""), name(kDefaultImageModel)));
+    cmd->add_option("--model", o.model,
+                    fmt::format("{} (default {})", image_models(""), name(kDefaultImageGlareModel)));
     cmd->add_option("--deg-per-px", o.degrees_per_pixel,
                     "Degrees of visual angle per pixel (default: the EXR's degreesPerPixel attribute)");
     cmd->add_option("--adaptation-cd-m2", o.adaptation_cd_m2,
@@ -294,9 +294,10 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
                     "the EXR's adaptationLuminance attribute, else the image's log-average)");
     cmd->add_option("--pupil-mm", o.pupil_mm,
                     name(stimuli::GlareModel::wave_optics) + ": the pupil diameter (mm) instead of the adaptation's");
-    cmd->add_option("--radius-deg", o.radius_deg,
-                    fmt::format("The kernel's radius (degrees; default per model, {} {})", name(stimuli::GlareModel::cie),
-                                stimuli::glare_model_type(stimuli::GlareModel::cie).default_radius_deg({}, 0.0)));
+    cmd->add_option(
+        "--radius-deg", o.radius_deg,
+        fmt::format("The kernel's radius (degrees; default per model, {} {})", name(stimuli::GlareModel::cie),
+                    stimuli::glare_model_type(stimuli::GlareModel::cie).default_radius_deg({}, 0.0)));
     cmd->add_option("--window", o.window, "The kernel's radial window: silverman (default), epanechnikov or none");
     cmd->add_option("--psf-size", o.psf_size,
                     name(stimuli::GlareModel::wave_optics) + ": the PSF size N (a power of two; default 512)");
@@ -317,8 +318,7 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
                                             fmt::format("'{}' is not a value", text));
                        o.settings.insert_or_assign(key, *v);
                    },
-                   fmt::format("{}: {} ({}; default {}, e.g. {})", m->name(), s.doc, s.unit, s.default_text,
-                               s.example))
+                   fmt::format("{}: {} ({}; default {}, e.g. {})", m->name(), s.doc, s.unit, s.default_text, s.example))
                 ->type_name(std::string(s.type));
         }
     }
@@ -326,7 +326,7 @@ void add_glare_command(CLI::App& app, GlareImageOptions& o) {
 
 ImageGlared glare_image(const GlareImageOptions& o, const std::function<stimuli::ExrImage()>& read_input) {
     stimuli::GlareSettings gs;
-    gs.model = kDefaultImageModel;
+    gs.model = kDefaultImageGlareModel;
     std::optional<double> scene_adaptation;
     if (!o.scene.empty()) {
         const stimuli::Scene scene = stimuli::load_scene(o.scene, {});

@@ -57,19 +57,19 @@ struct Registry {
 
 std::vector<Registry> registries() {
     std::vector<Registry> out;
-    Registry glare{"glare models", {}, {}, {"stimuli/include/atonlab/stimuli/glare_models/glare_model_list.h",
-                                           "stimuli/src/glare_models/"}};
+    Registry glare{"glare models",
+                   {},
+                   {},
+                   {"stimuli/include/atonlab/stimuli/glare_models/glare_model_list.h", "stimuli/src/glare_models/"}};
     for (const GlareModelType* m : glare_models())
         // "none" is also a window, a hue preservation, a light's background: not scanned.
         if (m->id() != GlareModel::none) glare.words.emplace_back(m->name());
-    // atonlab.glare()'s docstring names `atonlab glare`'s default model, which
-    // runner/src/image_commands.cpp keeps to itself (kDefaultImageModel); it goes
-    // when the runner's header that python/ includes declares it.
-    glare.exceptions = {{"python/src/images.cpp", {"spencer"}}};
     out.push_back(glare);
 
-    Registry encodings{"display encodings", {}, {}, {"display/include/atonlab/display/display_encodings.h",
-                                                     "display/src/display_encodings.cpp"}};
+    Registry encodings{"display encodings",
+                       {},
+                       {},
+                       {"display/include/atonlab/display/display_encodings.h", "display/src/display_encodings.cpp"}};
     for (const display::DisplayEncoding& e : display::display_encodings())
         // "gog" and "lut" are also the JSON fields holding those laws' parameters (fit_json): not scanned.
         if (e.from_peak_black != nullptr) encodings.words.emplace_back(e.name);
@@ -167,7 +167,8 @@ std::vector<std::string> misplaced_names(const Registry& r, std::set<std::string
             const std::string ext = entry.path().extension().string();
             if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".h")) continue;
             const std::string rel = entry.path().lexically_relative(root).generic_string();
-            if (std::any_of(r.allowed.begin(), r.allowed.end(), [&](const std::string& a) { return rel.starts_with(a); }))
+            if (std::any_of(r.allowed.begin(), r.allowed.end(),
+                            [&](const std::string& a) { return rel.starts_with(a); }))
                 continue;
             const auto exception = r.exceptions.find(rel);
             const auto excepted = [&](const std::string& name) {
@@ -206,8 +207,9 @@ TEST(Registries, NamesAreSpelledOnlyInTheirRegistry) {
 
 TEST(Registries, TheScanFindsANameInALiteral) {
     // The scanner itself: a name in a literal is found, in a comment or as part of a longer word it is not.
-    const auto lits = string_literals("// \"spencer\"\nauto a = \"spencer or cie\"; /* \"cie\" */ char c = '\"';\n"
-                                      "auto b = R\"x(wave-optics)x\"; auto d = \"cie_age_years\";\n");
+    const auto lits = string_literals(
+        "// \"spencer\"\nauto a = \"spencer or cie\"; /* \"cie\" */ char c = '\"';\n"
+        "auto b = R\"x(wave-optics)x\"; auto d = \"cie_age_years\";\n");
     ASSERT_EQ(lits.size(), 3u);
     EXPECT_EQ(lits[0].line, 2);
     EXPECT_TRUE(has_word(lits[0].text, "cie"));
@@ -429,8 +431,8 @@ intensity_cd = 1
 TEST(Registries, EveryGlareModelReadsBackFromASceneAndFromSet) {
     for (const GlareModelType* m : glare_models()) {
         const std::string name(m->name());
-        const Scene file = parse_scene(std::string(kScene) + "glare = \"" + name + "\"\n[eye]\nglare = \"" + name + "\"\n",
-                                       "registry.toml");
+        const Scene file = parse_scene(
+            std::string(kScene) + "glare = \"" + name + "\"\n[eye]\nglare = \"" + name + "\"\n", "registry.toml");
         EXPECT_EQ(file.glare.model, m->id()) << name;
         ASSERT_EQ(file.lights.size(), 1u);
         EXPECT_EQ(file.lights[0].glare, m->id()) << name;
@@ -459,16 +461,18 @@ TEST(Registries, EveryGlareModelsSettingsAreReadAndDocumentedAsDeclared) {
     for (const GlareModelType* m : glare_models()) {
         for (const GlareSetting& s : m->settings()) {
             EXPECT_TRUE(keys.insert(s.key).second) << s.key << " is declared twice";
-            const std::string row = fmt::format("| `{}` | {} | {} | {} | {} |", s.key, s.type, s.unit, s.default_text,
-                                                s.doc);
-            EXPECT_EQ(row_of(doc, s.key), row) << m->name() << ": docs/scene-file.md's row of " << s.key
-                                               << " is not its declaration";
+            const std::string row =
+                fmt::format("| `{}` | {} | {} | {} | {} |", s.key, s.type, s.unit, s.default_text, s.doc);
+            EXPECT_EQ(row_of(doc, s.key), row)
+                << m->name() << ": docs/scene-file.md's row of " << s.key << " is not its declaration";
             try {
                 // A key the reader does not know is refused as unknown; a known one may only be refused for its value.
-                (void)parse_scene(kScene, "registry.toml",
-                                  {atonlab::SceneOverride::parse(fmt::format("{}.{}=1", glare_table_name(s.table), s.key))});
+                (void)parse_scene(
+                    kScene, "registry.toml",
+                    {atonlab::SceneOverride::parse(fmt::format("{}.{}=1", glare_table_name(s.table), s.key))});
             } catch (const atonlab::InputError& e) {
-                EXPECT_EQ(std::string(e.what()).find("unknown key"), std::string::npos) << m->name() << ": " << e.what();
+                EXPECT_EQ(std::string(e.what()).find("unknown key"), std::string::npos)
+                    << m->name() << ": " << e.what();
             }
         }
     }
@@ -534,8 +538,8 @@ TEST(Registries, EveryNamedDisplayReadsBackFromASceneAndItsFitJson) {
     for (const display::DisplayEncoding& e : display::display_encodings()) {
         if (e.from_peak_black == nullptr) continue;
         const std::string name(e.name);
-        const Scene s = parse_scene(kScene, "registry.toml",
-                                    {atonlab::SceneOverride::parse("display.transfer=\"" + name + "\"")});
+        const Scene s =
+            parse_scene(kScene, "registry.toml", {atonlab::SceneOverride::parse("display.transfer=\"" + name + "\"")});
         EXPECT_EQ(display::display_encoding_of(s.output.display), &e) << name;
         EXPECT_EQ(s.output.display.name, e.display_name) << name;
         const display::DisplayModel d = *display::display_from_transfer(name, 200.0, 0.1);

@@ -49,6 +49,22 @@ glm::ivec3 code_at(const s::EncodedImage& codes, int x, int y) {
     return {codes.rgb[i], codes.rgb[i + 1], codes.rgb[i + 2]};
 }
 
+/// Calls f(i, code) for each of the n x n pixels from (x0, y0) (row 0 at the top)
+/// that lies on the screen, i the pixel's index in the window (row-major).
+template <class F>
+void for_each_window_code(const s::EncodedImage& codes, int x0, int y0, int n, F&& f) {
+    for (int v = 0; v < n; ++v) {
+        const int y = y0 + v;
+        if (y < 0 || y >= codes.height) continue;
+        for (int u = 0; u < n; ++u) {
+            const int x = x0 + u;
+            if (x < 0 || x >= codes.width) continue;
+            f(static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u),
+              code_at(codes, x, y));
+        }
+    }
+}
+
 /// The luminance (cd/m²) the screen emits at the n x n pixels from (x0, y0)
 /// (row 0 at the top) for the codes given: the display model's luminance,
 /// memoised per distinct code (a frame has few). Pixels beyond the screen are 0.
@@ -56,20 +72,13 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const display::D
                                   int n) {
     std::map<std::uint64_t, float> emitted;
     std::vector<float> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f);
-    for (int v = 0; v < n; ++v) {
-        const int y = y0 + v;
-        if (y < 0 || y >= codes.height) continue;
-        for (int u = 0; u < n; ++u) {
-            const int x = x0 + u;
-            if (x < 0 || x >= codes.width) continue;
-            const glm::ivec3 code = code_at(codes, x, y);
-            const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
-                                    (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
-            auto [it, fresh] = emitted.try_emplace(k, 0.0f);
-            if (fresh) it->second = static_cast<float>(display::displayed_luminance_cd_m2(model, code, codes.bits));
-            out[static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)] = it->second;
-        }
-    }
+    for_each_window_code(codes, x0, y0, n, [&](std::size_t i, const glm::ivec3& code) {
+        const std::uint64_t k = (static_cast<std::uint64_t>(code.r) << 32) |
+                                (static_cast<std::uint64_t>(code.g) << 16) | static_cast<std::uint64_t>(code.b);
+        auto [it, fresh] = emitted.try_emplace(k, 0.0f);
+        if (fresh) it->second = static_cast<float>(display::displayed_luminance_cd_m2(model, code, codes.bits));
+        out[i] = it->second;
+    });
     return out;
 }
 
@@ -77,17 +86,9 @@ std::vector<float> emitted_window(const s::EncodedImage& codes, const display::D
 /// per pixel; 0 beyond the screen.
 std::vector<std::uint16_t> codes_window(const s::EncodedImage& codes, int x0, int y0, int n) {
     std::vector<std::uint16_t> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(n) * 3, 0);
-    for (int v = 0; v < n; ++v) {
-        const int y = y0 + v;
-        if (y < 0 || y >= codes.height) continue;
-        for (int u = 0; u < n; ++u) {
-            const int x = x0 + u;
-            if (x < 0 || x >= codes.width) continue;
-            const glm::ivec3 code = code_at(codes, x, y);
-            const std::size_t i = (static_cast<std::size_t>(v) * static_cast<std::size_t>(n) + static_cast<std::size_t>(u)) * 3;
-            for (int ch = 0; ch < 3; ++ch) out[i + static_cast<std::size_t>(ch)] = static_cast<std::uint16_t>(code[ch]);
-        }
-    }
+    for_each_window_code(codes, x0, y0, n, [&](std::size_t i, const glm::ivec3& code) {
+        for (int ch = 0; ch < 3; ++ch) out[i * 3 + static_cast<std::size_t>(ch)] = static_cast<std::uint16_t>(code[ch]);
+    });
     return out;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "atonlab/common/toml_value.h"
+#include "atonlab/stimuli/glare_models/glare_model_list.h"
 #include "atonlab/stimuli/image_io.h"
 
 namespace CLI {
@@ -32,7 +33,7 @@ struct TonemapOptions {
     std::optional<std::string> dither;     ///< on or off
     std::optional<std::string> blueshift;  ///< on or off
     std::optional<std::string> hue_preservation;
-    std::optional<std::string> out_of_gamut;  ///< display.out_of_gamut (gamut.h)
+    std::optional<std::string> out_of_gamut;    ///< display.out_of_gamut (gamut.h)
     std::optional<double> key;                  ///< reinhard's key
     std::optional<std::string> reinhard_white;  ///< a number or "max"
     std::optional<double> white_cd_m2;          ///< linear, clamp
@@ -57,6 +58,10 @@ struct ToneMapped {
 /// the scene-referred image (o.input names it in messages), tone-mapped and
 /// encoded on the CPU. Throws InputError as the command does.
 ToneMapped tonemap_image(const TonemapOptions& options, const std::function<stimuli::ExrImage()>& read_input);
+
+/// `atonlab glare`'s (and atonlab.glare()'s) model when none is given: Spencer et al. 1995's PSF,
+/// which needs no scene (docs/glare.md).
+inline constexpr stimuli::GlareModel kDefaultImageGlareModel = stimuli::GlareModel::spencer;
 
 struct GlareImageOptions {
     std::string input;   ///< scene-referred EXR
