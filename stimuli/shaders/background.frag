@@ -1,6 +1,7 @@
 // The background (docs/architecture.md "The pipeline, one frame", step 1): a uniform field, or a sky of
 // uniform luminance over a flat sea that mirrors it with Schlick's Fresnel
-// factor (K2012 eq 3.17, §3.6.1). D65 white, absolute cd/m².
+// factor (K2012 eq 3.17, §3.6.1), in the colour of the sky's spectrum ([environment] spd; D65 white by
+// default), absolute cd/m².
 // Also writes the linear view depth (m along the view axis; +inf for sky) that
 // later stages use for occlusion tests (K2012 §5.3.2).
 layout(location = 0) out vec4 radiance;
@@ -15,6 +16,7 @@ uniform float sea_f0;           // Schlick R_F(0°)
 uniform int sky_sea;            // 0: uniform field
 uniform float pre_exposure;     // the HDR target stores luminance × pre_exposure (frame_renderer.h)
 uniform float sky_s_p;          // S/P of the sky's spectrum (D65: 2.4645), for the scotopic channel
+uniform vec3 sky_rgb;           // the sky's colour, linear Rec.709 with luminance 1 (D65: (1, 1, 1))
 
 void main() {
     vec3 dir_view = normalize(vec3((gl_FragCoord.xy - principal_px) / focal_px, -1.0));
@@ -29,6 +31,6 @@ void main() {
         depth = t * -dir_view.z;
     }
     // alpha: the scotopic channel (scotopic cd/m² × pre-exposure; docs/tone-mapping.md).
-    radiance = vec4(vec3(L * pre_exposure), L * pre_exposure * sky_s_p);
+    radiance = vec4(sky_rgb * (L * pre_exposure), L * pre_exposure * sky_s_p);
     view_depth = depth;
 }

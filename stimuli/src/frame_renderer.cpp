@@ -31,24 +31,24 @@ namespace atonlab::stimuli {
 namespace {
 constexpr std::size_t kDrawFloats = 16;  // struct LightDraw of light_eval.comp: 4 vec4
 
-double s_p_of_spectrum(const std::string& name) {
+double s_p_of_spectrum(const std::string& name, const char* whose) {
     // Named spectra are few and fixed: each ratio is integrated once (mesopic.h) and kept.
     static std::mutex mutex;
     static std::map<std::string, double> cache;
     const std::lock_guard lock(mutex);
     if (auto it = cache.find(name); it != cache.end()) return it->second;
     const auto spd = display::named_spectrum(name);
-    if (!spd) throw InputError(fmt::format("the light's spectrum \"{}\" is not a named spectrum", name));
+    if (!spd) throw InputError(fmt::format("{} spectrum \"{}\" is not a named spectrum", whose, name));
     return cache[name] = display::scotopic_to_photopic_ratio(*spd);
 }
 }  // namespace
 
 double light_s_p_ratio(const Light& light) {
-    return s_p_of_spectrum(light.spd.empty() ? "d65" : light.spd);
+    return s_p_of_spectrum(light.spd.empty() ? "d65" : light.spd, "the light's");
 }
 
-double sky_s_p_ratio() {
-    return s_p_of_spectrum("d65");
+double sky_s_p_ratio(const Environment& environment) {
+    return s_p_of_spectrum(environment.spd.empty() ? "d65" : environment.spd, "the sky's");
 }
 
 CameraProjection CameraProjection::from_scene(const Scene& scene) {
@@ -190,12 +190,14 @@ struct FrameRenderer::Impl {
 // that moves no code by threshold_codes on the frame's darkest background, Ω_min
 // the smallest pixel solid angle (a corner's), so that E · K_peak < ΔY · Ω_min
 // keeps every pixel the light touches below ΔY. Empty when the skips are off or
-// cannot be bounded (dynamic adaptation, the LDR glare path).
+// cannot be bounded (dynamic adaptation, the LDR glare path, a sky not D65: the bound is
+// computed over D65 backgrounds).
 std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const CameraProjection& P) {
     const DisplaySkips& k = options.skips;
     const OutputSettings& out = scene.output;
+    const bool d65_sky = scene.environment.spd.empty() || scene.environment.spd == "d65";
     if (!(k.cull_invisible_lights || k.crop_billboards) || !(k.threshold_codes > 0) ||
-        out.adaptation.mode != AdaptationMode::fixed || out.ldr_glare || scene.lights.empty())
+        out.adaptation.mode != AdaptationMode::fixed || out.ldr_glare || scene.lights.empty() || !d65_sky)
         return {};
     const Environment& env = scene.environment;
     double floor_cd_m2 = std::max(0.0, env.luminance_cd_m2);
@@ -274,7 +276,9 @@ void FrameRenderer::Impl::set_background_uniforms(const Scene& scene, const Came
     background.set("sea_f0", static_cast<float>(env.sea_reflectance_f0));
     background.set("sky_sea", env.background == Background::sky_sea ? 1 : 0);
     background.set("pre_exposure", pre);
-    background.set("sky_s_p", static_cast<float>(sky_s_p_ratio()));
+    background.set("sky_s_p", static_cast<float>(sky_s_p_ratio(env)));
+    background.set("sky_rgb", static_cast<float>(env.rgb_per_cd_m2.r), static_cast<float>(env.rgb_per_cd_m2.g),
+                   static_cast<float>(env.rgb_per_cd_m2.b));
 }
 
 // Pass 1b of render(): the discs, alpha-blended into the colour target only.

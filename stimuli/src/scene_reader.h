@@ -59,7 +59,7 @@ inline constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",  
                                              "bits",       "dither",      "dither_seed", "out_of_gamut"};
 inline constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
 inline constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
-                                                 "sea_reflectance"};
+                                                 "sea_reflectance", "spd"};
 /// [eye]'s own keys; eye_keys() adds the glare models' (glare_model.h).
 inline constexpr std::string_view kEyeOwnKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm",
                                                    "adaptation_stride"};

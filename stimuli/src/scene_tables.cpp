@@ -88,6 +88,16 @@ Environment read_environment(const Document& doc, const Section& root) {
     }
     e.sea_reflectance_f0 = s.number_or("sea_reflectance", e.sea_reflectance_f0);
     s.within("sea_reflectance", e.sea_reflectance_f0, 0.0, 1.0);
+    if (auto spd = s.string("spd")) {
+        const auto spectrum = named_spectrum(*spd);
+        if (!spectrum)
+            s.fail(s.get("spd"), "spd",
+                   fmt::format("unknown spectrum \"{}\" for the sky; named spectra are {}.", text::echo(*spd),
+                               join(spectrum_names(), "\"")));
+        e.spd = *spd;
+        // D65 is the display's white: drawn (1, 1, 1) exactly, as before the key (byte-identical frames).
+        if (*spd != "d65") e.rgb_per_cd_m2 = normalised_rgb_from_spectrum(*spectrum);
+    }
     return e;
 }
 

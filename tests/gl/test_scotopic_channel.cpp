@@ -1,7 +1,11 @@
 // The frame's scotopic channel (docs/tone-mapping.md "The scotopic channel"): the HDR target's alpha holds
 // each pixel's scotopic luminance (scotopic cd/m²), S/P of each light's own spectrum times the luminance
-// it adds, and the sky's (D65) S/P times the sky's. Expected S/P ratios are summed here from the CIE
-// tables (CIE 1951 V', CIE 1931 ȳ, 1700/683), not taken from the code.
+// it adds, and the S/P of the sky's spectrum ([environment] spd, D65 by default) times the sky's.
+// Expected S/P ratios are summed here from the CIE tables (CIE 1951 V', CIE 1931 ȳ, 1700/683), not
+// taken from the code.
+//
+// - The sky alone (default, d65, led-white): alpha over Y is its spectrum's S/P in every pixel, and the
+//   drawn colour its spectrum's chromaticity (CIE 1931 CMFs summed here).
 //
 // - Over a black sky, a light's alpha over its luminance is its spectrum's S/P, summed over the frame and
 //   in every lit pixel, with and without glare (billboards; the `cie` veil takes its RGB weights).
@@ -12,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "atonlab/display/colour.h"
 #include "atonlab/display/display_model.h"
@@ -71,10 +76,32 @@ TEST_F(ScotopicChannel, EachLightsAlphaIsItsSpectrumsSpTimesItsLuminance) {
             EXPECT_LT(worst, 1e-4) << glare << " " << colour;
         }
     }
-    // The sky alone: D65's S/P.
-    frame.render(parse_scene(one_light_scene("none", 0.1, 0.1, "white", 0.0), "sky.toml", {}), 0.0);
-    const ImageRGBA32F sky = frame.read_hdr();
-    EXPECT_NEAR(sky.rgba[3] / luminance(&sky.rgba[0]), s_p_from_cie_tables(d65_spectrum()), 1e-4);
+    // The sky alone: its spectrum's S/P ([environment] spd; D65 by default), and its spectrum's
+    // chromaticity (summed here from the CIE 1931 CMFs), in every pixel.
+    for (const std::string spd : {"", "d65", "led-white"}) {
+        std::vector<SceneOverride> sets;
+        if (!spd.empty()) sets.push_back(SceneOverride::parse("environment.spd=\"" + spd + "\""));
+        frame.render(parse_scene(one_light_scene("none", 0.1, 0.1, "white", 0.0), "sky.toml", sets), 0.0);
+        const ImageRGBA32F sky = frame.read_hdr();
+        const Spectrum spectrum = *named_spectrum(spd.empty() ? "d65" : spd);
+        const double sp = s_p_from_cie_tables(spectrum);
+        glm::dvec3 xyz(0.0);
+        for (int nm = 360; nm <= 830; ++nm) xyz += spectrum.at(nm) * glm::dvec3(cie1931_cmf(nm));
+        const glm::dvec2 xy(xyz.x / (xyz.x + xyz.y + xyz.z), xyz.y / (xyz.x + xyz.y + xyz.z));
+        double worst_sp = 0.0, worst_xy = 0.0;
+        for (std::size_t i = 0; i + 3 < sky.rgba.size(); i += 4) {
+            const float* p = &sky.rgba[i];
+            worst_sp = std::max(worst_sp, std::abs(p[3] / luminance(p) - sp) / sp);
+            const glm::dvec3 drawn = linear_rgb_to_xyz(glm::dvec3(p[0], p[1], p[2]));
+            const glm::dvec2 drawn_xy = glm::dvec2(drawn) / (drawn.x + drawn.y + drawn.z);
+            worst_xy = std::max(worst_xy, glm::length(drawn_xy - xy));
+        }
+        std::printf("sky %-9s S/P %.4f xy (%.4f, %.4f): alpha/Y worst pixel %.1e, xy worst %.1e\n",
+                    spd.empty() ? "(default)" : spd.c_str(), sp, xy.x, xy.y, worst_sp, worst_xy);
+        EXPECT_LT(worst_sp, 1e-4) << spd;
+        // The CIE tables' D65 lies 3e-5 from Rec.709's rounded white point, which draws it.
+        EXPECT_LT(worst_xy, 2e-4) << spd;
+    }
 }
 
 TEST_F(ScotopicChannel, WhiteLightFramesAreUnchangedByTheChannel) {

@@ -73,6 +73,13 @@ TEST(SceneFileErrors, UnknownColourName) {
     expect_error_at(xy, line_of(xy, "xy"), "light[0].xy", "not a chromaticity");
 }
 
+TEST(SceneFileErrors, UnknownSkySpectrumNamesTheKey) {
+    const std::string text = std::string(kMinimal) + "\n[environment]\nluminance_cd_m2 = 0.01\nspd = \"sodium\"\n";
+    expect_error_at(text, line_of(text, "spd"), "environment.spd", "unknown spectrum \"sodium\" for the sky");
+    // The override names --set instead of a line.
+    EXPECT_THROW(parse_scene(kMinimal, "harbour.toml", sets({"environment.spd=\"led-purple\""})), InputError);
+}
+
 TEST(SceneFileErrors, NegativeNaNAndInfiniteValues) {
     const std::string neg = with_light("name = \"buoy\"\nposition_m = [0, 2, -100]\nintensity_cd = -5\n");
     expect_error_at(neg, line_of(neg, "intensity_cd"), "light[0].intensity_cd",

@@ -51,7 +51,32 @@ TEST(ScotopicChannel, EachLightCarriesItsDiesSpFromTheCieTables) {
     const Light led = light_of("spd = \"led-green\"\n");
     EXPECT_NEAR(light_s_p_ratio(led), s_p_from_cie_tables(*display::named_spectrum("led-green")), 1e-9);
     EXPECT_NEAR(light_s_p_ratio(Light{}), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
-    EXPECT_NEAR(sky_s_p_ratio(), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+    EXPECT_NEAR(sky_s_p_ratio(Environment{}), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+}
+
+Environment environment_of(const std::string& keys) {
+    const std::string text =
+        "[display]\nwidth_px = 64\nheight_px = 64\nwidth_m = 0.05\nviewing_distance_m = 0.9\n"
+        "[environment]\nluminance_cd_m2 = 0.01\n" +
+        keys;
+    return parse_scene(text, "sky.toml", {}).environment;
+}
+
+TEST(ScotopicChannel, TheSkyCarriesItsOwnSpectrumsSp) {
+    // Default: D65, drawn in the display's white (1, 1, 1) exactly, so default frames are unchanged.
+    const Environment d65 = environment_of("");
+    EXPECT_EQ(d65.spd, "d65");
+    EXPECT_EQ(d65.rgb_per_cd_m2, glm::dvec3(1.0));
+    EXPECT_NEAR(sky_s_p_ratio(d65), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+    EXPECT_EQ(environment_of("spd = \"d65\"\n").rgb_per_cd_m2, glm::dvec3(1.0));
+    // The white LED (a blue pump under a phosphor): its own S/P, 2.04, below D65's 2.46, and its
+    // chromaticity, luminance 1 (Rec.709's Y weights, printed to 4 digits), red above blue.
+    const Environment led = environment_of("spd = \"led-white\"\n");
+    const double own = s_p_from_cie_tables(*display::named_spectrum("led-white"));
+    EXPECT_NEAR(sky_s_p_ratio(led), own, 1e-9 * own);
+    EXPECT_NEAR(own, 2.04, 0.01);
+    EXPECT_NEAR(0.2126 * led.rgb_per_cd_m2.r + 0.7152 * led.rgb_per_cd_m2.g + 0.0722 * led.rgb_per_cd_m2.b, 1.0, 1e-4);
+    EXPECT_GT(led.rgb_per_cd_m2.r, led.rgb_per_cd_m2.b);
 }
 
 }  // namespace

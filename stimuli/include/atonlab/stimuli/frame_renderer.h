@@ -183,8 +183,9 @@ struct GpuLightTables {
 /// light carries per photopic cd/m² (display::scotopic_to_photopic_ratio). The frame's scotopic channel
 /// (the HDR target's alpha) holds S/P × the luminance each light adds, plus sky_s_p_ratio() × the sky's.
 double light_s_p_ratio(const Light& light);
-/// S/P of the sky (D65: the background is drawn D65 white), 2.4645.
-double sky_s_p_ratio();
+/// S/P of the sky's (and the uniform field's) spectrum, Environment::spd ([environment] spd; D65 when
+/// empty, 2.4645); the background is drawn in that spectrum's colour, Environment::rgb_per_cd_m2.
+double sky_s_p_ratio(const Environment& environment);
 
 /// Packs lights relative to the eye (positions differenced in double before the
 /// fp32 rounding, so distant lights keep their precision).

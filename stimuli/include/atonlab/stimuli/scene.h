@@ -42,6 +42,12 @@ struct Environment {
     double luminance_cd_m2 = 0.001;          ///< sky (or uniform field) luminance
     double sea_reflectance_f0 = 0.02;        ///< Schlick R_F(0°) of the sea (K2012 eq 3.17, §3.6.1)
     double extinction_per_m = 0.0;           ///< Bouguer σ (K2012 eq 4.14); 0 = clear
+    /// The sky's (and the uniform field's) spectrum, a named_spectrum(): its S/P gives the sky's
+    /// scotopic luminance (sky_s_p_ratio, frame_renderer.h), its chromaticity the colour it is drawn in.
+    std::string spd = "d65";
+    /// The colour the sky is drawn in: linear Rec.709 normalised to Y = 1, of spd's chromaticity
+    /// (display::normalised_rgb_from_spectrum); D65 is the display's white, (1, 1, 1) exactly.
+    glm::dvec3 rgb_per_cd_m2{1.0};
 };
 
 /// A light's emission pattern shared by lights (K2012 §5.1: profiles are
