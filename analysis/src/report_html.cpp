@@ -5,10 +5,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "atonlab/analysis/report.h"
@@ -102,8 +101,6 @@ std::string drift_html(const Dataset& d) {
     }
     return h;
 }
-
-
 
 /// A JSON value's leaves as (path, cell) rows in document order, for the
 /// calibration's parameter table: objects give "a.b", arrays "a[0]"; strings
@@ -214,8 +211,8 @@ std::string condition_fits_html(const StudyResults& r, const ConditionInfo& c,
         lights_sentence(c),
         c.task == protocols::Task::YesNo    ? "yes"
         : c.task == protocols::Task::Adjust ? "the confirmed match"
-        : c.level_on == "test"   ? "chose the test"
-                                 : "chose the reference",
+        : c.level_on == "test"              ? "chose the test"
+                                            : "chose the reference",
         c.guess_rate, c.target_p, c.n_trials);
     if (!r.factor_columns.empty()) {
         // The design's other factors (fits.csv's factor columns), as the protocol set them.
@@ -282,10 +279,10 @@ std::string procedure_estimates_html(const StudyResults& r, const ConditionInfo&
             if (t.posterior) {
                 const PosteriorSummary& q = *t.posterior;
                 tracks += fmt::format(
-                    "<tr><td>{}</td><td>{}</td><td>QUEST</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                     "<td>posterior mean, sd {}</td><td class=\"num\">{}</td><td>{}</td></tr>\n",
-                    esc(g.observer), esc(t.session + " " + t.track), t.levels.size(), f3(q.mean), g3(q.sd),
-                    ci_text(q.interval), yes_no(q.reliable, q.reason, notes));
+                    esc(g.observer), esc(t.session + " " + t.track), esc(t.procedure), t.levels.size(), f3(q.mean),
+                    g3(q.sd), ci_text(q.interval), yes_no(q.reliable, q.reason, notes));
             }
         }
         if (g.matches) {
@@ -350,8 +347,7 @@ std::string sessions_html(const Dataset& d, const StudyResults& r, Footnotes& no
             esc(s.protocol_name), esc(s.status), esc(s.started_at), t ? t->n_trials : 0, t ? t->dropped_frames : 0,
             t ? t->trials_with_drops : 0, t ? t->missed_deadlines : 0,
             s.presentation_margin ? fmt::format("{:.0f} %", *s.presentation_margin * 100.0) : std::string("—"),
-            s.stops == 0 ? std::string("no")
-                         : esc(fmt::format("{} time(s); last: {}", s.stops, s.stop_text)),
+            s.stops == 0 ? std::string("no") : esc(fmt::format("{} time(s); last: {}", s.stops, s.stop_text)),
             !s.displayable   ? std::string("not recorded")
             : *s.displayable ? std::string("displayable")
                              : esc(fmt::format("NOT displayable, run with --allow-undisplayable: {}",
@@ -449,7 +445,8 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
     std::string h;
     Footnotes notes;  // long reasons, numbered under each table
     h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-    h += "<title>atonlab analysis</title>\n<style>\n" + std::string(detail::kReportStyle) + "\n</style>\n</head>\n<body>\n";
+    h += "<title>atonlab analysis</title>\n<style>\n" + std::string(detail::kReportStyle) +
+         "\n</style>\n</head>\n<body>\n";
     h += "<h1>atonlab analysis</h1>\n";
     // First, so a reader cannot miss it: inputs that were damaged and salvaged.
     for (const DamagedInput& x : d.damaged) {

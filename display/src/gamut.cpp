@@ -9,13 +9,14 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 namespace atonlab::display {
 
 namespace {
 
-constexpr std::array<std::string_view, 4> kChoiceNames = {"keep-luminance", "keep-signal-colour",
-                                                          "keep-chromaticity", "clip-channels"};
+constexpr std::array<std::string_view, 4> kChoiceNames = {"keep-luminance", "keep-signal-colour", "keep-chromaticity",
+                                                          "clip-channels"};
 constexpr std::array<std::string_view, kSignalColourCount> kColourNames = {"white", "red", "green", "yellow"};
 
 // COLREGs 1972 Annex I §7, "Colour specification of lights": the corner coordinates of each
@@ -258,6 +259,11 @@ Vec3 fit_to_gamut(Vec3 rgb, Vec3 w, OutOfGamut choice) {
 std::string signal_colour_areas_glsl() {
     const auto num = [](double v) { return fmt::format("{:.17e}LF", v); };  // always a double literal
     const auto polygon = [&](const std::vector<glm::dvec2>& p) {
+        // The shader's tables hold 8 corners (a shorter polygon repeats its last); clipping an area by the
+        // gamut triangle can add up to 3 corners, so more than 8 is an error here, not a truncated area.
+        if (p.empty() || p.size() > 8)
+            throw std::logic_error(
+                fmt::format("a signal-colour area has {} corners; the GLSL tables hold 1 to 8", p.size()));
         std::string s;
         for (std::size_t i = 0; i < 8; ++i) {
             const glm::dvec2 v = p[std::min(i, p.size() - 1)];

@@ -10,8 +10,8 @@
 
 #include "atonlab/display/gamut.h"
 #include "atonlab/display/tonemap.h"
-#include "atonlab/stimuli/tonemap.h"
 #include "atonlab/protocols/observer.h"
+#include "atonlab/stimuli/tonemap.h"
 #include "atonlab/store/json.h"
 
 namespace atonlab::runner {
@@ -48,10 +48,10 @@ void gamut_losses(const stimuli::ImageRGBA32F& hdr, const stimuli::Scene& sc, do
             if (x < 0 || y < 0 || x >= hdr.width || y >= hdr.height) continue;
             const float* px = hdr.pixel(x, y);
             const glm::dvec3 rgb(px[0], px[1], px[2]);
-            const glm::dvec3 rel = display::tonemap_pixel(rgb, adaptation_cd_m2, sc.output.tonemap);
+            const glm::dvec3 rel = display::tonemap_pixel(rgb, px[3], adaptation_cd_m2, sc.output.tonemap);
             // The tone curve's L_d: without hue preservation (eq 4.29) the output's luminance is
             // L_d itself; eq 4.28 (xyY) caps it at 1 before the display sees it.
-            const double asked = glm::dot(weights, display::tonemap_pixel(rgb, adaptation_cd_m2, no_hue));
+            const double asked = glm::dot(weights, display::tonemap_pixel(rgb, px[3], adaptation_cd_m2, no_hue));
             const double kept = std::min(1.0, asked);  // keep-luminance (gamut.h)
             const double shown = glm::dot(weights, display::fit_to_gamut(rel, weights, sc.output.encode.out_of_gamut));
             to_white.luminance_cd_m2[k] = static_cast<float>((asked - kept) * white_cd_m2);

@@ -1,6 +1,8 @@
 // `atonlab render SCENE.toml -o OUT.exr [--png OUT.png] [--time S] [--set key=value]...`
 // One frame, headless: the scene-referred EXR (cd/m²) and optionally the PNG of
 // the code values the calibrated display is sent (tone mapped, encoded, dithered).
+#include "render_command.h"
+
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -19,7 +21,6 @@
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/pipeline.h"
 #include "atonlab/stimuli/scene_file.h"
-#include "render_command.h"
 
 namespace atonlab::runner {
 
@@ -27,7 +28,8 @@ void add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::App* cmd = app.add_subcommand("render", "Render one frame of a scene headless to an EXR (cd/m²) and a PNG");
     cmd->add_option("scene", o.scene, "Scene file (TOML; see docs/scene-file.md)")->required();
     cmd->add_option("-o,--output", o.exr, "Output EXR: linear Rec.709, absolute cd/m²")->required();
-    cmd->add_option("--png", o.png, "Also write the PNG the display would show (the scene's tone mapper and display encoding)");
+    cmd->add_option("--png", o.png,
+                    "Also write the PNG the display would show (the scene's tone mapper and display encoding)");
     cmd->add_option("--time", o.time_s, "Time in seconds at which rhythms are sampled (default 0)");
     cmd->add_option("--set", o.overrides, "Override a scene key: section.key=value (TOML value; repeatable)");
     cmd->add_flag("--half", o.half, "Write the EXR as half floats instead of 32-bit floats");
@@ -76,9 +78,10 @@ int run_render(const RenderOptions& o) {
         constexpr float half_max = 65504.0f;
         std::size_t clamped = 0;
         stimuli::ImageRGBA32F h = hdr;
-        for (float& v : h.rgba)
-            if (v > half_max) {
-                v = half_max;
+        // R, G, B only: the alpha (the scotopic channel, up to 19 × Y for a blue light) is not written.
+        for (std::size_t i = 0; i < h.rgba.size(); ++i)
+            if (i % 4 != 3 && h.rgba[i] > half_max) {
+                h.rgba[i] = half_max;
                 ++clamped;
             }
         if (clamped > 0)

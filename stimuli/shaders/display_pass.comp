@@ -42,10 +42,10 @@ void main() {
     vec3 scene = max(texelFetch(frame_in, p, 0).rgb, vec3(0.0));
     if (ldr_scale > 0.0) scene = min(scene * ldr_scale, vec3(1.0));
     vec4 g = texelFetch(glare_hdr, p, 0);
-    vec3 relative = scene + tonemap_pixel_scotopic(g.rgb, scotopic_alpha != 0 ? g.a : -1.0, adaptation, tone);
+    vec3 relative = scene + tonemap_pixel_scotopic(g.rgb, scotopic_alpha != 0 ? max(g.a, 0.0) : -1.0, adaptation, tone);
 #else
     vec4 hdr = texelFetch(frame_in, p, 0) * inv_pre_exposure;
-    vec3 relative = tonemap_pixel_scotopic(hdr.rgb, scotopic_alpha != 0 ? hdr.a : -1.0, adaptation, tone);
+    vec3 relative = tonemap_pixel_scotopic(hdr.rgb, scotopic_alpha != 0 ? max(hdr.a, 0.0) : -1.0, adaptation, tone);
 #endif
     uvec3 c = encode_pixel(relative, p, frame_index, display);
     codes[p.y * size.x + p.x] = uvec2(c.r | (c.g << 16), c.b);

@@ -21,7 +21,7 @@ glm::dvec3 continuous_codes(const display::DisplayModel& display, glm::dvec3 rel
 }
 
 double invisible_luminance_cd_m2(const OutputSettings& out, double adaptation_cd_m2, double floor_cd_m2,
-                                 glm::dvec3 rgb_per_cd, double codes) {
+                                 glm::dvec3 rgb_per_cd, double light_s_p, double background_s_p, double codes) {
     constexpr double kSmallest = 1e-12, kLargest = 1e12;
     const double y = display::luminance_of_linear_rgb(rgb_per_cd);
     if (!(y > 0) || !(codes > 0)) return 0.0;
@@ -36,15 +36,19 @@ double invisible_luminance_cd_m2(const OutputSettings& out, double adaptation_cd
     for (double e = start; e <= 10.0; e += 1.0 / 16.0) backgrounds.push_back(std::pow(10.0, e));
     std::vector<glm::dvec3> base(backgrounds.size());
     for (std::size_t i = 0; i < backgrounds.size(); ++i)
-        base[i] = continuous_codes(
-            out.display, display::tonemap_pixel(glm::dvec3(backgrounds[i]), adaptation_cd_m2, out.tonemap), bits);
+        base[i] = continuous_codes(out.display,
+                                   display::tonemap_pixel(glm::dvec3(backgrounds[i]), background_s_p * backgrounds[i],
+                                                          adaptation_cd_m2, out.tonemap),
+                                   bits);
 
     // Checks the worst background first: where the last failure happened.
     std::size_t worst = 0;
     auto moves_too_far = [&](double dy) {
         auto check = [&](std::size_t i) {
             const glm::dvec3 c = continuous_codes(
-                out.display, display::tonemap_pixel(glm::dvec3(backgrounds[i]) + dy * colour, adaptation_cd_m2, out.tonemap),
+                out.display,
+                display::tonemap_pixel(glm::dvec3(backgrounds[i]) + dy * colour,
+                                       background_s_p * backgrounds[i] + light_s_p * dy, adaptation_cd_m2, out.tonemap),
                 bits);
             const glm::dvec3 d = glm::abs(c - base[i]);
             return std::max({d.r, d.g, d.b}) > codes;

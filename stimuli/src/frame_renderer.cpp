@@ -44,7 +44,11 @@ double s_p_of_spectrum(const std::string& name, const char* whose) {
 }  // namespace
 
 double light_s_p_ratio(const Light& light) {
-    return s_p_of_spectrum(light.spd.empty() ? "d65" : light.spd, "the light's");
+    if (!light.spd.empty()) return s_p_of_spectrum(light.spd, "the light's");
+    // No spectrum (an `xy` light, or one built in code): the rods see the drawn colour through the RGB
+    // weights (display/tonemap.h scotopic_weights_rgb), which give IALA red and blue their dies' S/P and
+    // white D65's; D65's own S/P would give a red xy light some 50 times the rod signal of a red die.
+    return display::scotopic_luminance_rgb(light.rgb_per_cd) / display::luminance_of_linear_rgb(light.rgb_per_cd);
 }
 
 double sky_s_p_ratio(const Environment& environment) {
@@ -55,15 +59,17 @@ CameraProjection CameraProjection::from_scene(const Scene& scene) {
     CameraProjection p;
     p.width_px = scene.display.width_px;
     p.height_px = scene.display.height_px;
-    const double fov_y = scene.camera.fov_y_deg ? *scene.camera.fov_y_deg * std::numbers::pi / 180.0
-                                                : scene.display.fov_y_rad();
+    const double fov_y =
+        scene.camera.fov_y_deg ? *scene.camera.fov_y_deg * std::numbers::pi / 180.0 : scene.display.fov_y_rad();
     p.focal_px = 0.5 * p.height_px / std::tan(0.5 * fov_y);
     p.world_from_view = glm::mat3_cast(scene.camera.orientation());
     p.eye_position_m = scene.camera.position_m;
     return p;
 }
 
-double CameraProjection::degrees_per_pixel_at_centre() const { return 180.0 / std::numbers::pi / focal_px; }
+double CameraProjection::degrees_per_pixel_at_centre() const {
+    return 180.0 / std::numbers::pi / focal_px;
+}
 
 GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const unsigned> glare_groups,
                            std::span<const double> invisible_lux) {
@@ -71,11 +77,13 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
     // Profiles: every table once, lights refer to them by offset (K2012 §5.1 ids).
     std::vector<std::pair<std::uint32_t, std::uint32_t>> vert, hor;
     for (const auto& v : scene.profiles.vertical) {
-        vert.emplace_back(static_cast<std::uint32_t>(t.profile_values.size()), static_cast<std::uint32_t>(v.table.size()));
+        vert.emplace_back(static_cast<std::uint32_t>(t.profile_values.size()),
+                          static_cast<std::uint32_t>(v.table.size()));
         t.profile_values.insert(t.profile_values.end(), v.table.begin(), v.table.end());
     }
     for (const auto& h : scene.profiles.horizontal) {
-        hor.emplace_back(static_cast<std::uint32_t>(t.profile_values.size()), static_cast<std::uint32_t>(h.table.size()));
+        hor.emplace_back(static_cast<std::uint32_t>(t.profile_values.size()),
+                         static_cast<std::uint32_t>(h.table.size()));
         t.profile_values.insert(t.profile_values.end(), h.table.begin(), h.table.end());
     }
     auto bits = [](std::uint32_t u) { return std::bit_cast<float>(u); };
@@ -127,8 +135,8 @@ GpuLightTables pack_lights(const Scene& scene, glm::dvec3 eye, std::span<const u
 struct FrameRenderer::Impl {
     gl::Program background = gl::Program::build(
         {{gl::ShaderStage::vertex, "fullscreen.vert"}, {gl::ShaderStage::fragment, "background.frag"}});
-    gl::Program disc = gl::Program::build(
-        {{gl::ShaderStage::vertex, "fullscreen.vert"}, {gl::ShaderStage::fragment, "disc.frag"}});
+    gl::Program disc =
+        gl::Program::build({{gl::ShaderStage::vertex, "fullscreen.vert"}, {gl::ShaderStage::fragment, "disc.frag"}});
     gl::Program light_eval = gl::Program::build({{gl::ShaderStage::compute, "light_eval.comp"}});
     gl::Program light_direct = gl::Program::build(
         {{gl::ShaderStage::vertex, "light_direct.vert"}, {gl::ShaderStage::fragment, "light_direct.frag"}});
@@ -149,9 +157,9 @@ struct FrameRenderer::Impl {
     gl::GpuTimer timers[3];
     bool timed = false;
     FrameTimings cpu_timings;
-    // ΔY (cd/m²) per display state and light colour (display_threshold.h): the
+    // ΔY (cd/m²) per display state and light colour and S/P (display_threshold.h): the
     // search takes milliseconds, the answer is the same frame after frame.
-    std::map<std::string, std::map<std::array<double, 3>, double>> invisible_cache;
+    std::map<std::string, std::map<std::array<double, 4>, double>> invisible_cache;
 
     static gl::PixelFormat pixel_format(HdrFormat f) {
         return f == HdrFormat::rgba16f ? gl::PixelFormat::rgba16f : gl::PixelFormat::rgba32f;
@@ -222,11 +230,14 @@ std::vector<double> FrameRenderer::Impl::invisible_lux(const Scene& scene, const
     if (per_colour.size() > 4096) per_colour.clear();
 
     std::vector<double> result(scene.lights.size(), 0.0);
+    const double background_s_p = sky_s_p_ratio(env);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const glm::dvec3 c = scene.lights[i].rgb_per_cd;
-        auto [it, fresh] = per_colour.try_emplace({c.r, c.g, c.b}, 0.0);
+        const double s_p = light_s_p_ratio(scene.lights[i]);
+        auto [it, fresh] = per_colour.try_emplace({c.r, c.g, c.b, s_p}, 0.0);
         if (fresh)
-            it->second = invisible_luminance_cd_m2(out, scene.adaptation_cd_m2, floor_cd_m2, c, k.threshold_codes);
+            it->second = invisible_luminance_cd_m2(out, scene.adaptation_cd_m2, floor_cd_m2, c, s_p, background_s_p,
+                                                   k.threshold_codes);
         result[i] = it->second * omega_min;
     }
     return result;
@@ -361,8 +372,8 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
     veil_report.applied = true;
     veil_report.observer = cie_observer(scene.glare);
     if (where == ComputePlacement::gpu) {
-        veil_report.outside_frame =
-            gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure, P.focal_px, cie_observer(scene.glare));
+        veil_report.outside_frame = gpu_veil.apply(glare_only, ldr ? nullptr : &hdr, ldr ? 1.0 : pre_exposure,
+                                                   P.focal_px, cie_observer(scene.glare));
         // The veil's passes took storage bindings 0-7 and texture unit 0: give
         // the frame's back (the LDR path draws its billboards after the veil,
         // reading `draws` at binding 3).
@@ -391,7 +402,6 @@ void FrameRenderer::Impl::convolve_veil(const Scene& scene, const CameraProjecti
         hdr.upload(frame.data());
     }
 }
-
 
 FramePlacements frame_placements(const Scene& scene, int width, int height) {
     FramePlacements out;
@@ -638,14 +648,22 @@ FrameStats FrameRenderer::stats() const {
     return s;
 }
 
-const GlareStage& FrameRenderer::glare() const { return impl_->glare; }
-const VeilReport& FrameRenderer::veil_report() const { return impl_->veil_report; }
+const GlareStage& FrameRenderer::glare() const {
+    return impl_->glare;
+}
+const VeilReport& FrameRenderer::veil_report() const {
+    return impl_->veil_report;
+}
 
 const gl::Texture2D* FrameRenderer::glare_texture() const {
     return impl_->glare_only ? &impl_->glare_only : nullptr;
 }
 
-const gl::Texture2D& FrameRenderer::hdr_texture() const { return impl_->hdr; }
-const gl::Texture2D& FrameRenderer::view_depth_texture() const { return impl_->depth; }
+const gl::Texture2D& FrameRenderer::hdr_texture() const {
+    return impl_->hdr;
+}
+const gl::Texture2D& FrameRenderer::view_depth_texture() const {
+    return impl_->depth;
+}
 
 }  // namespace atonlab::stimuli

@@ -34,10 +34,11 @@ glm::dvec3 read_colour(const Section& s) {
 
 /// The named spectrum a light's glare is integrated over (docs/glare.md "The light's spectrum"): its
 /// `spd`, else its IALA colour's representative spectrum (white's when no colour key is given), else
-/// D65 for an `xy`, which names no spectrum.
+/// none for an `xy`, which names no spectrum (Light::spd empty: its glare is D65's, its rods see its
+/// drawn colour).
 std::string glare_spectrum(const Section& s) {
     if (auto spd = s.string("spd")) return *spd;
-    if (s.has("xy")) return "d65";
+    if (s.has("xy")) return "";
     return iala_colour_spectrum_name(s.string("colour").value_or("white")).value_or("d65");
 }
 
@@ -270,8 +271,7 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
     const std::string radius_text =
         radius_node != nullptr
             ? fmt::format("glare.radius_deg = {}{}", number_text(radius_deg), at("glare", "radius_deg"))
-            : fmt::format("{:.4g}°, the {} model's default radius{}", radius_deg,
-                          glare_model_name(widest.model),
+            : fmt::format("{:.4g}°, the {} model's default radius{}", radius_deg, glare_model_name(widest.model),
                           glare_psf_degrees_per_texel(widest) > 0.0  // the FFT models
                               ? " for its psf_size"
                               : "");
@@ -280,9 +280,9 @@ void check_billboard(const Document& doc, const Section& root, const Scene& scen
         "{:.1f} px per degree, from display.width_px = {}{}, display.width_m = {}{} and "
         "display.viewing_distance_m = {}{}. Check the display's size and viewing distance, or give a smaller "
         "glare.radius_deg.",
-        number_text(width_px), kMaxGlareKernelPx, radius_text, ppd, scene.display.width_px,
-        at("display", "width_px"), number_text(scene.display.width_m), at("display", "width_m"),
-        number_text(scene.display.viewing_distance_m), at("display", "viewing_distance_m"));
+        number_text(width_px), kMaxGlareKernelPx, radius_text, ppd, scene.display.width_px, at("display", "width_px"),
+        number_text(scene.display.width_m), at("display", "width_m"), number_text(scene.display.viewing_distance_m),
+        at("display", "viewing_distance_m"));
     // At the radius when the file gives it, else at the viewing distance (the
     // usual culprit: a distance in mm written as metres).
     if (radius_node != nullptr) doc.fail(radius_node, "glare.radius_deg", message);

@@ -24,6 +24,7 @@
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/rhythm.h"
+#include "atonlab/display/colour.h"
 #include "atonlab/display/tonemap.h"
 #include "gl_test_support.h"
 
@@ -92,10 +93,13 @@ double worst_code_change(const ImageRGBA32F& a, const ImageRGBA32F& b, const Sce
     double worst = 0;
     for (std::size_t i = 0; i < a.rgba.size(); i += 4) {
         const glm::dvec3 pa{a.rgba[i], a.rgba[i + 1], a.rgba[i + 2]}, pb{b.rgba[i], b.rgba[i + 1], b.rgba[i + 2]};
-        if (pa == pb) continue;
+        if (pa == pb && a.rgba[i + 3] == b.rgba[i + 3]) continue;
         const double L = scene.adaptation_cd_m2;
-        const glm::dvec3 ca = continuous_codes(out.display, tonemap_pixel(pa, L, out.tonemap), out.encode.bits);
-        const glm::dvec3 cb = continuous_codes(out.display, tonemap_pixel(pb, L, out.tonemap), out.encode.bits);
+        // The alpha is the frame's scotopic channel, what the GPU's rods read (docs/tone-mapping.md).
+        const glm::dvec3 ca =
+            continuous_codes(out.display, tonemap_pixel(pa, a.rgba[i + 3], L, out.tonemap), out.encode.bits);
+        const glm::dvec3 cb =
+            continuous_codes(out.display, tonemap_pixel(pb, b.rgba[i + 3], L, out.tonemap), out.encode.bits);
         const glm::dvec3 d = glm::abs(ca - cb);
         worst = std::max({worst, d.r, d.g, d.b});
     }
@@ -133,6 +137,31 @@ TEST_F(Skips, InvisibleLightsAreCulledWithinTheStatedBound) {
                           culled.draws[i].invisible_lux * (1 + 1e-6))
                     << "light " << i << " was culled although brighter than its bound";
             }
+    }
+}
+
+// A light whose rods see more than its drawn colour tells them: IALA green's die (S/P 5.38) drawn
+// with the display's green primary (whose RGB weights give 1.80). Under the perceptual operator at
+// night and under cie191, the rods weigh most, so the bound must use the light's own S/P, as the
+// frame's scotopic channel does; with the colour's RGB weights it would cull lights that move a
+// code by up to about three times the bound.
+TEST_F(Skips, InvisibleGreenLightsAreCulledWithinTheBoundWhereTheRodsWeighMost) {
+    for (const MesopicModel mesopic : {MesopicModel::k2012, MesopicModel::cie191}) {
+        FrameRenderer r;
+        Scene scene = grid_scene(GlareModel::none);
+        scene.output.tonemap.tone_operator = ToneOperator::perceptual;
+        scene.output.tonemap.mesopic = mesopic;
+        for (Light& L : scene.lights) {
+            L.rgb_per_cd = *iala_colour_rgb("green");
+            L.spd = *iala_colour_spectrum_name("green");
+        }
+        const Frame exact = render(r, scene, {});
+        const Frame culled = render(r, scene, {true, false, 0.25});
+        const double change = worst_code_change(exact.hdr, culled.hdr, scene);
+        std::printf("green, perceptual %s: %d of %d lights drawn with the cull; worst code change %.4f (bound 0.25)\n",
+                    std::string(mesopic_model_name(mesopic)).c_str(), culled.stats.drawn, culled.stats.lights, change);
+        EXPECT_LT(culled.stats.drawn, exact.stats.drawn) << "the dim end must be culled";
+        EXPECT_LE(change, 0.25 + 1e-3) << mesopic_model_name(mesopic);
     }
 }
 

@@ -47,10 +47,18 @@ TEST(ScotopicChannel, EachLightCarriesItsDiesSpFromTheCieTables) {
         EXPECT_NEAR(light_s_p_ratio(l), own, 1e-9 * own) << c.colour;
         EXPECT_NEAR(own, c.expected_about, c.within) << c.colour;
     }
-    // An explicit spd wins over the colour; a light built in code (no spd) is D65, as is the sky.
+    // An explicit spd wins over the colour.
     const Light led = light_of("spd = \"led-green\"\n");
     EXPECT_NEAR(light_s_p_ratio(led), s_p_from_cie_tables(*display::named_spectrum("led-green")), 1e-9);
-    EXPECT_NEAR(light_s_p_ratio(Light{}), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
+    // A light without a spectrum (built in code, or given by xy) is seen by the rods through its drawn
+    // colour's RGB weights: white is D65's S/P to the weights' rounding, and an xy at the red die's
+    // chromaticity has about the die's S/P (0.047), not D65's 2.46.
+    EXPECT_NEAR(light_s_p_ratio(Light{}), s_p_from_cie_tables(display::d65_spectrum()), 2e-3);
+    const glm::dvec2 red_xy = *display::iala_colour_xy("red");
+    const Light red_by_xy = light_of("xy = [" + std::to_string(red_xy.x) + ", " + std::to_string(red_xy.y) + "]\n");
+    EXPECT_TRUE(red_by_xy.spd.empty());
+    const double red_die = s_p_from_cie_tables(*display::named_spectrum(*display::iala_colour_spectrum_name("red")));
+    EXPECT_NEAR(light_s_p_ratio(red_by_xy), red_die, 0.25 * red_die) << "an xy red light's rods";
     EXPECT_NEAR(sky_s_p_ratio(Environment{}), s_p_from_cie_tables(display::d65_spectrum()), 1e-9);
 }
 

@@ -26,7 +26,10 @@ glm::dvec3 continuous_codes(const display::DisplayModel& display, glm::dvec3 rel
 /// tone curves are steepest at their dark end, which the grid starts at); ΔY
 /// is bracketed by decades and bisected to 1% (rounded down). Returns 0 when
 /// even 1e-12 cd/m² moves a code too far, and 1e12 when nothing below it does.
+/// The rods see what the frame's scotopic channel carries (docs/tone-mapping.md
+/// "The scotopic channel"): the background's S/P × L_b plus the light's S/P ×
+/// ΔY (light_s_p_ratio), as the GPU tone mapper reads them.
 double invisible_luminance_cd_m2(const OutputSettings& out, double adaptation_cd_m2, double floor_cd_m2,
-                                 glm::dvec3 rgb_per_cd, double codes);
+                                 glm::dvec3 rgb_per_cd, double light_s_p, double background_s_p, double codes);
 
 }  // namespace atonlab::stimuli

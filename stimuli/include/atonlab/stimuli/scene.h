@@ -3,22 +3,21 @@
 // World frame: metres, right-handed, x east, y up, -z north. Bearings and yaw
 // are clockwise from north, as on a chart.
 #include <cstdint>
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include <glm/glm.hpp>
-#include <glm/gtc/quaternion.hpp>
-
-#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/display/geometry.h"
+#include "atonlab/stimuli/cie_glare.h"
 #include "atonlab/stimuli/eye_model.h"
-#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/glare_models/glare_setting.h"
 #include "atonlab/stimuli/output_settings.h"
+#include "atonlab/stimuli/placement.h"
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/rhythm.h"
 
@@ -26,9 +25,9 @@ namespace atonlab::stimuli {
 
 struct Camera {
     glm::dvec3 position_m{0.0, 3.0, 0.0};
-    double yaw_deg = 0.0;    ///< heading, clockwise from north (-z)
-    double pitch_deg = 0.0;  ///< up positive
-    double roll_deg = 0.0;   ///< clockwise positive, looking forward
+    double yaw_deg = 0.0;             ///< heading, clockwise from north (-z)
+    double pitch_deg = 0.0;           ///< up positive
+    double roll_deg = 0.0;            ///< clockwise positive, looking forward
     std::optional<double> fov_y_deg;  ///< vertical field of view; default: the display's visual angle
 
     /// World-from-camera rotation: camera looks down its -z, +y up, +x right.
@@ -39,9 +38,9 @@ enum class Background : std::uint8_t { uniform, sky_sea };
 
 struct Environment {
     Background background = Background::sky_sea;
-    double luminance_cd_m2 = 0.001;          ///< sky (or uniform field) luminance
-    double sea_reflectance_f0 = 0.02;        ///< Schlick R_F(0°) of the sea (K2012 eq 3.17, §3.6.1)
-    double extinction_per_m = 0.0;           ///< Bouguer σ (K2012 eq 4.14); 0 = clear
+    double luminance_cd_m2 = 0.001;    ///< sky (or uniform field) luminance
+    double sea_reflectance_f0 = 0.02;  ///< Schlick R_F(0°) of the sea (K2012 eq 3.17, §3.6.1)
+    double extinction_per_m = 0.0;     ///< Bouguer σ (K2012 eq 4.14); 0 = clear
     /// The sky's (and the uniform field's) spectrum, a named_spectrum(): its S/P gives the sky's
     /// scotopic luminance (sky_s_p_ratio, frame_renderer.h), its chromaticity the colour it is drawn in.
     std::string spd = "d65";
@@ -74,9 +73,10 @@ struct Light {
     double rhythm_period_s = 0.0;                ///< 0 = fixed
     double rhythm_phase_s = 0.0;                 ///< added to the time before the rhythm lookup
     /// The SPD its glare is integrated with (a named_spectrum(); K2012 §4.2.4,
-    /// eq 4.10). The scene file sets it for every light: its `spd`, else its IALA
-    /// colour's spectrum (display::iala_colour_spectrum_name), else "d65" for an
-    /// `xy`. Empty (a Light built in code): D65.
+    /// eq 4.10). The scene file sets it for every light but an `xy` one: its `spd`,
+    /// else its IALA colour's spectrum (display::iala_colour_spectrum_name). Empty
+    /// (an `xy` light, or a Light built in code): its glare is D65's, and its
+    /// scotopic channel the RGB weights of rgb_per_cd (light_s_p_ratio).
     std::string spd;
     /// Its own glare model ([[light]] glare); nullopt: the eye's ([eye] glare).
     /// The models' settings ([glare], the eye's PSF) are shared by all lights.
@@ -114,14 +114,14 @@ struct GlareSettings {
     GlareModel model = GlareModel::none;
     /// Pupil diameter (mm); nullopt: from the adaptation luminance (K2012 eq 3.15).
     std::optional<double> pupil_mm;
-    EyeModel eye;                       ///< wave-optics; its pupil_diameter_mm is set per frame
-    int psf_size = 512;                 ///< N of the PSF (power of two)
-    int spectral_samples = 30;          ///< K2012 §6.1: 30 is the compromise between 15 (steps) and 60
+    EyeModel eye;               ///< wave-optics; its pupil_diameter_mm is set per frame
+    int psf_size = 512;         ///< N of the PSF (power of two)
+    int spectral_samples = 30;  ///< K2012 §6.1: 30 is the compromise between 15 (steps) and 60
     SpectralPath spectral_path = SpectralPath::anchored;
-    int spectral_anchors = 6;           ///< anchored: exact FFTs (wavelengths placed by the SPD's luminance)
+    int spectral_anchors = 6;                     ///< anchored: exact FFTs (wavelengths placed by the SPD's luminance)
     GlareWindow window = GlareWindow::silverman;  ///< K2012 §5.3.1: Silverman is safe at 16 bits
-    std::optional<double> radius_deg;   ///< billboard radius; default per model (see glare_stage.h)
-    int area_layers = 16;               ///< at most this many disc layers (K2012 §4.2.6)
+    std::optional<double> radius_deg;             ///< billboard radius; default per model (see glare_stage.h)
+    int area_layers = 16;                         ///< at most this many disc layers (K2012 §4.2.6)
     /// The models' own settings that a file or an option gave, by key; each
     /// model declares its keys, defaults and checks in its own file
     /// (GlareModelType::settings(), glare_setting.h) and reads them with
