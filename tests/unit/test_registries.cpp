@@ -301,8 +301,10 @@ const std::map<std::string, Scanned>& scanned_sources() {
 std::set<std::string> files_spelling(const Entry& e) {
     std::set<std::string> out;
     for (const auto& [rel, src] : scanned_sources()) {
+        const auto& identifiers =
+            src.identifiers;  // a structured binding cannot be captured before C++20's P1091 (clang 14)
         bool spells = std::any_of(e.identifiers.begin(), e.identifiers.end(),
-                                  [&](const std::string& id) { return src.identifiers.count(id) != 0; });
+                                  [&](const std::string& id) { return identifiers.count(id) != 0; });
         for (const Literal& lit : src.literals)
             for (const std::string& w : e.words) spells = spells || has_word(lit.text, w);
         if (spells) out.insert(rel);
