@@ -59,7 +59,6 @@ int main(int argc, char** argv) {
         // stays red and gives up luminance (docs/tone-mapping.md "Out of gamut: colour or
         // luminance"). The tone mapper and the encoder take the one choice together.
         scene.output.encode.out_of_gamut = d::OutOfGamut::keep_signal_colour;
-        scene.output.tonemap.out_of_gamut = d::OutOfGamut::keep_signal_colour;
         scene.glare.model = st::GlareModel::wave_optics;
         scene.glare.psf_size = 256;
         scene.glare.eye.gratings.enabled = false;  // resolved only from N = 512

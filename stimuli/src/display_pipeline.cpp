@@ -63,7 +63,11 @@ struct DisplayPipeline::Impl {
         state.upload(0, sizeof(zero), zero);
     }
     void upload_settings(const OutputSettings& s) {
-        const display::ToneMapGpuParams tp = display::tonemap_gpu_params(s.tonemap);
+        // display.out_of_gamut's home is the encoder's setting; the tone mapper follows it
+        // (ToneMapSettings::out_of_gamut), so that a caller sets it once.
+        display::ToneMapSettings tm = s.tonemap;
+        tm.out_of_gamut = s.encode.out_of_gamut;
+        const display::ToneMapGpuParams tp = display::tonemap_gpu_params(tm);
         tone_block.upload(0, sizeof(tp), &tp);
         const display::GpuDisplayParams dp = display::gpu_display_params(s.display, s.encode);
         display_block.upload(0, sizeof(dp), &dp);

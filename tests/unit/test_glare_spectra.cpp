@@ -137,7 +137,7 @@ colour = "yellow"
     std::vector<std::pair<std::string, std::string>> got;
     for (const Light& l : scene.lights) got.emplace_back(l.name, l.spd);
     const std::vector<std::pair<std::string, std::string>> want = {
-        {"plain", "d65"},      {"port", "iala-red"}, {"opt", "iala-red"},  {"stbd", "iala-green"},  {"chroma", "d65"},
+        {"plain", "d65"},      {"port", "iala-red"}, {"opt", "iala-red"},  {"stbd", "iala-green"},  {"chroma", ""},
         {"lamp", "led-white"}, {"lh/W", "d65"},      {"lh/R", "iala-red"}, {"amber", "iala-yellow"}};
     EXPECT_EQ(got, want);
     // The displayed colour is still K2012 table 4.1's.

@@ -21,11 +21,10 @@
 #include <glm/glm.hpp>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <span>
 
 #include "atonlab/display/gamut.h"
 
@@ -141,10 +140,10 @@ struct ToneMapSettings {
 
     HuePreservation hue_preservation = HuePreservation::xyY;
 
-    /// display.out_of_gamut (gamut.h), set with the encoder's. Under keep_luminance the rgb
-    /// hue mode and the clamp operator bring their output into the gamut here, keeping
-    /// luminance (as always); under any other choice they leave it to the encoder, which
-    /// applies the choice, so that the two never disagree.
+    /// display.out_of_gamut (gamut.h). Its home is EncodeSettings::out_of_gamut: the GPU display
+    /// pipeline and the scene reader copy it here; code calling tonemap_pixel itself sets both. Under keep_luminance
+    /// the rgb hue mode and the clamp operator bring their output into the gamut here, keeping luminance (as always);
+    /// under any other choice they leave it to the encoder, which applies the choice, so that the two never disagree.
     OutOfGamut out_of_gamut = OutOfGamut::keep_luminance;
     /// The luminance the tone curve aims for: K2012's (default) or CIE 191:2010's MES2 mesopic
     /// luminance of the pixel's (L_p, L_s) with m of the adaptation field (mesopic_equivalent_cd_m2).
@@ -277,7 +276,8 @@ struct ToneMapGpuParams {
         mode{};  ///< operator, hue preservation, blueshift (0 off, BlueshiftLuminance), white_cd_m2 given (0/1)
     std::array<float, 4> curve{};    ///< 1/L_white² (empirical), Reinhard key, 1/L_white² (Reinhard), Kakimoto g
     std::array<float, 4> display{};  ///< Kakimoto k, white_cd_m2, L_dmax, L_da (cd/m²)
-    std::array<float, 4> tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), OutOfGamut as a float, field S/P if mesopic = cie191 else 0
+    std::array<float, 4>
+        tvi{};  ///< log10 ε_C(L_da), σ₀ (cd/m²), OutOfGamut as a float, field S/P if mesopic = cie191 else 0
     std::array<float, 4> blue_rgb{};      ///< blueshift RGB at Y = 1 (eq 4.29); w: its y
     std::array<float, 4> blue_per_sum{};  ///< blueshift RGB per unit X+Y+Z (the xyY path); w: 0
     std::array<float, 4> rgb_to_x{};      ///< rows of the Rec.709 RGB -> XYZ matrix (w: 0)
