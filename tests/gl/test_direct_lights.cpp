@@ -3,15 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <glm/gtc/quaternion.hpp>
 #include <numbers>
 #include <random>
-
-#include <glm/gtc/quaternion.hpp>
 #define GLM_ENABLE_EXPERIMENTAL
 #include <glm/gtx/quaternion.hpp>
 
-#include "atonlab/stimuli/atmosphere.h"
 #include "atonlab/display/colour.h"
+#include "atonlab/stimuli/atmosphere.h"
 #include "atonlab/stimuli/footprint.h"
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/light_model.h"
@@ -34,14 +33,7 @@ Scene black_scene() {
     return s;
 }
 
-class DirectLights : public GLTest {
-protected:
-    void SetUp() override {
-        GLTest::SetUp();
-        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
-    }
-    std::unique_ptr<FrameRenderer> renderer;
-};
+class DirectLights : public RendererTest {};
 
 TEST_F(DirectLights, EnergyRuleHoldsFromOneMetreToThirtyKilometres) {
     // Radius 1 cm: a 29 px disc at 1 m, 1 px² near 51 m, 1e-3 px across at 30 km:
@@ -81,8 +73,8 @@ TEST_F(DirectLights, EnergyRuleHoldsWithFogProfilesAndColour) {
     light.position_m = {3.0, 1.0, -1852.0};
     scene.lights = {light};
     renderer->render(scene, 0.0);
-    const LightAtEye ref = evaluate_light(light, scene.profiles, scene.camera.position_m, 0.0,
-                                          scene.environment.extinction_per_m);
+    const LightAtEye ref =
+        evaluate_light(light, scene.profiles, scene.camera.position_m, 0.0, scene.environment.extinction_per_m);
     const double got = image_illuminance_lux(renderer->read_hdr(), renderer->projection().focal_px);
     EXPECT_NEAR(got / illuminance_lux(ref), 1.0, 0.01);
     // Bouguer (K2012 eq 4.14) really attenuated it: T(d) at V = 5 nmi is 0.05^(d/V).

@@ -52,18 +52,7 @@ double luminance(const ImageRGBA32F& img, int x, int y) {
     return luminance_of_linear_rgb({p[0], p[1], p[2]});
 }
 
-class Disc_ : public GLTest {
-protected:
-    void SetUp() override {
-        GLTest::SetUp();
-        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
-    }
-    ImageRGBA32F render(const Scene& scene) {
-        renderer->render(scene, 0.0);
-        return renderer->read_hdr();
-    }
-    std::unique_ptr<FrameRenderer> renderer;
-};
+class Disc_ : public RendererTest {};
 using Disc = Disc_;
 
 TEST_F(Disc, InsideHoldsTheRequestedLuminance) {
@@ -134,9 +123,10 @@ TEST_F(Disc, AngularDiameterWithinOnePixel) {
             const double r = 0.5 * diameter * kDeg;
             const double expected_px = P.focal_px * (std::tan(a + r) - std::tan(a - r));
             EXPECT_NEAR(chord_px, expected_px, 1.0);
-            std::printf("azimuth %5.2f deg, diameter %.2f deg: by area %.4f deg (pixel %.4f deg), chord %.2f px "
-                        "(closed form %.2f px)\n",
-                        azimuth, diameter, by_area_deg, pixel_deg, chord_px, expected_px);
+            std::printf(
+                "azimuth %5.2f deg, diameter %.2f deg: by area %.4f deg (pixel %.4f deg), chord %.2f px "
+                "(closed form %.2f px)\n",
+                azimuth, diameter, by_area_deg, pixel_deg, chord_px, expected_px);
         }
     }
 }

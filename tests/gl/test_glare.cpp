@@ -1,14 +1,13 @@
 // The glare stage on the GPU: the PSF pipeline against its double-precision
 // CPU references, and the billboards against docs/architecture.md's "Physical invariants" (glare
 // redistributes a light's energy; it neither creates nor loses it).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <numbers>
 #include <optional>
-
-#include <fmt/format.h>
 
 #include "atonlab/stimuli/frame_renderer.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -119,17 +118,12 @@ Light light_at(glm::dvec3 p, double intensity_cd = 100.0, double radius_m = 0.1)
     return L;
 }
 
-class GlareFrames : public GLTest {
+class GlareFrames : public RendererTest {
 protected:
-    void SetUp() override {
-        GLTest::SetUp();
-        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
-    }
     double energy(const Scene& scene) {
         renderer->render(scene, 0.0);
         return image_illuminance_lux(renderer->read_hdr(), renderer->projection().focal_px);
     }
-    std::unique_ptr<FrameRenderer> renderer;
 };
 
 TEST_F(GlareFrames, EveryModelPutsTheLightsIlluminanceIntoTheFrame) {
@@ -153,7 +147,8 @@ TEST_F(GlareFrames, EveryModelPutsTheLightsIlluminanceIntoTheFrame) {
 TEST_F(GlareFrames, GlareAndNoGlareFramesHoldTheSameEnergy) {
     // K2012 fig 6.17: four 100 cd lights at 10, 20, 50 and 100 m, plus colour and fog.
     // Every model: the billboards keep all of it, `cie` all but what it reports outside the frame.
-    for (GlareModel model : {GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer, GlareModel::cie}) {
+    for (GlareModel model :
+         {GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer, GlareModel::cie}) {
         Scene scene = black_scene(model);
         scene.environment.extinction_per_m = 1e-3;
         const double xs[] = {-0.02, -0.007, 0.007, 0.02};
@@ -194,8 +189,10 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
         GlareModel eye;
         std::optional<GlareModel> a;
     };
-    const Case cases[] = {{GlareModel::none, GlareModel::wave_optics}, {GlareModel::none, GlareModel::gaussian_bloom},
-                          {GlareModel::none, GlareModel::spencer},     {GlareModel::none, GlareModel::cie},
+    const Case cases[] = {{GlareModel::none, GlareModel::wave_optics},
+                          {GlareModel::none, GlareModel::gaussian_bloom},
+                          {GlareModel::none, GlareModel::spencer},
+                          {GlareModel::none, GlareModel::cie},
                           {GlareModel::wave_optics, std::nullopt}};
     const double d = 1000.0, x = std::tan(1.5 * std::numbers::pi / 180.0);
     for (const Case& k : cases) {
@@ -265,10 +262,10 @@ TEST_F(GlareFrames, LightsWithTheirOwnGlareModelsShareAFrameEachKeepingItsEnergy
         double b_sum = 0.0, a_spill = 0.0;
         for (int yy = by - 12; yy <= by + 12; ++yy)
             for (int xx = bx - 12; xx <= bx + 12; ++xx) {
-                b_sum += luminance_of_linear_rgb({only_b.pixel(xx, yy)[0], only_b.pixel(xx, yy)[1],
-                                                  only_b.pixel(xx, yy)[2]});
-                a_spill += luminance_of_linear_rgb({only_a.pixel(xx, yy)[0], only_a.pixel(xx, yy)[1],
-                                                    only_a.pixel(xx, yy)[2]});
+                b_sum += luminance_of_linear_rgb(
+                    {only_b.pixel(xx, yy)[0], only_b.pixel(xx, yy)[1], only_b.pixel(xx, yy)[2]});
+                a_spill += luminance_of_linear_rgb(
+                    {only_a.pixel(xx, yy)[0], only_a.pixel(xx, yy)[1], only_a.pixel(xx, yy)[2]});
                 if (glare_path(a_model) == GlarePath::billboard) {
                     for (int c = 0; c < 3; ++c) {
                         EXPECT_EQ(both.pixel(xx, yy)[c], only_b.pixel(xx, yy)[c]) << name;
@@ -381,8 +378,7 @@ TEST_F(GlareFrames, FocusedEyePeaksAtTheLightAndBothEyesKeepItsEnergy) {
     for (const EyeModel& eye : {EyeModel{}, EyeModel::k2012()}) {
         scene.glare.eye = eye;
         // The preset draws with the thesis's spectral method (scene_file.cpp, eye_preset).
-        scene.glare.spectral_path =
-            eye.scale == EyeScale::two_scales ? SpectralPath::anchored : SpectralPath::rescaled;
+        scene.glare.spectral_path = eye.scale == EyeScale::two_scales ? SpectralPath::anchored : SpectralPath::rescaled;
         const double with_glare = energy(scene);
         const ImageRGBA32F img = renderer->read_hdr();
         const auto peak = brightest(img);

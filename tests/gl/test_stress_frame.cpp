@@ -87,12 +87,8 @@ bool record_finite(const LightDrawRecord& d) {
     return std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); });
 }
 
-class StressDirectLights : public GLTest {
+class StressDirectLights : public RendererTest {
 protected:
-    void SetUp() override {
-        GLTest::SetUp();
-        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
-    }
     /// Renders and checks the invariants every frame must keep; returns the frame.
     ImageRGBA32F render_checked(const Scene& scene, double time_s, const std::string& what) {
         renderer->render(scene, time_s);
@@ -108,7 +104,6 @@ protected:
             return i++ % 4 == 3 || v == static_cast<float>(kBackground);
         });
     }
-    std::unique_ptr<FrameRenderer> renderer;
 };
 
 TEST_F(StressDirectLights, LightAtCameraPosition) {

@@ -50,18 +50,7 @@ intensity_cd = 100
                        "toy.toml", set);
 }
 
-class ToyGlareModel : public GLTest {
-protected:
-    void SetUp() override {
-        GLTest::SetUp();
-        if (!IsSkipped()) renderer = std::make_unique<FrameRenderer>();
-    }
-    ImageRGBA32F render(const Scene& scene) {
-        renderer->render(scene, 0.0);
-        return renderer->read_hdr();
-    }
-    std::unique_ptr<FrameRenderer> renderer;
-};
+class ToyGlareModel : public RendererTest {};
 
 TEST_F(ToyGlareModel, DrawsFromASceneFilesKeysWithItsOwnSetting) {
     ASSERT_TRUE(glare_model_from_name("toy-disc")) << "the toy model's registry line did not run";

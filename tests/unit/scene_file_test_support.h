@@ -123,4 +123,16 @@ inline std::vector<SceneOverride> sets(std::initializer_list<const char*> texts)
     return out;
 }
 
+/// The smallest scene with one light: an 800 × 600 px display and a 1 cd buoy 500 m ahead.
+inline constexpr const char* kOneBuoyScene = R"([display]
+width_px = 800
+height_px = 600
+width_m = 0.4
+viewing_distance_m = 0.6
+[[light]]
+name = "buoy"
+position_m = [0, 2, -500]
+intensity_cd = 1
+)";
+
 }  // namespace atonlab::stimuli::scene_file_test

@@ -16,22 +16,14 @@
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/stimuli/image_io.h"
 #include "atonlab/stimuli/scene_file.h"
+#include "scene_file_test_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace atonlab::stimuli;
 
-constexpr const char* kScene = R"([display]
-width_px = 800
-height_px = 600
-width_m = 0.4
-viewing_distance_m = 0.6
-[[light]]
-name = "buoy"
-position_m = [0, 2, -500]
-intensity_cd = 1
-)";
+constexpr const char* kScene = atonlab::stimuli::scene_file_test::kOneBuoyScene;
 
 // A folder holding aperture.png (aperture_image's example), where the scenes are read from.
 class GlareSettingsTest : public ::testing::Test {

@@ -25,6 +25,7 @@
 #include "atonlab/stimuli/image_glare.h"
 #include "atonlab/stimuli/scene.h"
 #include "atonlab/stimuli/scene_file.h"
+#include "scene_file_test_support.h"
 
 namespace {
 
@@ -419,16 +420,7 @@ TEST(Registries, GlareModelNamesAreUniqueAndRoundTrip) {
     EXPECT_FALSE(glare_model_from_name("sparkle").has_value());
 }
 
-constexpr const char* kScene = R"([display]
-width_px = 800
-height_px = 600
-width_m = 0.4
-viewing_distance_m = 0.6
-[[light]]
-name = "buoy"
-position_m = [0, 2, -500]
-intensity_cd = 1
-)";
+constexpr const char* kScene = atonlab::stimuli::scene_file_test::kOneBuoyScene;
 
 TEST(Registries, EveryGlareModelReadsBackFromASceneAndFromSet) {
     for (const GlareModelType* m : glare_models()) {
