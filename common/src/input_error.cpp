@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
+#include <mutex>
+#include <set>
+
 #include "atonlab/common/input_text.h"
 
 namespace atonlab {
@@ -39,5 +43,22 @@ InputError::InputError(SourceLocation where, const std::string& message, std::ve
 
 InputError::InputError(const std::string& message)
     : std::runtime_error(text::one_line(message)), message_(text::one_line(message)) {}
+
+}  // namespace atonlab
+
+namespace atonlab {
+
+std::string note_deprecated(const SourceLocation& where, const std::string& old_spelling,
+                            const std::string& new_spelling) {
+    static std::mutex mutex;
+    static std::set<std::string> said;
+    const std::lock_guard lock(mutex);
+    if (!said.insert(old_spelling).second) return {};
+    SourceLocation at = where;
+    at.key.clear();  // the note names the spelling itself
+    std::string line = format_error(at, fmt::format("note: {} is deprecated; write {}", old_spelling, new_spelling));
+    std::fprintf(stderr, "%s\n", line.c_str());
+    return line;
+}
 
 }  // namespace atonlab

@@ -1,65 +1,88 @@
-// The display encodings' registry (display_encodings.h): the only place their
-// names are spelled. Adding one: its TransferKind, its CPU law
-// (transfer_laws.h), its GLSL function in display_encode.glsl, and one line here.
+// The display encodings' registry (display_encodings.h). Each encoding is one file,
+// display/src/encodings/NAME.cpp, defining display_encoding_NAME(); its line in the
+// list below is the only other place it is named.
 #include "atonlab/display/display_encodings.h"
 
 #include <fmt/format.h>
 
-#include <array>
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
 #include "atonlab/display/display_model.h"
-#include "transfer_laws.h"
+
+// The library's encodings, one line each (the function its file defines), in the order the
+// GPU numbers them (their `kind`).
+#define ATONLAB_DISPLAY_ENCODINGS(X) \
+    X(display_encoding_srgb)         \
+    X(display_encoding_gog)          \
+    X(display_encoding_lut)          \
+    X(display_encoding_pq)
 
 namespace atonlab::display {
+
+#define ATONLAB_DISPLAY_ENCODING_DECLARATION(function) const DisplayEncoding& function();
+ATONLAB_DISPLAY_ENCODINGS(ATONLAB_DISPLAY_ENCODING_DECLARATION)
+#undef ATONLAB_DISPLAY_ENCODING_DECLARATION
+
 namespace {
 
-DisplayModel srgb_display(double peak_cd_m2, double black_cd_m2) {
-    return DisplayModel::srgb(peak_cd_m2, black_cd_m2);
+std::vector<const DisplayEncoding*>& registry() {
+    static std::vector<const DisplayEncoding*> list = {
+#define ATONLAB_DISPLAY_ENCODING_ENTRY(function) &function(),
+        ATONLAB_DISPLAY_ENCODINGS(ATONLAB_DISPLAY_ENCODING_ENTRY)
+#undef ATONLAB_DISPLAY_ENCODING_ENTRY
+    };
+    return list;
 }
-DisplayModel pq_display(double peak_cd_m2, double black_cd_m2) {
-    return DisplayModel::pq(peak_cd_m2, black_cd_m2);
-}
-
-// In TransferKind's order (checked below).
-constexpr std::array<DisplayEncoding, 4> kEncodings = {{
-    {TransferKind::srgb, "srgb", "sRGB", transfer_law::srgb_luminance, transfer_law::srgb_drive,
-     "display_drive_srgb", srgb_display},
-    {TransferKind::gog, "gog", "GOG", transfer_law::gog_luminance, transfer_law::gog_drive, "display_drive_gog",
-     nullptr},
-    {TransferKind::lut, "lut", "LUT", transfer_law::lut_luminance, transfer_law::lut_drive, "display_drive_lut",
-     nullptr},
-    {TransferKind::pq, "pq", "PQ", transfer_law::pq_luminance, transfer_law::pq_drive, "display_drive_pq",
-     pq_display},
-}};
-
-constexpr bool in_kind_order() {
-    for (std::size_t i = 0; i < kEncodings.size(); ++i)
-        if (static_cast<std::size_t>(kEncodings[i].kind) != i) return false;
-    return true;
-}
-static_assert(in_kind_order(), "kEncodings must list the encodings in TransferKind's order");
 
 }  // namespace
 
-std::span<const DisplayEncoding> display_encodings() {
-    return kEncodings;
+void ChannelCheck::fail(const std::string& key, const std::string& message) const {
+    fail_display(fmt::format("{}.{}", channel, key), message);
 }
 
-const DisplayEncoding& display_encoding(TransferKind kind) {
-    const auto i = static_cast<std::size_t>(kind);
-    if (i >= kEncodings.size()) throw std::logic_error("display_encoding: not a TransferKind");
-    return kEncodings[i];
+void ChannelCheck::fail_display(const std::string& key, const std::string& message) const {
+    SourceLocation at = where;
+    at.key = where.key.empty() ? key : where.key + "." + key;
+    throw InputError(at, fmt::format("display '{}': {}", display, message));
+}
+
+std::span<const DisplayEncoding* const> display_encodings() {
+    return registry();
 }
 
 const DisplayEncoding* display_encoding_named(std::string_view name) {
-    for (const DisplayEncoding& e : kEncodings)
-        if (e.name == name) return &e;
+    for (const DisplayEncoding* e : registry())
+        if (e->name == name) return e;
     return nullptr;
 }
 
-std::optional<DisplayModel> display_from_transfer(std::string_view name, double peak_cd_m2, double black_cd_m2) {
+const DisplayEncoding& display_encoding(std::string_view name) {
+    const DisplayEncoding* e = display_encoding_named(name);
+    if (e == nullptr) throw std::logic_error(fmt::format("display_encoding: no encoding is named '{}'", name));
+    return *e;
+}
+
+int display_encoding_index(const DisplayEncoding& encoding) {
+    const auto& list = registry();
+    const auto it = std::find(list.begin(), list.end(), &encoding);
+    if (it == list.end())
+        throw std::logic_error(fmt::format("display_encoding_index: '{}' is not registered", encoding.name));
+    return static_cast<int>(it - list.begin());
+}
+
+bool register_display_encoding(const DisplayEncoding& encoding) {
+    if (display_encoding_named(encoding.name) != nullptr)
+        throw std::logic_error(fmt::format("register_display_encoding: '{}' is taken", encoding.name));
+    if (encoding.parameters.size() > kEncodingParameters)
+        throw std::logic_error(fmt::format("register_display_encoding: '{}' has more than {} parameters", encoding.name,
+                                           kEncodingParameters));
+    registry().push_back(&encoding);
+    return true;
+}
+
+std::optional<DisplayModel> display_from_encoding(std::string_view name, double peak_cd_m2, double black_cd_m2) {
     const DisplayEncoding* e = display_encoding_named(name);
     if (e == nullptr || e->from_peak_black == nullptr) return std::nullopt;
     return e->from_peak_black(peak_cd_m2, black_cd_m2);
@@ -67,8 +90,8 @@ std::optional<DisplayModel> display_from_transfer(std::string_view name, double 
 
 std::string display_encoding_choices(std::string_view quote, bool all) {
     std::vector<std::string_view> names;
-    for (const DisplayEncoding& e : kEncodings)
-        if (all || e.from_peak_black != nullptr) names.push_back(e.name);
+    for (const DisplayEncoding* e : registry())
+        if (all || e->from_peak_black != nullptr) names.push_back(e->name);
     std::string s;
     for (std::size_t i = 0; i < names.size(); ++i) {
         if (i > 0) s += i + 1 == names.size() ? " or " : ", ";
@@ -78,22 +101,24 @@ std::string display_encoding_choices(std::string_view quote, bool all) {
 }
 
 const DisplayEncoding* display_encoding_of(const DisplayModel& display) {
-    const TransferKind kind = display.channels[0].kind;
-    for (const ChannelTransfer& ch : display.channels)
-        if (ch.kind != kind) return nullptr;
-    return &display_encoding(kind);
+    const DisplayEncoding* e = display.channels[0].encoding;
+    for (const ChannelEncoding& ch : display.channels)
+        if (ch.encoding != e) return nullptr;
+    return e;
 }
 
 std::string display_encodings_glsl() {
-    // The last encoding is the else branch, so every path returns.
+    const auto& list = registry();
     std::string s =
-        "// Generated by display_encodings_glsl() (display/src/display_encodings.cpp): each channel's\n"
-        "// inverse transfer law by its kind (GpuDisplayChannel::kind = TransferKind).\n"
-        "double display_drive_by_kind(DisplayChannel c, double L) {\n";
-    for (std::size_t i = 0; i + 1 < kEncodings.size(); ++i)
-        s += fmt::format("    if (c.kind == {}) return {}(c, L);  // {}\n", static_cast<int>(kEncodings[i].kind),
-                         kEncodings[i].glsl_drive_function, kEncodings[i].name);
-    s += fmt::format("    return {}(c, L);  // {}\n}}\n", kEncodings.back().glsl_drive_function, kEncodings.back().name);
+        "// Generated by display_encodings_glsl() (display/src/display_encodings.cpp) from each\n"
+        "// encoding's file (display/src/encodings/NAME.cpp).\n";
+    for (const DisplayEncoding* e : list) s += fmt::format("\n// {}\n{}\n", e->name, e->glsl);
+    // The channel's law by its kind (GpuDisplayChannel::kind); the last is the else branch, so every path returns.
+    s += "\ndouble display_drive_by_kind(DisplayChannel c, double L) {\n";
+    for (std::size_t i = 0; i + 1 < list.size(); ++i)
+        s += fmt::format("    if (c.kind == {}) return {}(c, L);  // {}\n", i, list[i]->glsl_drive_function,
+                         list[i]->name);
+    s += fmt::format("    return {}(c, L);  // {}\n}}\n", list.back()->glsl_drive_function, list.back()->name);
     return s;
 }
 

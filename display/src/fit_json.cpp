@@ -27,23 +27,21 @@ void put_display(Json& out, const DisplayModel& model) {
 Json channels_json(const DisplayModel& model) {
     Json channels = Json::array();
     for (int c = 0; c < 3; ++c) {
-        const ChannelTransfer& ch = model.channels[static_cast<std::size_t>(c)];
+        const ChannelEncoding& ch = model.channels[static_cast<std::size_t>(c)];
         // The laws made from a black and a white (sRGB, PQ) are defined by them; the fitted ones carry
         // them for the reader's eye.
-        const bool own = display_encoding(ch.kind).from_peak_black != nullptr;
+        const DisplayEncoding& e = *ch.encoding;
+        const bool own = e.from_peak_black != nullptr;
         Json j{{"channel", kChannelNames[c]},
-               {"transfer", std::string(display_encoding(ch.kind).name)},
+               {"encoding", std::string(e.name)},
                {"black_cd_m2", own ? ch.black_cd_m2 : ch.min_cd_m2()},
                {"white_cd_m2", own ? ch.white_cd_m2 : ch.max_cd_m2()}};
-        // Each law's own parameters (display_model.h ChannelTransfer).
-        if (ch.kind == TransferKind::gog) {
-            j.update(gog_json(ch.gog));
-        } else if (ch.kind == TransferKind::pq) {
-            j["pq_weight"] = ch.pq_weight;
-        } else if (ch.kind == TransferKind::lut) {
+        // The encoding's own parameters and knots, as it declares them (display_encodings.h).
+        for (std::size_t i = 0; i < e.parameters.size(); ++i) j[std::string(e.parameters[i].key)] = ch.parameter[i];
+        if (!e.knots_key.empty()) {
             Json points = Json::array();
             for (const LutPoint& p : ch.lut) points.push_back(Json::array({p.drive, p.cd_m2}));
-            j["lut"] = std::move(points);
+            j[std::string(e.knots_key)] = std::move(points);
         }
         channels.push_back(std::move(j));
     }
@@ -133,32 +131,35 @@ DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string 
         const Json& cj = (*channels)[c];
         const std::string cat = fmt::format("{}channels[{}].", at, c);
         if (!cj.is_object()) missing(fmt::format("has no object {}", cat));
-        const auto transfer = cj.find("transfer");
-        const std::string law = transfer != cj.end() && transfer->is_string() ? transfer->get<std::string>() : "";
+        // "transfer": the key's name before it was "encoding" (calibrations stored until 2026-12).
+        auto named = cj.find("encoding");
+        if (named == cj.end()) named = cj.find("transfer");
+        const std::string law = named != cj.end() && named->is_string() ? named->get<std::string>() : "";
         const DisplayEncoding* encoding = display_encoding_named(law);
         if (encoding == nullptr)
-            missing(fmt::format("has no known transfer {}transfer ({})", cat, display_encoding_choices("", true)));
-        ChannelTransfer& ch = model.channels[c];
-        ch.kind = encoding->kind;
-        // Each law's parameters (display_model.h ChannelTransfer).
-        const TransferKind kind = encoding->kind;
+            missing(fmt::format("has no known encoding {}encoding ({})", cat, display_encoding_choices("", true)));
+        ChannelEncoding& ch = model.channels[c];
+        ch.encoding = encoding;
         if (encoding->from_peak_black != nullptr) {  // sRGB, PQ: their black and white
             ch.black_cd_m2 = number(cj, cat, "black_cd_m2");
             ch.white_cd_m2 = number(cj, cat, "white_cd_m2");
-            // Rows written before the weight was stored: a PQ channel's weight is its share of the peak.
-            if (ch.kind == TransferKind::pq)
-                ch.pq_weight =
-                    cj.contains("pq_weight") ? number(cj, cat, "pq_weight") : ch.white_cd_m2 / model.peak_cd_m2;
-        } else if (kind == TransferKind::gog) {
-            ch.gog =
-                GogParams{number(cj, cat, "a"), number(cj, cat, "b"), number(cj, cat, "k"), number(cj, cat, "gamma")};
-        } else if (kind == TransferKind::lut) {
-            const auto lut = cj.find("lut");
-            if (lut == cj.end() || !lut->is_array() || lut->empty()) missing(fmt::format("has no points {}lut", cat));
-            for (std::size_t i = 0; i < lut->size(); ++i) {
-                const Json& p = (*lut)[i];
+        }
+        // The encoding's own parameters and knots, as it declares them (display_encodings.h).
+        for (std::size_t i = 0; i < encoding->parameters.size(); ++i) {
+            const EncodingParameter& p = encoding->parameters[i];
+            const std::string key(p.key);
+            ch.parameter[i] = p.missing != nullptr && !cj.contains(key) ? p.missing(ch, model.peak_cd_m2)
+                                                                        : number(cj, cat, key.c_str());
+        }
+        if (!encoding->knots_key.empty()) {
+            const std::string key(encoding->knots_key);
+            const auto knots = cj.find(key);
+            if (knots == cj.end() || !knots->is_array() || knots->empty())
+                missing(fmt::format("has no points {}{}", cat, key));
+            for (std::size_t i = 0; i < knots->size(); ++i) {
+                const Json& p = (*knots)[i];
                 if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
-                    missing(fmt::format("has no [drive, cd_m2] pair {}lut[{}]", cat, i));
+                    missing(fmt::format("has no [drive, cd_m2] pair {}{}[{}]", cat, key, i));
                 ch.lut.push_back(LutPoint{p[0].get<double>(), p[1].get<double>()});
             }
         }

@@ -40,7 +40,7 @@ class Frame:
     time_s: float  # scene time, s
     render_s: float  # wall-clock s inside the library
     metadata: dict[str, Any]  # the EXR header's attributes
-    display: dict[str, Any]  # the display as numbers: peak_cd_m2, black_cd_m2, transfer, bits, primaries_xy, ...
+    display: dict[str, Any]  # the display as numbers: peak_cd_m2, black_cd_m2, encoding, bits, primaries_xy, ...
     @property
     def displayed_cd_m2(self) -> npt.NDArray[np.float32]: ...  # H×W×3: what each channel emits, cd/m²
     def added_lux(self, light: str, radius_deg: float = 0.5) -> float: ...  # `atonlab check`'s "adds", lx
@@ -60,12 +60,13 @@ class Scene:
     def render(self, time_s: float = 0.0) -> Frame: ...
 
 def tonemap(hdr: npt.ArrayLike, *, operator: Optional[str] = None, adaptation_cd_m2: Optional[float] = None,
-            display: Optional[str] = None, peak_cd_m2: Optional[float] = None, black_cd_m2: Optional[float] = None,
+            encoding: Optional[str] = None, peak_cd_m2: Optional[float] = None, black_cd_m2: Optional[float] = None,
             dither: Optional[bool] = None, blueshift: Optional[bool] = None, hue_preservation: Optional[str] = None,
             key: Optional[float] = None, reinhard_white: Union[float, str, None] = None,
             white_cd_m2: Optional[float] = None, epsilon_cd_m2: Optional[float] = None,
-            scale: Optional[float] = None, scene: Optional[str] = None) -> npt.NDArray[np.uint8]:
-    """H×W×3 cd/m² → H×W×3 uint8 display codes, as `atonlab tonemap`."""
+            scale: Optional[float] = None, scene: Optional[str] = None,
+            display: Optional[str] = None) -> npt.NDArray[np.uint8]:
+    """H×W×3 cd/m² → H×W×3 uint8 display codes, as `atonlab tonemap`. display= is encoding='s deprecated old name."""
 
 def glare(hdr: npt.ArrayLike, deg_per_px: float, *, model: Optional[str] = None,
           adaptation_cd_m2: Optional[float] = None, pupil_mm: Optional[float] = None,

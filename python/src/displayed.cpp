@@ -2,6 +2,7 @@
 // display as numbers, the codes decoded through its model to the luminance
 // each pixel shows, and the light a judged light adds within the observer's
 // window, computed by the same code as `atonlab check` (displayability.h).
+#include <pybind11/eval.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -20,24 +21,61 @@
 
 namespace atonlab::python {
 
+namespace {
+
+/// Frame.display's type: a dict whose key "transfer" (the old name of "encoding")
+/// still reads "encoding", with a DeprecationWarning.
+py::object display_dict_type() {
+    static const py::object* type = [] {
+        py::dict scope;
+        py::exec(R"(
+import warnings
+
+class DisplayDict(dict):
+    """Frame.display: "transfer" is the deprecated old name of "encoding"."""
+
+    def _key(self, key):
+        if key == "transfer":
+            warnings.warn('Frame.display["transfer"] is deprecated; read ["encoding"]', DeprecationWarning,
+                          stacklevel=3)
+            return "encoding"
+        return key
+
+    def __getitem__(self, key):
+        return dict.__getitem__(self, self._key(key))
+
+    def get(self, key, default=None):
+        return dict.get(self, self._key(key), default)
+
+    def __contains__(self, key):
+        return dict.__contains__(self, self._key(key))
+)",
+                 scope);
+        return new py::object(scope["DisplayDict"]);  // kept for the process: no destructor after Python's end
+    }();
+    return *type;
+}
+
+}  // namespace
+
 py::dict display_dict(const stimuli::Scene& scene, int bits) {
     const display::DisplayModel& m = scene.output.display;
-    py::dict d;
+    py::dict d = display_dict_type()();
     d["name"] = m.name;
     d["peak_cd_m2"] = m.peak_cd_m2;
     d["black_cd_m2"] = m.black_cd_m2;
-    std::vector<std::string> transfer;
+    std::vector<std::string> encoding;
     py::list white, black;
-    for (const display::ChannelTransfer& c : m.channels) {
-        transfer.emplace_back(display::display_encoding(c.kind).name);
+    for (const display::ChannelEncoding& c : m.channels) {
+        encoding.emplace_back(c.encoding->name);
         white.append(c.max_cd_m2());
         black.append(c.min_cd_m2());
     }
     // One law for all three channels (every display but a mixed calibration): its name.
-    if (transfer[0] == transfer[1] && transfer[1] == transfer[2])
-        d["transfer"] = transfer[0];
+    if (encoding[0] == encoding[1] && encoding[1] == encoding[2])
+        d["encoding"] = encoding[0];
     else
-        d["transfer"] = transfer;
+        d["encoding"] = encoding;
     d["channel_white_cd_m2"] = white;
     d["channel_black_cd_m2"] = black;
     d["bits"] = bits;

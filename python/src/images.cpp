@@ -49,21 +49,26 @@ std::string toml_string(const std::string& s) {
 }
 
 py::array tonemap(const py::array& hdr, const std::optional<std::string>& tone_operator,
-                  const std::optional<double>& adaptation_cd_m2, const std::optional<std::string>& display,
+                  const std::optional<double>& adaptation_cd_m2, const std::optional<std::string>& encoding,
                   const std::optional<double>& peak_cd_m2, const std::optional<double>& black_cd_m2,
                   const std::optional<bool>& dither, const std::optional<bool>& blueshift,
                   const std::optional<std::string>& hue_preservation, const std::optional<double>& key,
                   const std::optional<py::object>& reinhard_white, const std::optional<double>& white_cd_m2,
                   const std::optional<double>& epsilon_cd_m2, const std::optional<double>& scale,
-                  const std::optional<std::string>& scene) {
+                  const std::optional<std::string>& scene, const std::optional<std::string>& display) {
     runner::TonemapOptions o;
+    if (display) {  // the keyword's old name
+        if (encoding) throw py::value_error("give encoding= alone: display= is its old name");
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, "tonemap(display=...) is deprecated; write encoding=...", 1) != 0)
+            throw py::error_already_set();
+    }
     o.input = "hdr";
     o.scene = scene.value_or("");
     o.scale = scale;
     o.adaptation_cd_m2 = adaptation_cd_m2;
     o.epsilon_cd_m2 = epsilon_cd_m2;
     o.tone_operator = tone_operator;
-    o.display = display;
+    o.encoding = encoding ? encoding : display;
     o.peak_cd_m2 = peak_cd_m2;
     o.black_cd_m2 = black_cd_m2;
     o.dither = on_off(dither);
@@ -380,22 +385,24 @@ std::string toml_value(const py::handle& value, const std::string& key) {
 }
 
 void bind_images(py::module_& m) {
-    // The display names from the registry (display_encodings.h), as `atonlab tonemap --display`'s help.
+    // The encodings' names from the registry (display_encodings.h), as `atonlab tonemap --encoding`'s help.
     static const std::string tonemap_doc = fmt::format(
         "Tone-maps and display-encodes an H×W×3 (or ×4) scene-referred array (linear Rec.709, cd/m², or "
         "cd/m² = value × scale) as `atonlab tonemap` does, on the CPU in double precision; returns the H×W×3 "
         "uint8 codes an 8-bit display is sent. operator: empirical (default), perceptual, reinhard, kakimoto, "
-        "linear, clamp; adaptation_cd_m2: L_wa (default: the log-average, K2012 eq 4.15); display: {} (default "
-        "{}), with peak_cd_m2 (100) and black_cd_m2 (0.1); dither, blueshift: bools; "
+        "linear, clamp; adaptation_cd_m2: L_wa (default: the log-average, K2012 eq 4.15); encoding: the display's, {} "
+        "(default {}; display= is its deprecated old name), with peak_cd_m2 (100) and black_cd_m2 (0.1); dither, "
+        "blueshift: bools; "
         "hue_preservation: none, xyY, rgb; key, reinhard_white (a number or \"max\"): reinhard; white_cd_m2: "
         "linear and clamp; scene: take [display] and [tonemap] from a scene file. The GIL is released.",
-        display::display_encoding_choices(""), display::display_encoding(display::TransferKind::srgb).name);
+        display::display_encoding_choices(""), display::display_encoding_srgb().name);
     m.def("tonemap", &tonemap, py::arg("hdr"), py::kw_only(), py::arg("operator") = py::none(),
-          py::arg("adaptation_cd_m2") = py::none(), py::arg("display") = py::none(), py::arg("peak_cd_m2") = py::none(),
-          py::arg("black_cd_m2") = py::none(), py::arg("dither") = py::none(), py::arg("blueshift") = py::none(),
-          py::arg("hue_preservation") = py::none(), py::arg("key") = py::none(), py::arg("reinhard_white") = py::none(),
-          py::arg("white_cd_m2") = py::none(), py::arg("epsilon_cd_m2") = py::none(), py::arg("scale") = py::none(),
-          py::arg("scene") = py::none(), tonemap_doc.c_str());
+          py::arg("adaptation_cd_m2") = py::none(), py::arg("encoding") = py::none(),
+          py::arg("peak_cd_m2") = py::none(), py::arg("black_cd_m2") = py::none(), py::arg("dither") = py::none(),
+          py::arg("blueshift") = py::none(), py::arg("hue_preservation") = py::none(), py::arg("key") = py::none(),
+          py::arg("reinhard_white") = py::none(), py::arg("white_cd_m2") = py::none(),
+          py::arg("epsilon_cd_m2") = py::none(), py::arg("scale") = py::none(), py::arg("scene") = py::none(),
+          py::arg("display") = py::none(), tonemap_doc.c_str());
     static const std::string glare_doc = glare_docstring();
     m.def("glare", &glare, py::arg("hdr"), py::arg("deg_per_px"), py::kw_only(), py::arg("model") = py::none(),
           py::arg("adaptation_cd_m2") = py::none(), py::arg("pupil_mm") = py::none(),

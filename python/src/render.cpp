@@ -8,8 +8,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <chrono>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -40,10 +40,10 @@ struct SceneSource {
 };
 
 struct PyFrame {
-    py::array hdr;       ///< H×W×3 float32, cd/m², a view of `rgba`'s memory
-    py::array rgba;      ///< H×W×4 float32, the frame's own buffer (A: scotopic cd/m²)
-    py::object codes;    ///< H×W×3 uint8 (8-bit display) or uint16, or None
-    int bits = 0;        ///< the display's code depth
+    py::array hdr;     ///< H×W×3 float32, cd/m², a view of `rgba`'s memory
+    py::array rgba;    ///< H×W×4 float32, the frame's own buffer (A: scotopic cd/m²)
+    py::object codes;  ///< H×W×3 uint8 (8-bit display) or uint16, or None
+    int bits = 0;      ///< the display's code depth
     double deg_per_px = 0.0;
     double time_s = 0.0;
     double render_s = 0.0;  ///< wall-clock s inside the library (render, read back), for the overhead bench
@@ -111,10 +111,10 @@ public:
         out.hdr = rgb_view(std::move(frame->hdr));
         // The RGBA array over the same buffer (hdr's base owns it).
         const py::ssize_t h = out.hdr.shape(0), w = out.hdr.shape(1);
-        out.rgba = py::array(py::dtype::of<float>(), {h, w, py::ssize_t{4}},
-                             {w * 4 * py::ssize_t(sizeof(float)), 4 * py::ssize_t(sizeof(float)),
-                              py::ssize_t(sizeof(float))},
-                             out.hdr.data(), out.hdr.base());
+        out.rgba =
+            py::array(py::dtype::of<float>(), {h, w, py::ssize_t{4}},
+                      {w * 4 * py::ssize_t(sizeof(float)), 4 * py::ssize_t(sizeof(float)), py::ssize_t(sizeof(float))},
+                      out.hdr.data(), out.hdr.base());
         return out;
     }
 
@@ -194,8 +194,9 @@ GlUse::~GlUse() {
 void bind_render(py::module_& m) {
     // The laws' names from the registry (display_encodings.h).
     static const std::string display_doc = fmt::format(
-        "The display as numbers: name, peak_cd_m2, black_cd_m2, transfer (the channels' law: {}; a list of three "
-        "where they differ), channel_white_cd_m2 and channel_black_cd_m2 (R, G, B), bits, primaries_xy (red, "
+        "The display as numbers: name, peak_cd_m2, black_cd_m2, encoding (the channels' law: {}; a list of three "
+        "where they differ; \"transfer\" is its deprecated old name), channel_white_cd_m2 and channel_black_cd_m2 (R, "
+        "G, B), bits, primaries_xy (red, "
         "green, blue and white CIE 1931 xy: Rec.709 with D65), width_px, height_px, width_m, viewing_distance_m "
         "and focal_px (the viewing distance in pixel pitches).",
         display::display_encoding_choices("\"", true));
@@ -203,7 +204,9 @@ void bind_render(py::module_& m) {
         .def_readonly("hdr", &PyFrame::hdr,
                       "H×W×3 float32: linear Rec.709 (sRGB primaries, D65), absolute cd/m² (Y = 0.2126 R + 0.7152 G "
                       "+ 0.0722 B is the luminance); row 0 is the top. A view of the frame's own memory (no copy).")
-        .def_readonly("rgba", &PyFrame::rgba, "H×W×4 float32: the same memory as hdr with its alpha, the frame's scotopic luminance (scotopic cd/m²).")
+        .def_readonly(
+            "rgba", &PyFrame::rgba,
+            "H×W×4 float32: the same memory as hdr with its alpha, the frame's scotopic luminance (scotopic cd/m²).")
         .def_readonly("codes", &PyFrame::codes,
                       "H×W×3 display codes as the display gets them (tone-mapped, encoded, dithered): uint8 for an "
                       "8-bit display, uint16 for a deeper one (bits says).")
@@ -250,12 +253,15 @@ void bind_render(py::module_& m) {
                     "(bool, int, float, str, lists), as `--set` takes them. Raises InputError naming the file, line "
                     "and key (or the override's key).")
         .def_property_readonly("path", &PyScene::path, "The scene file.")
-        .def_property_readonly("width_px", [](const PyScene& s) { return s.scene().display.width_px; },
-                               "The display's width in pixels (the frame's width).")
-        .def_property_readonly("height_px", [](const PyScene& s) { return s.scene().display.height_px; },
-                               "The display's height in pixels.")
-        .def_property_readonly("adaptation_cd_m2", [](const PyScene& s) { return s.scene().adaptation_cd_m2; },
-                               "The scene's adaptation luminance (cd/m²).")
+        .def_property_readonly(
+            "width_px", [](const PyScene& s) { return s.scene().display.width_px; },
+            "The display's width in pixels (the frame's width).")
+        .def_property_readonly(
+            "height_px", [](const PyScene& s) { return s.scene().display.height_px; },
+            "The display's height in pixels.")
+        .def_property_readonly(
+            "adaptation_cd_m2", [](const PyScene& s) { return s.scene().adaptation_cd_m2; },
+            "The scene's adaptation luminance (cd/m²).")
         .def("render", &PyScene::render, py::arg("time_s") = 0.0,
              "Renders one frame headless at scene time time_s (s; rhythms are sampled there), as `atonlab render` "
              "does (dynamic adaptation adopts the frame's log-average at once). The GIL is released while the GPU "

@@ -97,9 +97,10 @@ void add_tonemap_command(CLI::App& app, TonemapOptions& o) {
     cmd->add_option("--epsilon-cd-m2", o.epsilon_cd_m2, "ε of the log-average (cd/m²; default 1e-6)");
     cmd->add_option("--operator", o.tone_operator,
                     "Tone curve: empirical (default), perceptual, reinhard, kakimoto, linear, clamp");
-    cmd->add_option("--display", o.display,
-                    fmt::format("Display transfer: {} (default {})", display::display_encoding_choices(""),
-                                display::display_encoding(display::TransferKind::srgb).name));
+    cmd->add_option("--encoding", o.encoding,
+                    fmt::format("The display's encoding: {} (default {})", display::display_encoding_choices(""),
+                                display::display_encoding_srgb().name));
+    cmd->add_option("--display", o.deprecated_display, "Deprecated: --encoding")->group("");  // hidden from --help
     cmd->add_option("--peak-cd-m2", o.peak_cd_m2, "The display's peak white (cd/m²; default 100)");
     cmd->add_option("--black-cd-m2", o.black_cd_m2, "The display's black (cd/m²; default 0.1)");
     cmd->add_option("--dither", o.dither, "on (default: the pipeline's spatio-temporal dither) or off (round)");
@@ -136,22 +137,25 @@ ToneMapped tonemap_image(const TonemapOptions& o, const std::function<stimuli::E
                                          *o.tone_operator));
         tm.tone_operator = *op;
     }
-    if (o.display || o.peak_cd_m2 || o.black_cd_m2) {
+    if (o.deprecated_display) {
+        if (o.encoding) throw InputError(option("--display"), "give --encoding alone: --display is its old name");
+        note_deprecated(option("--display"), "--display", "--encoding");
+    }
+    const std::optional<std::string>& named = o.encoding ? o.encoding : o.deprecated_display;
+    if (named || o.peak_cd_m2 || o.black_cd_m2) {
         const double peak = o.peak_cd_m2 ? positive(o.peak_cd_m2, "--peak-cd-m2", "the peak") : out.display.peak_cd_m2;
         const double black = o.black_cd_m2 ? *o.black_cd_m2 : out.display.black_cd_m2;
         if (!(black >= 0 && black < peak))
             throw InputError(option("--black-cd-m2"), "the black must be at least 0 and below the peak (cd/m²)");
         // The scene's law when a name alone makes it (display_encodings.h), else sRGB.
         const display::DisplayEncoding* own = display::display_encoding_of(out.display);
-        const std::string transfer =
-            o.display.value_or(std::string(own != nullptr && own->from_peak_black != nullptr
-                                               ? own->name
-                                               : display::display_encoding(display::TransferKind::srgb).name));
-        if (auto d = display::display_from_transfer(transfer, peak, black))
+        const std::string encoding = named.value_or(std::string(
+            own != nullptr && own->from_peak_black != nullptr ? own->name : display::display_encoding_srgb().name));
+        if (auto d = display::display_from_encoding(encoding, peak, black))
             out.display = std::move(*d);
         else
-            throw InputError(option("--display"),
-                             fmt::format("must be {}, not '{}'", display::display_encoding_choices(""), transfer));
+            throw InputError(option(o.encoding ? "--encoding" : "--display"),
+                             fmt::format("must be {}, not '{}'", display::display_encoding_choices(""), encoding));
         tm.display_peak_cd_m2 = peak;
     }
     out.encode.dither = on_off(o.dither, "--dither", out.encode.dither == display::Dither::spatiotemporal)

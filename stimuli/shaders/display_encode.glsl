@@ -3,7 +3,7 @@
 //
 // - DisplayParams has the layout of GpuDisplayParams (display_model.h) under both
 //   std140 and std430: fill it with gpu_display_params() and upload it as a UBO or SSBO.
-// - LUT channels read their knots (drive, cd/m², slope; doubles) from the SSBO at
+// - Channels whose encoding has knots (lut: drive, cd/m², slope; doubles) read them from the SSBO at
 //   DISPLAY_LUT_BINDING (default 7; #define it before the #include to move it),
 //   filled with gpu_display_lut(). Shaders that never meet a LUT display may leave it unbound.
 // - The inverse transfer functions run in double precision. GLSL has no double
@@ -20,13 +20,13 @@ const int DISPLAY_DITHER_NONE = 0;
 struct DisplayChannel {
     double black_cd_m2;  // L(0)
     double white_cd_m2;  // L(1)
-    double pq_weight;
-    double a;
-    double b;
-    double k;
-    double gamma;
-    double inv_gamma;
-    int kind;
+    double p0;  // p0 … p5: the encoding's parameters (DisplayEncoding::gpu_parameters)
+    double p1;
+    double p2;
+    double p3;
+    double p4;
+    double p5;
+    int kind;  // the encoding's place in display_encodings()
     int lut_first;
     int lut_count;
     int pad;
@@ -122,72 +122,9 @@ double display_dither_threshold(ivec2 pixel, uint frame, int channel, uint seed)
 }
 
 // ---------------------------------------------------------------------------
-// Inverse transfer functions (ChannelTransfer::drive_for).
-
-// Exact inverse of the monotone cubic through the LUT knots, for black < L < white.
-double display_lut_drive(DisplayChannel c, double L) {
-    int lo = 0;
-    int hi = c.lut_count - 1;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (display_lut[3 * (c.lut_first + mid) + 1] < L) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    int i0 = 3 * (c.lut_first + lo);
-    int i1 = 3 * (c.lut_first + hi);
-    double v0 = display_lut[i0], L0 = display_lut[i0 + 1], m0 = display_lut[i0 + 2];
-    double v1 = display_lut[i1], L1 = display_lut[i1 + 1], m1 = display_lut[i1 + 2];
-    double h = v1 - v0;
-    double delta = L1 - L0;
-    double c1 = h * m0;
-    double c2 = 3.0LF * delta - 2.0LF * h * m0 - h * m1;
-    double c3 = -2.0LF * delta + h * m0 + h * m1;
-    double y = L - L0;
-    // Newton steps, bisection whenever a step leaves the bracket (display_model.cpp solve_segment).
-    double tlo = 0.0LF, thi = 1.0LF;
-    double t = y / delta;
-    for (int i = 0; i < 64; ++i) {
-        double f = t * (c1 + t * (c2 + t * c3)) - y;
-        if (f < 0.0LF) {
-            tlo = t;
-        } else {
-            thi = t;
-        }
-        double next = t - f / (c1 + t * (2.0LF * c2 + t * 3.0LF * c3));
-        if (!(next > tlo && next < thi)) next = 0.5LF * (tlo + thi);
-        bool done = abs(next - t) <= 1e-15LF || thi - tlo <= 1e-15LF;
-        t = next;
-        if (done) break;
-    }
-    return v0 + t * h;
-}
-
-// One function per encoding, each the twin of its CPU law's inverse (display_encodings.h
-// names them), for black < L <= white.
-double display_drive_srgb(DisplayChannel c, double L) {
-    double t = (L - c.black_cd_m2) / (c.white_cd_m2 - c.black_cd_m2);
-    // max(): the power branch dips 3e-8 below the break just above it (display_model.cpp).
-    return t <= 0.0031308049535603713LF ? 12.92LF * t
-                                        : max(1.055LF * display_pow(t, 0.4166666666666666667LF) - 0.055LF, 0.04045LF);
-}
-
-double display_drive_gog(DisplayChannel c, double L) {
-    return (display_pow(L - c.a, c.inv_gamma) - c.b) / c.k;
-}
-
-double display_drive_lut(DisplayChannel c, double L) {
-    return L >= c.white_cd_m2 ? 1.0LF : display_lut_drive(c, L);
-}
-
-double display_drive_pq(DisplayChannel c, double L) {  // SMPTE ST 2084 inverse EOTF of L / weight
-    double ym1 = display_pow((L / c.pq_weight) / 10000.0LF, 0.1593017578125LF);
-    return display_pow((0.8359375LF + 18.8515625LF * ym1) / (1.0LF + 18.6875LF * ym1), 78.84375LF);
-}
-
-// display_drive_by_kind(c, L): the function of c's kind, generated from the registry.
+// The encodings' laws: each encoding's GLSL (the twin of its CPU inverse, from its
+// file display/src/encodings/NAME.cpp) and display_drive_by_kind(c, L), the function
+// of c's kind, generated from the registry (display_encodings.h).
 #include "display_encodings.glsl"
 
 double display_drive_for(DisplayChannel c, double L) {

@@ -21,15 +21,15 @@
 #include <system_error>
 #include <utility>
 
-#include "atonlab/stimuli/atmosphere.h"
 #include "atonlab/common/error_list.h"
+#include "atonlab/common/input_error.h"
 #include "atonlab/common/input_limits.h"
 #include "atonlab/common/input_text.h"
 #include "atonlab/common/toml_reader.h"
 #include "atonlab/common/toml_text.h"
 #include "atonlab/display/calibration.h"
 #include "atonlab/display/colour.h"
-#include "atonlab/common/input_error.h"
+#include "atonlab/stimuli/atmosphere.h"
 #include "atonlab/stimuli/fft.h"
 #include "atonlab/stimuli/glare_kernel.h"
 #include "atonlab/stimuli/glare_stage.h"
@@ -52,24 +52,27 @@ inline constexpr std::string_view kSetPrefix = "--set ";
 
 using toml_reader::KeyList;
 
-inline constexpr std::string_view kSections[] = {"display", "camera", "environment", "eye", "glare", "tonemap", "profiles", "light",
-                                           "disc"};
-inline constexpr std::string_view kDisplayKeys[] = {"width_px",   "height_px",   "width_m",     "viewing_distance_m",
-                                             "peak_cd_m2", "black_cd_m2", "transfer",    "calibration",
-                                             "bits",       "dither",      "dither_seed", "out_of_gamut"};
+inline constexpr std::string_view kSections[] = {"display", "camera",   "environment", "eye", "glare",
+                                                 "tonemap", "profiles", "light",       "disc"};
+inline constexpr std::string_view kDisplayKeys[] = {
+    "width_px",    "height_px", "width_m", "viewing_distance_m", "peak_cd_m2",  "black_cd_m2", "encoding", "transfer",
+    "calibration", "bits",      "dither",  "dither_seed",        "out_of_gamut"};
 inline constexpr std::string_view kCameraKeys[] = {"position_m", "yaw_deg", "pitch_deg", "roll_deg", "fov_deg"};
-inline constexpr std::string_view kEnvironmentKeys[] = {"background", "luminance_cd_m2", "visibility_nmi", "extinction_per_km",
-                                                 "sea_reflectance", "spd"};
+inline constexpr std::string_view kEnvironmentKeys[] = {"background",        "luminance_cd_m2", "visibility_nmi",
+                                                        "extinction_per_km", "sea_reflectance", "spd"};
 /// [eye]'s own keys; eye_keys() adds the glare models' (glare_model.h).
 inline constexpr std::string_view kEyeOwnKeys[] = {"adaptation", "adaptation_cd_m2", "glare", "pupil_mm",
                                                    "adaptation_stride"};
-inline constexpr std::string_view kTonemapKeys[] = {
-    "operator", "white_relative", "reinhard_key", "reinhard_white_relative", "kakimoto_g", "kakimoto_k",
-    "white_cd_m2", "display_adaptation_cd_m2", "blueshift", "blueshift_luminance", "blueshift_xy", "hue_preservation",
-    "ldr_glare", "mesopic"};
+inline constexpr std::string_view kTonemapKeys[] = {"operator",     "white_relative",
+                                                    "reinhard_key", "reinhard_white_relative",
+                                                    "kakimoto_g",   "kakimoto_k",
+                                                    "white_cd_m2",  "display_adaptation_cd_m2",
+                                                    "blueshift",    "blueshift_luminance",
+                                                    "blueshift_xy", "hue_preservation",
+                                                    "ldr_glare",    "mesopic"};
 /// The [glare] keys every model shares (the glare stage's); glare_keys() adds each model's own.
-inline constexpr std::string_view kSharedGlareKeys[] = {"psf_size", "spectral_samples", "window", "radius_deg",
-                                                        "area_layers", "placement"};
+inline constexpr std::string_view kSharedGlareKeys[] = {"psf_size",   "spectral_samples", "window",
+                                                        "radius_deg", "area_layers",      "placement"};
 /// The keys [eye] and [glare] take: their own, then each glare model's in the registry's order.
 KeyList eye_keys();
 KeyList glare_keys();
@@ -77,12 +80,25 @@ inline constexpr std::string_view kProfileKinds[] = {"vertical", "horizontal"};
 inline constexpr std::string_view kVerticalKeys[] = {"elevation_deg", "relative"};
 inline constexpr std::string_view kHorizontalKeys[] = {"sectors", "bearing_deg", "relative"};
 inline constexpr std::string_view kSectorKeys[] = {"from_deg", "to_deg", "level", "edge_deg"};
-inline constexpr std::string_view kLightKeys[] = {
-    "name",    "position_m", "intensity_cd",   "radius_m", "colour",           "xy",
-    "spd",     "yaw_deg",    "pitch_deg",      "roll_deg", "vertical_profile", "horizontal_profile",
-    "sectors", "rhythm",     "rhythm_phase_s", "ramp_s",   "glare"};
+inline constexpr std::string_view kLightKeys[] = {"name",
+                                                  "position_m",
+                                                  "intensity_cd",
+                                                  "radius_m",
+                                                  "colour",
+                                                  "xy",
+                                                  "spd",
+                                                  "yaw_deg",
+                                                  "pitch_deg",
+                                                  "roll_deg",
+                                                  "vertical_profile",
+                                                  "horizontal_profile",
+                                                  "sectors",
+                                                  "rhythm",
+                                                  "rhythm_phase_s",
+                                                  "ramp_s",
+                                                  "glare"};
 inline constexpr std::string_view kDiscKeys[] = {"name",   "position_m", "diameter_deg", "luminance_cd_m2",
-                                          "colour", "xy",         "spd"};
+                                                 "colour", "xy",         "spd"};
 
 /// Keys of which a table may hold at most one. An override that sets one of
 /// them removes the others from its table, so "--set light.buoy.colour=red"
@@ -291,8 +307,8 @@ private:
     void save(toml::table& table, std::string_view key);
     struct Edit {
         toml::table* table = nullptr;
-        toml::key key;       ///< as the table held it (with its source), or as made
-        toml::table saved;   ///< "v": the node it held; empty when the key was absent
+        toml::key key;      ///< as the table held it (with its source), or as made
+        toml::table saved;  ///< "v": the node it held; empty when the key was absent
     };
     std::vector<Edit> edits_;
 };

@@ -1,7 +1,6 @@
 // The scene file's single tables: [display], [camera], [environment], [eye], [glare], [tonemap] (scene_reader.h).
-#include "scene_reader.h"
-
 #include "atonlab/display/display_encodings.h"
+#include "scene_reader.h"
 
 namespace atonlab::stimuli::scene_reader {
 
@@ -201,8 +200,9 @@ void read_glare(const Document& doc, const Section& root, GlareSettings& g, doub
         if (auto v = placement_from_name(*p))
             g.placement = *v;
         else
-            s.fail(s.get("placement"), "placement",
-                   fmt::format("unknown placement \"{}\"; it must be \"automatic\", \"gpu\" or \"cpu\".", text::echo(*p)));
+            s.fail(
+                s.get("placement"), "placement",
+                fmt::format("unknown placement \"{}\"; it must be \"automatic\", \"gpu\" or \"cpu\".", text::echo(*p)));
     }
     // Each model's own keys (glare_models/): every model's, whichever the scene uses, since a light may pick its own.
     for (const GlareModelType* m : glare_models()) m->read_glare_keys(doc, s, g, pupil_mm);
@@ -221,13 +221,18 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
                    fmt::format("the display's black ({} cd/m²) must be below its peak ({} cd/m²).", number_text(black),
                                number_text(peak)));
         // The laws a name alone makes (display_encodings.h); sRGB unless the file says otherwise.
-        const std::string transfer =
-            s.string("transfer").value_or(std::string(display_encoding(TransferKind::srgb).name));
-        if (auto d = display_from_transfer(transfer, peak, black))
+        // `transfer` is the key's old name: still read, with a note.
+        if (s.has("transfer") && s.has("encoding"))
+            s.fail(s.get("transfer"), "transfer", "give encoding alone: transfer is its old name.");
+        const char* const key = s.has("transfer") ? "transfer" : "encoding";
+        if (s.has("transfer"))
+            note_deprecated(doc.where(s.get("transfer"), "display.transfer"), "[display] transfer", "encoding");
+        const std::string encoding = s.string(key).value_or(std::string(display_encoding_srgb().name));
+        if (auto d = display_from_encoding(encoding, peak, black))
             out.display = std::move(*d);
         else
-            s.fail(s.get("transfer"), "transfer",
-                   fmt::format("unknown transfer \"{}\"; it must be {} (or give a calibration file).", transfer,
+            s.fail(s.get(key), key,
+                   fmt::format("unknown encoding \"{}\"; it must be {} (or give a calibration file).", encoding,
                                display_encoding_choices("\"")));
         if (auto cal = s.string("calibration")) {
             std::filesystem::path p(*cal);
@@ -235,7 +240,8 @@ void read_output(const Document& doc, const Section& root, OutputSettings& out) 
             try {
                 out.display = display_from_calibration(fit_calibration(read_calibration_file(p)), p.stem().string());
             } catch (const InputError& e) {
-                s.fail(s.get("calibration"), "calibration", fmt::format("the calibration file is unusable: {}", e.what()));
+                s.fail(s.get("calibration"), "calibration",
+                       fmt::format("the calibration file is unusable: {}", e.what()));
             }
         }
         out.encode.bits = s.integer("bits", 1, 16).value_or(out.encode.bits);

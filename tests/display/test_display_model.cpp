@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/display/display_model.h"
 #include "input_error.h"
 #include "text_contains.h"
@@ -279,7 +280,7 @@ TEST(Encoder, OutOfRangeInputsNeverLeaveTheCodeRange) {
                         if (std::isnan(x) || x <= 0.0) {
                             EXPECT_EQ(code, glm::ivec3(0)) << x;
                         }
-                        if (x >= 1.0 && d.channels[0].kind != TransferKind::pq) {
+                        if (x >= 1.0 && !d.channels[0].follows("pq")) {
                             EXPECT_EQ(code, glm::ivec3(max_code)) << x;
                         }
                         if (x >= 1.0) {
@@ -415,7 +416,7 @@ TEST(GpuParams, PackTheModelAndTheLutKnots) {
     const auto knots = gpu_display_lut(d);
     ASSERT_EQ(knots.size(), 3u * 3u * 8u);
     for (int c = 0; c < 3; ++c) {
-        EXPECT_EQ(p.channel[c].kind, static_cast<int>(TransferKind::lut));
+        EXPECT_EQ(p.channel[c].kind, display_encoding_index(display_encoding("lut")));
         EXPECT_EQ(p.channel[c].lut_first, 8 * c);
         EXPECT_EQ(p.channel[c].lut_count, 8);
         EXPECT_DOUBLE_EQ(p.channel[c].white_cd_m2, d.channels[static_cast<std::size_t>(c)].max_cd_m2());

@@ -1,5 +1,5 @@
 // fit_json (display/fit_json.h, docs/calibration.md "fit_json"): the display model
-// written once and read back bit for bit, for every transfer law.
+// written once and read back bit for bit, for every display encoding.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,19 +17,13 @@ void expect_same_model(const DisplayModel& a, const DisplayModel& b) {
     EXPECT_EQ(a.peak_cd_m2, b.peak_cd_m2);
     EXPECT_EQ(a.black_cd_m2, b.black_cd_m2);
     for (std::size_t c = 0; c < 3; ++c) {
-        const ChannelTransfer& x = a.channels[c];
-        const ChannelTransfer& y = b.channels[c];
-        EXPECT_EQ(x.kind, y.kind) << c;
-        EXPECT_EQ(x.gog.a, y.gog.a);
-        EXPECT_EQ(x.gog.b, y.gog.b);
-        EXPECT_EQ(x.gog.k, y.gog.k);
-        EXPECT_EQ(x.gog.gamma, y.gog.gamma);
-        if (x.kind == TransferKind::srgb || x.kind == TransferKind::pq) {
+        const ChannelEncoding& x = a.channels[c];
+        const ChannelEncoding& y = b.channels[c];
+        EXPECT_EQ(x.encoding, y.encoding) << c;
+        EXPECT_EQ(x.parameter, y.parameter) << c;  // gog's a, b, k, gamma; pq's weight
+        if (x.follows("srgb") || x.follows("pq")) {
             EXPECT_EQ(x.black_cd_m2, y.black_cd_m2);
             EXPECT_EQ(x.white_cd_m2, y.white_cd_m2);
-        }
-        if (x.kind == TransferKind::pq) {
-            EXPECT_EQ(x.pq_weight, y.pq_weight);
         }
         ASSERT_EQ(x.lut.size(), y.lut.size());
         for (std::size_t i = 0; i < x.lut.size(); ++i) {
@@ -57,7 +51,7 @@ TEST(FitJson, NominalRowHoldsBitsDitherAndEveryChannelsRange) {
     const DisplayModel m = DisplayModel::srgb(100.0, 0.1);
     const std::string text = nominal_fit_json(m, EncodeSettings{8, Dither::spatiotemporal, 0});
     EXPECT_NE(text.find(R"("bits":8,"dither":true)"), std::string::npos) << text;
-    EXPECT_NE(text.find(R"("channel":"green","transfer":"srgb")"), std::string::npos) << text;
+    EXPECT_NE(text.find(R"("channel":"green","encoding":"srgb")"), std::string::npos) << text;
     EXPECT_EQ(text.rfind(R"({"model":"nominal",)", 0), 0u) << text;
 }
 
@@ -73,9 +67,9 @@ TEST(FitJson, AnIncompleteModelNamesWhatIsMissing) {
     EXPECT_NE(input_error_of([] { display_model_from_fit_json("not json", ""); }).find("not a JSON object"),
               std::string::npos);
     const std::string no_gamma = R"({"model":"gog","display":{"peak_cd_m2":100,"black_cd_m2":0.1,"channels":[)"
-                                 R"({"transfer":"gog","a":0,"b":0,"k":1,"gamma":2},)"
-                                 R"({"transfer":"gog","a":0,"b":0,"k":1},)"
-                                 R"({"transfer":"gog","a":0,"b":0,"k":1,"gamma":2}]}})";
+                                 R"({"encoding":"gog","a":0,"b":0,"k":1,"gamma":2},)"
+                                 R"({"encoding":"gog","a":0,"b":0,"k":1},)"
+                                 R"({"encoding":"gog","a":0,"b":0,"k":1,"gamma":2}]}})";
     EXPECT_NE(input_error_of([&] {
                   display_model_from_fit_json(no_gamma, "");
               }).find("has no number display.channels[1].gamma"),
@@ -85,9 +79,34 @@ TEST(FitJson, AnIncompleteModelNamesWhatIsMissing) {
     EXPECT_NE(input_error_of([&] { display_model_from_fit_json(empty_lut, ""); }).find("has no points channels[0].lut"),
               std::string::npos);
     const std::string unknown = R"({"peak_cd_m2":1,"black_cd_m2":0,"channels":[)"
-                                R"({"transfer":"hlg"},{"transfer":"srgb"},{"transfer":"srgb"}]})";
-    EXPECT_NE(input_error_of([&] { display_model_from_fit_json(unknown, ""); }).find("channels[0].transfer"),
+                                R"({"encoding":"hlg"},{"encoding":"srgb"},{"encoding":"srgb"}]})";
+    EXPECT_NE(input_error_of([&] { display_model_from_fit_json(unknown, ""); }).find("channels[0].encoding"),
               std::string::npos);
+}
+
+TEST(FitJson, ACalibrationStoredWithTheOldKeyTransferReadsAsWithEncoding) {
+    // Calibrations stored before the key was "encoding" name it "transfer"; the nominal
+    // srgb row, the gog row (written out by hand) and a PQ row without its weight read the same.
+    const DisplayModel m = DisplayModel::srgb(100.0, 0.1);
+    std::string text = nominal_fit_json(m, EncodeSettings{});
+    for (std::size_t at = text.find(R"("encoding":)"); at != std::string::npos; at = text.find(R"("encoding":)", at))
+        text.replace(at, 11, R"("transfer":)");
+    ASSERT_EQ(text.find("encoding"), std::string::npos) << text;
+    expect_same_model(m, display_model_from_fit_json(text, m.name));
+    const std::string gog = R"({"peak_cd_m2":101,"black_cd_m2":0.3,"channels":[)"
+                            R"({"transfer":"gog","a":0.1,"b":0.5,"k":2,"gamma":2},)"
+                            R"({"transfer":"gog","a":0.1,"b":0.5,"k":8,"gamma":2},)"
+                            R"({"transfer":"gog","a":0.1,"b":0.5,"k":1,"gamma":2}]})";
+    const DisplayModel g = display_model_from_fit_json(gog, "old");
+    // L(1) = a + (b + k)^gamma: 0.1 + 2.5², 0.1 + 8.5², 0.1 + 1.5².
+    EXPECT_DOUBLE_EQ(g.channels[1].max_cd_m2(), 0.1 + 8.5 * 8.5);
+    EXPECT_TRUE(g.channels[2].follows("gog"));
+    // A PQ channel without pq_weight: its share of the peak.
+    const std::string pq = R"({"peak_cd_m2":1000,"black_cd_m2":0,"channels":[)"
+                           R"({"transfer":"pq","black_cd_m2":0,"white_cd_m2":200},)"
+                           R"({"transfer":"pq","black_cd_m2":0,"white_cd_m2":700},)"
+                           R"({"transfer":"pq","black_cd_m2":0,"white_cd_m2":100}]})";
+    EXPECT_DOUBLE_EQ(display_model_from_fit_json(pq, "old").channels[1].parameter[0], 0.7);
 }
 
 TEST(FitJson, MeasuredFitKeepsTheRampsAndANullContrastForAZeroBlack) {

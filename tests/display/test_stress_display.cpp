@@ -80,7 +80,7 @@ TEST(StressDisplayModel, EncodeNonDecreasingFromExactZeroToAbovePeak) {
                     // At and above 1 the channel's full luminance L(1): full drive, except on PQ,
                     // whose codes are absolute (the code for the display's peak, 1000 cd/m² = 0.75).
                     const glm::ivec3 at_one = encode_pixel(display, glm::dvec3(1.0), pixel, 7, settings);
-                    if (display.channels[0].kind != TransferKind::pq) {
+                    if (!display.channels[0].follows("pq")) {
                         ASSERT_EQ(at_one, glm::ivec3(max_code)) << display.name;
                     }
                     for (double white : {1.0 + 1e-9, 2.0, 1e300, kInf}) {
@@ -121,7 +121,7 @@ TEST(StressDisplayModel, DecodeNonDecreasingInTheCode) {
 TEST(StressDisplayModel, InverseTransferNeverStepsBackAtItsBreakpoints) {
     // drive_for(L) at consecutive doubles around the sRGB toe (IEC 61966-2-1's rounded
     // breakpoint), the GOG cut-off, the LUT's flat toe and knots, and PQ's black/peak clips.
-    auto sweep_around = [](const ChannelTransfer& ch, double L0, const std::string& what) {
+    auto sweep_around = [](const ChannelEncoding& ch, double L0, const std::string& what) {
         double L = L0;
         for (int i = 0; i < 3000; ++i) L = std::nextafter(L, -kInf);
         double prev = ch.drive_for(L);
@@ -136,7 +136,7 @@ TEST(StressDisplayModel, InverseTransferNeverStepsBackAtItsBreakpoints) {
         }
     };
     const DisplayModel srgb = DisplayModel::srgb(100.0, 0.0);
-    const ChannelTransfer& g = srgb.channels[1];
+    const ChannelEncoding& g = srgb.channels[1];
     // The decoder's switch at V = 0.04045 lies at L = white · 0.04045 / 12.92.
     sweep_around(g, g.white_cd_m2 * (0.04045 / 12.92), "sRGB toe");
     sweep_around(g, g.white_cd_m2 * 0.0031308, "sRGB IEC breakpoint");

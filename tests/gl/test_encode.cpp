@@ -1,5 +1,5 @@
 // The GLSL display encoder (display_encode.glsl, through test_encode.comp)
-// against the CPU reference encode_pixel(): every transfer kind, dither on and
+// against the CPU reference encode_pixel(): every display encoding, dither on and
 // off, 8 and 10 bits, the std430 and std140 layouts of DisplayParams. Inputs
 // are random relative RGB in [0, 1.2] with exact 0 and 1 and a few NaN,
 // negative and infinite values. The contract: >= 99.9 % of 8-bit codes
@@ -15,8 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "atonlab/display/display_encodings.h"
 #include "atonlab/display/display_model.h"
+#include "atonlab/display/fit_json.h"
 #include "atonlab/stimuli/gl/objects.h"
+#include "atonlab/stimuli/scene_file.h"
 #include "gl_test_support.h"
 
 namespace atonlab::test {
@@ -109,7 +112,7 @@ Agreement run_case(const gl::Program& prog, bool ubo, const DisplayModel& displa
     return a;
 }
 
-TEST_F(GpuEncode, MatchesTheCpuReferenceForEveryTransferKind) {
+TEST_F(GpuEncode, MatchesTheCpuReferenceForEveryEncoding) {
     const auto ssbo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}});
     const auto ubo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}}, {"PARAMS_IN_UBO"});
     const auto inputs = make_inputs();
@@ -153,6 +156,43 @@ TEST_F(GpuEncode, EveryOutOfGamutChoiceMatchesTheCpuReference) {
             EXPECT_LE(a.max_diff, 1) << name << " " << display.name;
         }
     }
+}
+
+// An encoding of one file outside the library (toy_display_encoding/toy_gamma.cpp, its
+// one registry line there): a scene file names it, the GPU encodes with the GLSL its file
+// gives as the CPU does, its codes are its law's, and its parameter goes through the fit JSON.
+TEST_F(GpuEncode, AnEncodingOfOneFileIsReadEncodedAndStoredAsTheLibrarysAre) {
+    const DisplayEncoding* toy = display_encoding_named("toy-gamma");
+    ASSERT_NE(toy, nullptr) << "the toy encoding's registry line did not run";
+    const stimuli::Scene scene = stimuli::parse_scene(
+        "[display]\nwidth_px = 64\nheight_px = 48\nwidth_m = 0.4\nviewing_distance_m = 0.6\n"
+        "peak_cd_m2 = 120\nblack_cd_m2 = 0.2\nencoding = \"toy-gamma\"\n",
+        "toy.toml");
+    const DisplayModel& display = scene.output.display;
+    ASSERT_EQ(display_encoding_of(display), toy);
+    EXPECT_EQ(display.name, "Toy");
+    // Its law, by hand: relative 0.25 over black is V = 0.25^(1/2) = 0.5, code 0.5 · 255 rounded = 128.
+    const double L = display.black_cd_m2 + 0.25 * (display.peak_cd_m2 - display.black_cd_m2);
+    const glm::ivec3 code =
+        encode_pixel(display, glm::dvec3(L / display.peak_cd_m2), {0, 0}, 0, EncodeSettings{8, Dither::none, 0});
+    EXPECT_EQ(code, glm::ivec3(128));
+    // The GPU, with the GLSL from the toy's file, against the CPU.
+    const auto ssbo = gl::Program::build({{gl::ShaderStage::compute, "test_encode.comp"}});
+    for (const Dither dither : {Dither::none, Dither::spatiotemporal}) {
+        const Agreement a = run_case(ssbo, false, display, EncodeSettings{10, dither, 77}, make_inputs());
+        EXPECT_GE(static_cast<double>(a.identical) / static_cast<double>(a.total), 0.999);
+        EXPECT_LE(a.max_diff, 1);
+    }
+    // Its parameter in the fit JSON, by its declared key, read back as it was; a bad one is refused by its check.
+    DisplayModel steeper = display;
+    for (auto& ch : steeper.channels) ch.parameter[0] = 2.4;
+    const std::string json = nominal_fit_json(steeper, EncodeSettings{});
+    EXPECT_NE(json.find(R"("encoding":"toy-gamma")"), std::string::npos) << json;
+    EXPECT_NE(json.find(R"("gamma":2.4)"), std::string::npos) << json;
+    const DisplayModel back = display_model_from_fit_json(json, "back");
+    for (const auto& ch : back.channels) EXPECT_EQ(ch.parameter[0], 2.4);
+    for (auto& ch : steeper.channels) ch.parameter[0] = -1.0;
+    EXPECT_THROW(steeper.validate(), InputError);
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ def test_a_custom_observer_answers_and_is_stored_as_its_own_kind(gl, tmp_path):
     assert v["codes"].shape == v["displayed_cd_m2"].shape + (3,) and v["codes"].dtype == np.uint16
     assert v["bits"] == 8 and v["codes"].max() > 0
     d = atonlab.Scene.load(str(TINY.parent / "small.scene.toml")).render().display
-    assert d["transfer"] == "srgb"
+    assert d["encoding"] == "srgb"
     share = rec709_luminance_shares()
     black, white = share * d["black_cd_m2"], share * d["peak_cd_m2"]
     decoded = (black + (white - black) * srgb_eotf(v["codes"] / 255.0)).sum(axis=2)

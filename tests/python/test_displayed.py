@@ -35,7 +35,12 @@ def rec709_luminance_shares():
 def test_display_as_numbers(gl):
     frame = atonlab.Scene.load(str(QUICKSTART_SCENE), {**SMALL, "display.peak_cd_m2": 250.0}).render()
     d = frame.display
-    assert d["peak_cd_m2"] == 250.0 and d["transfer"] == "srgb" and d["bits"] == 8 == frame.bits
+    assert d["peak_cd_m2"] == 250.0 and d["encoding"] == "srgb" and d["bits"] == 8 == frame.bits
+    # "transfer", the key's old name, still reads it, with a DeprecationWarning.
+    with pytest.warns(DeprecationWarning, match=r'Frame.display\["transfer"\] is deprecated'):
+        assert d["transfer"] == "srgb"
+    with pytest.warns(DeprecationWarning):
+        assert "transfer" in d and d.get("transfer") == "srgb"
     # Rec.709's channel shares of white and its primaries with D65.
     assert d["channel_white_cd_m2"] == pytest.approx(list(250 * rec709_luminance_shares()), rel=1e-9)
     assert d["primaries_xy"]["red"] == pytest.approx((0.64, 0.33), abs=1e-9)

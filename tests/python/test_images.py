@@ -40,7 +40,7 @@ def test_exr_round_trip(exr):
     {"operator": "perceptual", "adaptation_cd_m2": 0.03},
     {"operator": "reinhard", "reinhard_white": "max", "dither": False},
     {"operator": "linear", "white_cd_m2": 50.0, "blueshift": False, "hue_preservation": "rgb"},
-    {"display": "pq", "peak_cd_m2": 1000.0, "black_cd_m2": 0.05},
+    {"encoding": "pq", "peak_cd_m2": 1000.0, "black_cd_m2": 0.05},
 ])
 def test_tonemap_equals_the_command_line(exr, tmp_path, settings):
     codes = atonlab.tonemap(hdr_image(), **settings)
@@ -105,6 +105,22 @@ def test_light_equals_the_command_line():
     d = atonlab.light.range_nmi(250.0, visibility_nmi=7.0)
     assert d == pytest.approx(printed, rel=1e-5)  # printed with 6 digits
     assert atonlab.light.intensity_cd(d, visibility_nmi=7.0) == pytest.approx(250.0, rel=1e-9)
+
+
+def test_the_old_names_of_encoding_still_work_with_a_note(exr, tmp_path):
+    # tonemap(display=) and `--display`, the old names of encoding= and `--encoding`.
+    settings = {"peak_cd_m2": 1000.0, "black_cd_m2": 0.05}
+    expected = atonlab.tonemap(hdr_image(), encoding="pq", **settings)
+    with pytest.warns(DeprecationWarning, match="display=.* is deprecated; write encoding="):
+        assert np.array_equal(atonlab.tonemap(hdr_image(), display="pq", **settings), expected)
+    with pytest.raises(ValueError, match="give encoding= alone"):
+        atonlab.tonemap(hdr_image(), display="pq", encoding="pq")
+    png = tmp_path / "old.png"
+    r = cli("tonemap", exr, "-o", png, "--display", "pq", "--peak-cd-m2", "1000", "--black-cd-m2", "0.05")
+    assert "--display: note: --display is deprecated; write --encoding" in r.stderr
+    assert np.array_equal(read_png(png), expected)
+    r = cli("tonemap", exr, "-o", png, "--display", "pq", "--encoding", "pq", check=False)
+    assert r.returncode == 2 and "give --encoding alone" in r.stderr
 
 
 def test_light_against_allard():

@@ -427,16 +427,17 @@ TEST(AnalysisReport, NominalDisplayModelCurveIsTheSrgbCurve) {
     // The runner's nominal model: three sRGB channels sharing black 0.1 and white 100 cd/m2 by Rec.709 weights.
     const std::string fit =
         R"({"model":"nominal","peak_cd_m2":100,"black_cd_m2":0.1,"bits":8,"dither":true,"channels":[)"
-        R"({"transfer":"srgb","black_cd_m2":0.021264,"white_cd_m2":21.264},)"
-        R"({"transfer":"srgb","black_cd_m2":0.071517,"white_cd_m2":71.517},)"
-        R"({"transfer":"srgb","black_cd_m2":0.007219,"white_cd_m2":7.219}]})";
+        R"({"encoding":"srgb","black_cd_m2":0.021264,"white_cd_m2":21.264},)"
+        R"({"encoding":"srgb","black_cd_m2":0.071517,"white_cd_m2":71.517},)"
+        R"({"encoding":"srgb","black_cd_m2":0.007219,"white_cd_m2":7.219}]})";
     // IEC 61966-2-1: V = 0.5 decodes to ((0.5 + 0.055) / 1.055)^2.4 = 0.21404.
     const double expect = 0.1 + (100.0 - 0.1) * std::pow(0.555 / 1.055, 2.4);
     EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 0.5), expect, 1e-9);
     EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 0.0), 0.1, 1e-12);
     EXPECT_NEAR(*model_grey_luminance_cd_m2(fit, 1.0), 100.0, 1e-9);
     EXPECT_FALSE(model_grey_luminance_cd_m2(R"({"channels":[{"transfer":"lut"}]})", 0.5).has_value());
-    // A measured GOG model (docs/calibration.md "fit_json"): L = sum over channels of a + (b + k V)^gamma.
+    // A measured GOG model (docs/calibration.md "fit_json"), stored with the key's old name "transfer":
+    // L = sum over channels of a + (b + k V)^gamma.
     const std::string gog = R"({"model":"gog","display":{"peak_cd_m2":100,"black_cd_m2":0.1,"channels":[)"
                             R"({"channel":"red","transfer":"gog","a":0.03,"b":0.02,"k":2.9,"gamma":2.2},)"
                             R"({"channel":"green","transfer":"gog","a":0.05,"b":-0.01,"k":5.0,"gamma":2.4},)"

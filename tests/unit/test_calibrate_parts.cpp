@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "../store/store_test_support.h"
-#include "atonlab/protocols/protocol_file.h"
-#include "atonlab/display/calibration.h"
 #include "atonlab/common/input_error.h"
+#include "atonlab/display/calibration.h"
+#include "atonlab/protocols/protocol_file.h"
 #include "atonlab/stimuli/glare_stage.h"
 #include "atonlab/store/json.h"
 #include "atonlab/store/store.h"
@@ -244,7 +244,8 @@ std::vector<display::Measurement> synthetic_measurements(const display::DisplayM
 TEST(CalibrateRecord, FitJsonRoundTripsTheDisplayModel) {
     const auto report = display::fit_calibration(synthetic_measurements(power_display(2.3)));
     const auto model = display::display_from_calibration(report, "lab");
-    display::DisplayGeometry g{1920, 1080, 0.598, 0.9, 0.336};  // width, height px; width m; distance m; measured height m
+    display::DisplayGeometry g{1920, 1080, 0.598, 0.9,
+                               0.336};  // width, height px; width m; distance m; measured height m
     store::Calibration c;
     c.id = store::CalibrationId{3};
     c.display_name = "lab";
@@ -252,8 +253,8 @@ TEST(CalibrateRecord, FitJsonRoundTripsTheDisplayModel) {
     EXPECT_TRUE(is_measured(c));
     const display::DisplayModel back = display_model_of(c);
     for (int ch = 0; ch < 3; ++ch) {
-        const auto& a = model.channels[static_cast<std::size_t>(ch)].gog;
-        const auto& b = back.channels[static_cast<std::size_t>(ch)].gog;
+        const auto a = display::gog_params_of(model.channels[static_cast<std::size_t>(ch)]);
+        const auto b = display::gog_params_of(back.channels[static_cast<std::size_t>(ch)]);
         EXPECT_EQ(a.a, b.a);  // shortest round-trip decimal, read back by SQLite's JSON
         EXPECT_EQ(a.b, b.b);
         EXPECT_EQ(a.k, b.k);
@@ -394,7 +395,8 @@ TEST(CalibratePolicy, ProtocolDisplayNameAndMaximumAge) {
     EXPECT_EQ(named.display.name, "booth-2");
     EXPECT_EQ(named.display.max_calibration_age_days, 14.5);
     // Neither key becomes a scene override (the scene's [display] has no such keys).
-    for (const SceneOverride& o : named.display_overrides()) EXPECT_EQ(o.text().find("name"), std::string::npos) << o.text();
+    for (const SceneOverride& o : named.display_overrides())
+        EXPECT_EQ(o.text().find("name"), std::string::npos) << o.text();
     auto error_key = [&](const std::string& keys) {
         try {
             protocols::parse_protocol(with_keys(keys), "p.toml");
@@ -410,8 +412,9 @@ TEST(CalibratePolicy, ProtocolDisplayNameAndMaximumAge) {
     EXPECT_EQ(error_key("\n\nmax_calibration_age_days = \"30\"\n"), "display.max_calibration_age_days");
     // display.max_out_of_gamut_loss: R5's share (docs/running.md), 5 % unless given, 0 … 1.
     EXPECT_EQ(plain.display.max_out_of_gamut_loss, 0.05);
-    EXPECT_EQ(protocols::parse_protocol(with_keys("max_out_of_gamut_loss = 0.2\n"), "p.toml").display.max_out_of_gamut_loss,
-              0.2);
+    EXPECT_EQ(
+        protocols::parse_protocol(with_keys("max_out_of_gamut_loss = 0.2\n"), "p.toml").display.max_out_of_gamut_loss,
+        0.2);
     EXPECT_EQ(error_key("\n\nmax_out_of_gamut_loss = 1.5\n"), "display.max_out_of_gamut_loss");
 }
 

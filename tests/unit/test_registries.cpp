@@ -20,6 +20,7 @@
 #include "atonlab/common/scene_override.h"
 #include "atonlab/display/display_encodings.h"
 #include "atonlab/display/display_model.h"
+#include "atonlab/display/fit_json.h"
 #include "atonlab/protocols/procedures.h"
 #include "atonlab/stimuli/glare_models/glare_model.h"
 #include "atonlab/stimuli/image_glare.h"
@@ -70,10 +71,11 @@ std::vector<Registry> registries() {
     Registry encodings{"display encodings",
                        {},
                        {},
-                       {"display/include/atonlab/display/display_encodings.h", "display/src/display_encodings.cpp"}};
-    for (const display::DisplayEncoding& e : display::display_encodings())
+                       {"display/include/atonlab/display/display_encodings.h", "display/src/display_encodings.cpp",
+                        "display/src/encodings/"}};
+    for (const display::DisplayEncoding* e : display::display_encodings())
         // "gog" and "lut" are also the JSON fields holding those laws' parameters (fit_json): not scanned.
-        if (e.from_peak_black != nullptr) encodings.words.emplace_back(e.name);
+        if (e->from_peak_black != nullptr) encodings.words.emplace_back(e->name);
     out.push_back(encodings);
     return out;
 }
@@ -257,13 +259,11 @@ std::vector<HowToAdd> how_to_adds() {
     }
     out.push_back(glare);
     HowToAdd encoding{"How to add a display encoding", {}};
-    for (const display::DisplayEncoding& e : display::display_encodings()) {
-        const std::string name(e.name);  // TransferKind::pq, DisplayModel::pq, transfer_law::pq_luminance
-        encoding.entries.push_back(
-            {name,
-             name,
-             {name, name + "_luminance", name + "_drive", name + "_display", std::string(e.glsl_drive_function)},
-             {name}});
+    for (const display::DisplayEncoding* e : display::display_encodings()) {
+        // Its file defines display_encoding_pq(), which the list's line names. DisplayModel::pq
+        // and the other makers of the library's encodings are conveniences a new one needs not.
+        const std::string name(e->name);
+        encoding.entries.push_back({name, name, {"display_encoding_" + name}, {}});
     }
     out.push_back(encoding);
     HowToAdd procedure{"How to add a procedure", {}};
@@ -510,35 +510,44 @@ TEST(Registries, EveryImageGlareKernelConservesEnergy) {
 // Display encodings.
 
 TEST(Registries, DisplayEncodingsAreUniqueAndPairedWithTheirGlsl) {
-    const std::string glsl = read_text(fs::path(ATONLAB_SOURCE_DIR) / "stimuli/shaders/display_encode.glsl");
-    const std::string dispatch = display::display_encodings_glsl();
+    const std::string glsl = display::display_encodings_glsl();
     std::set<std::string_view> names, display_names, functions;
-    std::size_t i = 0;
-    for (const display::DisplayEncoding& e : display::display_encodings()) {
-        EXPECT_EQ(static_cast<std::size_t>(e.kind), i++) << e.name;
-        EXPECT_TRUE(names.insert(e.name).second) << e.name;
-        EXPECT_TRUE(display_names.insert(e.display_name).second) << e.display_name;
-        EXPECT_TRUE(functions.insert(e.glsl_drive_function).second) << e.glsl_drive_function;
-        EXPECT_EQ(display::display_encoding_named(e.name), &e);
-        EXPECT_NE(glsl.find("double " + std::string(e.glsl_drive_function) + "(DisplayChannel c, double L)"),
+    int i = 0;
+    for (const display::DisplayEncoding* e : display::display_encodings()) {
+        EXPECT_EQ(display::display_encoding_index(*e), i++) << e->name;
+        EXPECT_TRUE(names.insert(e->name).second) << e->name;
+        EXPECT_TRUE(display_names.insert(e->display_name).second) << e->display_name;
+        EXPECT_TRUE(functions.insert(e->glsl_drive_function).second) << e->glsl_drive_function;
+        EXPECT_EQ(display::display_encoding_named(e->name), e);
+        // Its GLSL defines the function it names, and the dispatch calls it for its kind.
+        EXPECT_NE(e->glsl.find("double " + std::string(e->glsl_drive_function) + "(DisplayChannel c, double L)"),
                   std::string::npos)
-            << e.name << ": display_encode.glsl has no " << e.glsl_drive_function;
-        EXPECT_NE(dispatch.find(std::string(e.glsl_drive_function) + "(c, L)"), std::string::npos) << e.name;
+            << e->name << ": its glsl defines no " << e->glsl_drive_function;
+        EXPECT_NE(glsl.find(fmt::format("{}(c, L);  // {}", e->glsl_drive_function, e->name)), std::string::npos)
+            << e->name;
+        EXPECT_LE(e->parameters.size(), display::kEncodingParameters) << e->name;
     }
     EXPECT_EQ(display::display_encoding_named("PQ"), nullptr);
+    EXPECT_THROW((void)display::display_encoding("hlg"), std::logic_error);
+    EXPECT_THROW(display::register_display_encoding(display::display_encoding("pq")), std::logic_error);
 }
 
 TEST(Registries, EveryNamedDisplayReadsBackFromASceneAndItsFitJson) {
-    for (const display::DisplayEncoding& e : display::display_encodings()) {
-        if (e.from_peak_black == nullptr) continue;
-        const std::string name(e.name);
+    for (const display::DisplayEncoding* e : display::display_encodings()) {
+        if (e->from_peak_black == nullptr) continue;
+        const std::string name(e->name);
         const Scene s =
-            parse_scene(kScene, "registry.toml", {atonlab::SceneOverride::parse("display.transfer=\"" + name + "\"")});
-        EXPECT_EQ(display::display_encoding_of(s.output.display), &e) << name;
-        EXPECT_EQ(s.output.display.name, e.display_name) << name;
-        const display::DisplayModel d = *display::display_from_transfer(name, 200.0, 0.1);
-        for (const display::ChannelTransfer& ch : d.channels) {
-            EXPECT_EQ(ch.kind, e.kind);
+            parse_scene(kScene, "registry.toml", {atonlab::SceneOverride::parse("display.encoding=\"" + name + "\"")});
+        EXPECT_EQ(display::display_encoding_of(s.output.display), e) << name;
+        EXPECT_EQ(s.output.display.name, e->display_name) << name;
+        const display::DisplayModel d = *display::display_from_encoding(name, 200.0, 0.1);
+        const display::DisplayModel back =
+            display::display_model_from_fit_json(display::nominal_fit_json(d, display::EncodeSettings{}), d.name);
+        for (std::size_t c = 0; c < 3; ++c) {
+            const display::ChannelEncoding& ch = d.channels[c];
+            EXPECT_EQ(ch.encoding, e);
+            EXPECT_EQ(back.channels[c].encoding, e);
+            EXPECT_EQ(back.channels[c].parameter, ch.parameter) << name;
             // The law and its inverse agree (the registry pairs them): L(V(L)) = L.
             const double L = 0.5 * (ch.min_cd_m2() + ch.max_cd_m2());
             EXPECT_NEAR(ch.luminance_cd_m2(ch.drive_for(L)), L, 1e-9 * ch.max_cd_m2()) << name;

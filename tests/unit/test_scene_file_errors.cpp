@@ -80,6 +80,27 @@ TEST(SceneFileErrors, UnknownSkySpectrumNamesTheKey) {
     EXPECT_THROW(parse_scene(kMinimal, "harbour.toml", sets({"environment.spd=\"led-purple\""})), InputError);
 }
 
+TEST(SceneFileErrors, TheDisplaysOldKeyTransferIsReadAsEncodingWithANote) {
+    const std::string old = std::string(kMinimal) + "peak_cd_m2 = 1000\ntransfer = \"pq\"\n";
+    testing::internal::CaptureStderr();
+    const Scene s = parse_scene(old, "harbour.toml");
+    const std::string said = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(s.output.display.name, "PQ");
+    EXPECT_EQ(s.output.display.peak_cd_m2, 1000.0);
+    // The note is said once per process: here, or by an earlier test in the same process.
+    if (!said.empty()) {
+        EXPECT_EQ(said, "harbour.toml:" + std::to_string(line_of(old, "transfer")) +
+                            ": note: [display] transfer is deprecated; write encoding\n");
+    }
+    EXPECT_EQ(atonlab::note_deprecated({}, "[display] transfer", "encoding"), "") << "the scene reader said no note";
+    // The new key, and the two together.
+    EXPECT_EQ(parse_scene(std::string(kMinimal) + "encoding = \"pq\"\n", "harbour.toml").output.display.name, "PQ");
+    const std::string both = std::string(kMinimal) + "encoding = \"pq\"\ntransfer = \"pq\"\n";
+    expect_error_at(both, line_of(both, "transfer"), "display.transfer", "give encoding alone");
+    const std::string unknown = std::string(kMinimal) + "encoding = \"hlg\"\n";
+    expect_error_at(unknown, line_of(unknown, "encoding"), "display.encoding", "unknown encoding \"hlg\"");
+}
+
 TEST(SceneFileErrors, NegativeNaNAndInfiniteValues) {
     const std::string neg = with_light("name = \"buoy\"\nposition_m = [0, 2, -100]\nintensity_cd = -5\n");
     expect_error_at(neg, line_of(neg, "intensity_cd"), "light[0].intensity_cd",

@@ -13,8 +13,8 @@ bool is_measured(const store::Calibration& c) {
     if (display::fit_json_model(c.fit_json).value_or("") != "gog") return false;
     try {
         const display::DisplayModel m = display::display_model_from_fit_json(c.fit_json, c.display_name);
-        for (const display::ChannelTransfer& ch : m.channels)
-            if (ch.kind != display::TransferKind::gog) return false;
+        for (const display::ChannelEncoding& ch : m.channels)
+            if (!ch.follows("gog")) return false;
         return true;
     } catch (const InputError&) {
         return false;

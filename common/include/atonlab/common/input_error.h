@@ -14,11 +14,11 @@ namespace atonlab {
 /// ("light[2].intensity_cd"), or a command-line option (`option`: "--set" with
 /// the key "camera.yaw_deg", or "--display-width-px").
 struct SourceLocation {
-    std::string file;    ///< file path; empty for a command-line value
-    int line = 0;        ///< 1-based; 0 when unknown
-    int column = 0;      ///< 1-based; 0 when unknown
-    std::string key;     ///< dotted key path; empty when the error is about the whole file or option
-    std::string option = {};  ///< the command-line option that gave the value ("--set"); empty for a file
+    std::string file;            ///< file path; empty for a command-line value
+    int line = 0;                ///< 1-based; 0 when unknown
+    int column = 0;              ///< 1-based; 0 when unknown
+    std::string key;             ///< dotted key path; empty when the error is about the whole file or option
+    std::string option = {};     ///< the command-line option that gave the value ("--set"); empty for a file
     bool key_is_column = false;  ///< `key` names a CSV file's column: what() says "column 'NAME'"
 
     /// A value given on the command line by `option` (and, for --set, its key).
@@ -59,5 +59,11 @@ private:
     std::optional<SourceLocation> where_;
     std::string message_;
 };
+
+/// A spelling that still works but is deprecated: writes one line to stderr, once
+/// per process for each old spelling, "WHERE: note: OLD is deprecated; write NEW"
+/// (WHERE as InputError gives it). Returns the line, empty when already said.
+std::string note_deprecated(const SourceLocation& where, const std::string& old_spelling,
+                            const std::string& new_spelling);
 
 }  // namespace atonlab

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "atonlab/common/input_error.h"
@@ -19,13 +20,12 @@
 
 namespace atonlab::display {
 
-/// How one channel turns a drive level V in [0, 1] into luminance (cd/m²).
-enum class TransferKind {
-    srgb,  ///< IEC 61966-2-1 decoding, scaled between the channel's black and white
-    gog,   ///< gain-offset-gamma with black offset (Berns 1996): L = a + (b + k V)^gamma
-    lut,   ///< measured (V, L) pairs, monotone cubic (Fritsch–Carlson PCHIP) interpolation
-    pq,    ///< SMPTE ST 2084 EOTF (absolute), clipped to the display's black and peak
-};
+struct DisplayEncoding;  // display_encodings.h: a law a channel follows, and its parameters
+/// sRGB's encoding (display/src/encodings/srgb.cpp), a channel's unless set.
+const DisplayEncoding& display_encoding_srgb();
+
+/// The most parameters an encoding has of its own (ChannelEncoding::parameter).
+inline constexpr std::size_t kEncodingParameters = 6;
 
 /// GOG with black offset: L(V) = a + (b + k·V)^gamma where b + k·V > 0, else a.
 /// a is in cd/m²; b and k are in (cd/m²)^(1/gamma), so (b + k)^gamma is the
@@ -37,25 +37,32 @@ struct GogParams {
     double gamma = 2.2;
 };
 
+struct ChannelEncoding;
+/// A gog channel's parameters (ChannelEncoding::parameter, in this order).
+GogParams gog_params_of(const ChannelEncoding& channel);
+
 /// One measured point of a LUT channel.
 struct LutPoint {
     double drive;  ///< V in [0, 1]
     double cd_m2;  ///< the channel's luminance at that drive
 };
 
-/// The transfer function of one channel (red, green or blue). A channel is
+/// How one channel (red, green or blue) turns a drive level V in [0, 1] into
+/// luminance (cd/m²): its encoding (the law) and the law's parameters. A channel is
 /// self-contained: it knows its own black and white luminance.
-struct ChannelTransfer {
-    TransferKind kind = TransferKind::srgb;
-    /// srgb, pq: the channel's luminance at V = 0 (its share of the display's black), cd/m².
+struct ChannelEncoding {
+    const DisplayEncoding* encoding = &display_encoding_srgb();
+    /// The laws a black and a white define (srgb, pq): the channel's luminance at V = 0
+    /// (its share of the display's black), cd/m².
     double black_cd_m2 = 0.0;
-    /// srgb, pq: the channel's luminance at V = 1 (its share of the display's peak), cd/m².
+    /// ...and at V = 1 (its share of the display's peak), cd/m².
     double white_cd_m2 = 0.0;
-    /// pq: the channel's share of an achromatic stimulus (its Rec.709 weight):
-    /// L(V) = clamp(weight · EOTF(V), black, white).
-    double pq_weight = 0.0;
-    GogParams gog;              ///< gog only
-    std::vector<LutPoint> lut;  ///< lut only: drive strictly increasing from 0 to 1, cd/m² non-decreasing
+    /// The encoding's own parameters, in the order its declaration lists them
+    /// (DisplayEncoding::parameters): gog's a, b, k, gamma (GogParams); pq's weight,
+    /// the channel's share of an achromatic stimulus: L(V) = clamp(weight · EOTF(V), black, white).
+    std::array<double, kEncodingParameters> parameter{};
+    std::vector<LutPoint>
+        lut;  ///< the knots of a law that has them (lut): drive strictly increasing from 0 to 1, cd/m² non-decreasing
 
     /// L(V) in cd/m². V is clamped to [0, 1]; NaN is taken as 0.
     double luminance_cd_m2(double drive) const;
@@ -65,6 +72,8 @@ struct ChannelTransfer {
     double drive_for(double L_cd_m2) const;
     double min_cd_m2() const;  ///< L(0)
     double max_cd_m2() const;  ///< L(1)
+    /// Whether the channel follows the encoding of that name.
+    bool follows(std::string_view encoding_name) const;
 };
 
 /// A display: per-channel transfer functions and the whole-screen peak and
@@ -74,7 +83,7 @@ struct DisplayModel {
     std::string name = "sRGB";
     double peak_cd_m2 = 100.0;  ///< luminance of full white (all channels at V = 1), cd/m²
     double black_cd_m2 = 0.0;   ///< luminance of black (all channels at V = 0), cd/m²
-    std::array<ChannelTransfer, 3> channels;
+    std::array<ChannelEncoding, 3> channels;
 
     /// An sRGB display: each channel follows IEC 61966-2-1 scaled between its
     /// Rec.709 share (0.2126 / 0.7152 / 0.0722) of black and of peak.
@@ -83,10 +92,13 @@ struct DisplayModel {
     /// code means the same cd/m² on every PQ display, clipped to this one's black
     /// and peak (peak <= 10000 cd/m²).
     static DisplayModel pq(double peak_cd_m2, double black_cd_m2 = 0.0, std::string name = "PQ");
-    /// A GOG display; peak and black are the sums of the channels' L(1) and L(0).
+    /// A GOG display (encodings/gog.cpp); peak and black are the sums of the channels' L(1) and L(0).
     static DisplayModel gog(const std::array<GogParams, 3>& channels, std::string name = "GOG");
     /// A measured-LUT display; peak and black are the sums of the channels' L(1) and L(0).
     static DisplayModel lut(const std::array<std::vector<LutPoint>, 3>& channels, std::string name = "LUT");
+
+    /// Sets peak and black to the sums of the channels' L(1) and L(0) (a fitted display's).
+    void sum_channels();
 
     /// Throws InputError for a display that cannot be encoded for: peak not
     /// positive, black negative or not below peak, a LUT that is not strictly
@@ -162,13 +174,12 @@ double displayed_luminance_cd_m2(const DisplayModel& display, glm::ivec3 code, i
 // holds the CPU model's own PCHIP slopes); stimuli's display pipeline uploads them.
 
 struct GpuDisplayChannel {
-    double black_cd_m2;  ///< L(0), as min_cd_m2()
-    double white_cd_m2;  ///< L(1), as max_cd_m2()
-    double pq_weight;
-    double a, b, k, gamma, inv_gamma;  ///< GOG; inv_gamma = 1 / gamma computed once here
-    std::int32_t kind;                 ///< TransferKind as an int
-    std::int32_t lut_first;            ///< lut: index of this channel's first knot in the LUT buffer
-    std::int32_t lut_count;            ///< lut: number of knots
+    double black_cd_m2;   ///< L(0), as min_cd_m2()
+    double white_cd_m2;   ///< L(1), as max_cd_m2()
+    double parameter[6];  ///< p0 … p5: the encoding's parameters as it packs them (DisplayEncoding::gpu_parameters)
+    std::int32_t kind;    ///< the encoding's place in display_encodings() (display_encoding_index)
+    std::int32_t lut_first;  ///< index of this channel's first knot in the knots buffer (gpu_display_lut)
+    std::int32_t lut_count;  ///< number of knots
     std::int32_t pad;
 };
 static_assert(sizeof(GpuDisplayChannel) == 80);
@@ -184,10 +195,11 @@ static_assert(sizeof(GpuDisplayParams) == 256);
 
 /// The encoder's parameters for the GPU (validates the display and the bits).
 GpuDisplayParams gpu_display_params(const DisplayModel& display, const EncodeSettings& settings);
-/// The LUT knots of all lut channels, for the SSBO at DISPLAY_LUT_BINDING:
-/// per knot three doubles (drive, cd/m², PCHIP slope dL/dV), channels in order,
-/// indexed by GpuDisplayChannel::lut_first. Never empty (one dummy knot when no
-/// channel is a LUT) so that a buffer can always be bound.
+/// The knots of all channels whose encoding has them, for the SSBO at
+/// DISPLAY_LUT_BINDING: three doubles per knot as the encoding packs them (lut:
+/// drive, cd/m², PCHIP slope dL/dV), channels in order, indexed by
+/// GpuDisplayChannel::lut_first. Never empty (one dummy knot when no channel has
+/// knots) so that a buffer can always be bound.
 std::vector<double> gpu_display_lut(const DisplayModel& display);
 
 }  // namespace atonlab::display

@@ -4,8 +4,9 @@
 // GOG fits and, under "display", the DisplayModel sessions encode for; the
 // nominal row `atonlab run` records for an uncalibrated display keeps the scene's
 // DisplayModel at the top level. Both write the display model the same way:
-// peak_cd_m2, black_cd_m2 and per channel its transfer, black and white (cd/m²)
-// and the transfer's parameters (GOG a, b, k, gamma; PQ weight; LUT points).
+// peak_cd_m2, black_cd_m2 and per channel its encoding, black and white (cd/m²)
+// and the encoding's parameters and knots as it declares them (GOG a, b, k, gamma; PQ
+// pq_weight; LUT lut). A channel's "transfer" (the key's old name) is read as "encoding".
 #include <optional>
 #include <string>
 #include <string_view>
@@ -35,7 +36,7 @@ std::optional<std::string> fit_json_model(std::string_view fit_json);
 /// The display model in fit_json (under "display" when that object has
 /// channels, else at the top level), named `name`, not validated. Throws
 /// InputError (key "fit_json") whose message names what is missing, e.g. "has
-/// no number display.channels[1].gamma", or an unknown transfer.
+/// no number display.channels[1].gamma", or an unknown encoding.
 DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string name);
 
 }  // namespace atonlab::display

@@ -27,7 +27,9 @@ struct TonemapOptions {
     std::optional<double> adaptation_cd_m2;  ///< default: the log-average (K2012 eq 4.15)
     std::optional<double> epsilon_cd_m2;     ///< ε of eq 4.15
     std::optional<std::string> tone_operator;
-    std::optional<std::string> display;  ///< srgb or pq
+    std::optional<std::string> encoding;  ///< the display's encoding: srgb or pq (display_encodings.h)
+    /// `--display`, the old name of `--encoding`: still taken, with a note.
+    std::optional<std::string> deprecated_display;
     std::optional<double> peak_cd_m2;
     std::optional<double> black_cd_m2;
     std::optional<std::string> dither;     ///< on or off
