@@ -1,11 +1,12 @@
 // The glare stage on the GPU: the PSF pipeline against its double-precision
 // CPU references, and the billboards against docs/architecture.md's "Physical invariants" (glare
-// redistributes a light's energy; it neither creates nor loses it).
+// redistributes a light's energy; it neither creates nor loses it). A model's
+// own frames: tests/gl/glare_models/NAME.cpp, in the same GlareFrames suite
+// (tests/support/glare_frames.h).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <numbers>
 #include <optional>
 
@@ -16,7 +17,7 @@
 #include "atonlab/stimuli/profile.h"
 #include "atonlab/stimuli/psf_generator.h"
 #include "gl_test_support.h"
-#include "input_error.h"
+#include "glare_frames.h"
 
 namespace atonlab::test {
 namespace {
@@ -31,17 +32,6 @@ double relative_l2(const std::vector<double>& a, const std::vector<double>& b) {
         den += b[i] * b[i];
     }
     return std::sqrt(num / den);
-}
-
-// An eye with obstacles but no gratings (those need N ≥ 512 to be resolved), so
-// small sizes exercise every part of the pupil plane quickly.
-EyeModel small_eye() {
-    EyeModel e;
-    e.pupil_diameter_mm = 6.0;
-    e.gratings.enabled = false;
-    e.halo_radius_deg.reset();
-    e.defocus_diopters = 0.5;
-    return e;
 }
 
 using GlarePsf = GLTest;
@@ -93,38 +83,6 @@ TEST_F(GlarePsf, DefaultEyeAtN512MatchesCpuAndIsBitIdenticalForASeed) {
 
 // ---------------------------------------------------------------------------
 // Billboards in frames.
-
-// 320×240 px at f = 2880 px (about 50 px per degree), black.
-Scene black_scene(GlareModel model) {
-    Scene s;
-    s.display = {320, 240, 0.1, 0.9};
-    s.camera.position_m = {0, 0, 0};
-    s.environment.background = Background::uniform;
-    s.environment.luminance_cd_m2 = 0.0;
-    s.glare.model = model;
-    s.glare.eye = small_eye();
-    s.glare.psf_size = 256;
-    s.glare.pupil_mm = 6.0;
-    s.glare.values["bloom_sigma_deg"] = 0.2;
-    s.glare.radius_deg = 1.0;
-    return s;
-}
-
-Light light_at(glm::dvec3 p, double intensity_cd = 100.0, double radius_m = 0.1) {
-    Light L;
-    L.position_m = p;
-    L.intensity_cd = intensity_cd;
-    L.radius_m = radius_m;
-    return L;
-}
-
-class GlareFrames : public RendererTest {
-protected:
-    double energy(const Scene& scene) {
-        renderer->render(scene, 0.0);
-        return image_illuminance_lux(renderer->read_hdr(), renderer->projection().focal_px);
-    }
-};
 
 TEST_F(GlareFrames, EveryModelPutsTheLightsIlluminanceIntoTheFrame) {
     for (GlareModel model : {GlareModel::wave_optics, GlareModel::gaussian_bloom, GlareModel::spencer}) {
@@ -348,55 +306,6 @@ TEST_F(GlareFrames, CieVeilOfOneLightIsTheCieGlareSpreadFunctionAndKeepsItsEnerg
     EXPECT_LT(v.outside_frame.g, 0.5);
 }
 
-TEST_F(GlareFrames, FocusedEyePeaksAtTheLightAndBothEyesKeepItsEnergy) {
-    // One 100 cd light at 1 km, the 6.89 mm pupil of 0.001 cd/m² (eq 3.15).
-    // The default two-scale eye draws its core where the light is: the
-    // frame's brightest pixel is the light's own (the no-glare frame's). The
-    // k2012 preset's core, two waves out of focus (0.2 D) and stretched with
-    // the halo (blur radius 6.89 mm · 0.2 D / 2 × 10.2 = 0.40°, ~20 px), is a
-    // ring around a dark centre (at an odd number of half waves, 6 mm, the
-    // centre would be bright again). Both frames hold the light's illuminance
-    // within 1% (the window's cut is renormalised).
-    Scene scene = black_scene(GlareModel::none);
-    scene.glare.pupil_mm = pupil_diameter_mm_from_adaptation(0.001);
-    scene.lights = {light_at(glm::dvec3(0.013, -0.007, -1.0) * 1000.0)};
-    const double direct = energy(scene);
-    const ImageRGBA32F no_glare = renderer->read_hdr();
-    auto brightest = [](const ImageRGBA32F& img) {
-        std::pair<int, int> best{0, 0};
-        float v = -1;
-        for (int y = 0; y < img.height; ++y)
-            for (int x = 0; x < img.width; ++x)
-                if (img.pixel(x, y)[1] > v) {
-                    v = img.pixel(x, y)[1];
-                    best = {x, y};
-                }
-        return best;
-    };
-    const auto light_pixel = brightest(no_glare);
-    scene.glare.model = GlareModel::wave_optics;
-    for (const EyeModel& eye : {EyeModel{}, EyeModel::k2012()}) {
-        scene.glare.eye = eye;
-        // The preset draws with the thesis's spectral method (scene_file.cpp, eye_preset).
-        scene.glare.spectral_path = eye.scale == EyeScale::two_scales ? SpectralPath::anchored : SpectralPath::rescaled;
-        const double with_glare = energy(scene);
-        const ImageRGBA32F img = renderer->read_hdr();
-        const auto peak = brightest(img);
-        const float centre = img.pixel(light_pixel.first, light_pixel.second)[1];
-        const float top = img.pixel(peak.first, peak.second)[1];
-        const bool focused = eye.scale == EyeScale::two_scales;
-        std::printf("%s eye: energy ratio %.5f, brightest pixel (%d, %d), light's pixel (%d, %d), centre / max %.3f\n",
-                    focused ? "focused" : "k2012", with_glare / direct, peak.first, peak.second, light_pixel.first,
-                    light_pixel.second, centre / top);
-        EXPECT_NEAR(with_glare / direct, 1.0, 0.01);
-        if (focused) {
-            EXPECT_EQ(peak, light_pixel);
-        } else {
-            EXPECT_LT(centre / top, 0.5);
-        }
-    }
-}
-
 TEST_F(GlareFrames, HiddenLightsEmitNothing) {
     Scene scene = black_scene(GlareModel::wave_optics);
     scene.camera.position_m = {0, 3, 0};
@@ -435,35 +344,6 @@ TEST_F(GlareFrames, GlareOfALightJustOffTheImageReachesIn) {
     EXPECT_LT(got, 0.6 * e);
     scene.glare.model = GlareModel::none;
     EXPECT_EQ(energy(scene), 0.0);
-}
-
-TEST_F(GlareFrames, ApertureImageGivesItsDiffractionPattern) {
-    // A hand-made obstacle: a clear disc crossed by one opaque bar, as a PNG.
-    const int w = 64;
-    std::vector<float> rgb(static_cast<std::size_t>(w) * w * 3, 0.0f);
-    for (int y = 0; y < w; ++y)
-        for (int x = 0; x < w; ++x) {
-            const bool open = std::hypot(x - 31.5, y - 31.5) < 12.0 && std::abs(y - 31.5) > 2.0;
-            for (int c = 0; c < 3; ++c) rgb[(static_cast<std::size_t>(y) * w + x) * 3 + c] = open ? 1.0f : 0.0f;
-        }
-    const auto dir = std::filesystem::temp_directory_path() / "atonlab_glare_test";
-    std::filesystem::create_directories(dir);
-    write_png_rgb8(dir / "bar.png", w, w, rgb);
-    Scene scene = black_scene(GlareModel::aperture);
-    scene.glare.values["aperture_image"] = (dir / "bar.png").string();
-    scene.lights = {light_at({0.0, 0.0, -500.0})};
-    EXPECT_NEAR(energy(scene) / (100.0 / 250000.0), 1.0, 0.01);
-    ASSERT_NE(renderer->glare().psf(0), nullptr);
-    // The bar (horizontal in the image) diffracts into a vertical streak: more energy along y than along x.
-    const RgbPsf& p = *renderer->glare().psf(0);
-    double along_x = 0, along_y = 0;
-    for (int k = 10; k < 60; ++k) {
-        along_x += p.at(p.n / 2 + k, p.n / 2).g;
-        along_y += p.at(p.n / 2, p.n / 2 + k).g;
-    }
-    EXPECT_GT(along_y, 2 * along_x);
-    scene.glare.values["aperture_image"] = (dir / "missing.png").string();
-    EXPECT_NE(input_error_of([&] { renderer->render(scene, 0.0); }).find("aperture_image"), std::string::npos);
 }
 
 }  // namespace

@@ -1,17 +1,31 @@
-// The two-scale eye (docs/glare.md) against what optics says without it: a
+// The `wave-optics` glare model (stimuli/src/glare_models/wave_optics/): the
+// eye's PSF by FFT of its pupil plane, over the light's spectrum.
+// Its two-scale eye (docs/glare.md) against what optics says without it: a
 // focused eye's PSF peaks at its centre at every pupil, its core is the
 // aperture's Airy pattern at the physical scale, a large defocus gives the
 // geometric blur disc p·ΔD/2, the obstacles take from the core what they
 // block, and the lenticular halo sits at its configured radius with red
 // outside blue (Simpson 1953). The k2012 preset keeps the thesis's ringed core.
+// Its anchored spectral path (spectral_path.h, the `spectral_path` key) against
+// the exact per-wavelength reference (spectral_psf_exact, FFTW double at every
+// sample): the default eye (its Fresnel term E changes the pattern with λ) and a
+// clear pupil (only the resampling), at a reduced N.
+// Elsewhere: the eye model's parts (pupil plane, geometry, hippus, validate) in
+// tests/unit/test_eye_model.cpp, the PSF's shared CPU references and kernels in
+// test_psf.cpp, the model on the GPU and in frames in tests/gl/glare_models/wave_optics.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 #include <vector>
 
+#include "atonlab/display/colour.h"
 #include "atonlab/stimuli/psf.h"
+#include "atonlab/stimuli/spectral_path.h"
+#include "input_error.h"
 
 namespace atonlab::test {
 namespace {
@@ -20,6 +34,8 @@ using namespace atonlab::stimuli;
 using namespace atonlab::display;
 
 constexpr double kPi = std::numbers::pi;
+constexpr int kN = 256;       // the spectral paths' reduced size
+constexpr int kSamples = 30;  // GlareSettings::spectral_samples
 
 // Index of the largest texel.
 std::size_t argmax(const std::vector<double>& v) {
@@ -216,6 +232,43 @@ TEST(EyePsf, K2012PresetKeepsTheThesisRingedCore) {
     fftw_forward(field);
     const MonoPsf single = mono_psf_from_spectrum(field, psf_degrees_per_texel(eye), kReferenceWavelengthNm);
     EXPECT_EQ(single.value, psf.value);
+}
+
+// ---- The spectral paths ---------------------------------------------------------------
+
+TEST(SpectralPath, AnchorsSitWhereTheLightIs) {
+    const SpectralSamples s = spectral_samples(d65_spectrum(), kSamples);
+    const std::vector<double> a = spectral_anchor_wavelengths(s, 6);
+    ASSERT_EQ(a.size(), 6u);
+    EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
+    // D65 × CMFs: the 1% and 99% quantiles lie inside the visible band's tails.
+    EXPECT_GT(a.front(), 400.0);
+    EXPECT_LT(a.back(), 700.0);
+    // A narrow red LED spectrum pulls them all into the red.
+    const std::vector<double> red =
+        spectral_anchor_wavelengths(spectral_samples(*named_spectrum("led-red"), kSamples), 4);
+    for (double l : red) EXPECT_GT(l, 580.0);
+    EXPECT_NE(input_error_of([&] { spectral_anchor_wavelengths(s, 0); }).find("spectral_anchors"), std::string::npos);
+}
+
+TEST(SpectralPath, DefaultEyeAndClearPupilWithinOnePercentOfTheExactPath) {
+    const SpectralSamples samples = spectral_samples(d65_spectrum(), kSamples);
+    EyeModel current;  // the default eye (focused, two scales), night pupil (as bench/ measures it)
+    current.pupil_diameter_mm = 6.0;
+    EyeModel k2012 = EyeModel::k2012();  // the thesis's single scale with its defocus
+    k2012.pupil_diameter_mm = 6.0;
+    const EyeModel clear = EyeModel::clear_pupil(6.0);
+    for (const auto& [name, eye] :
+         {std::pair{"default", current}, std::pair{"k2012", k2012}, std::pair{"clear pupil", clear}}) {
+        const RgbPsf exact = spectral_psf_exact(eye, kN, samples);
+        const RgbPsf anchored = spectral_psf_anchored(eye, kN, samples, 6);
+        const RgbPsf rescaled = spectral_psf_resampled(mono_psf_reference(eye, kN, kReferenceWavelengthNm), samples);
+        const double e_anchored = relative_l2(anchored, exact), e_rescaled = relative_l2(rescaled, exact);
+        std::printf("%-12s N=%d: anchored (6) %.4f, eq 4.9 rescaled %.4f relative L2 vs exact\n", name, kN, e_anchored,
+                    e_rescaled);
+        EXPECT_LT(e_anchored, 1e-2) << name;
+        EXPECT_NEAR(anchored.luminance_sum(), 1.0, 1e-12);
+    }
 }
 
 }  // namespace

@@ -1,13 +1,17 @@
-// The anchored spectral path on the GPU (GpuPsfGenerator::generate_anchored,
+// The `wave-optics` glare model on the GPU (stimuli/src/glare_models/wave_optics/).
+// Its anchored spectral path (GpuPsfGenerator::generate_anchored,
 // psf_anchored.comp) held to the CPU's spectral_psf_anchored (anchors in
 // double by FFTW, samples summed in fp32) on this GL driver (issue 27 item 1:
-// relative L2 ≤ 1e-5), with the GPU's fp32 FFT forced even on llvmpipe.
+// relative L2 ≤ 1e-5), with the GPU's fp32 FFT forced even on llvmpipe; and
+// its eyes in a frame: the focused eye's core on the light, the k2012 preset's
+// ring, the light's energy kept. Without GL: tests/unit/glare_models/wave_optics.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <future>
 #include <stdexcept>
+#include <utility>
 
 #include "atonlab/display/colour.h"
 #include "atonlab/stimuli/frame_renderer.h"
@@ -16,6 +20,7 @@
 #include "atonlab/stimuli/psf_generator.h"
 #include "atonlab/stimuli/spectral_path.h"
 #include "gl_test_support.h"
+#include "glare_frames.h"
 
 namespace atonlab::test {
 namespace {
@@ -171,6 +176,57 @@ TEST_F(PsfAnchoredGpu, PupilPlanesDrawnAheadOnAWorkerGiveTheSameKernelBitForBit)
     // On the CPU placement there is nothing to do ahead: its build keeps the cores busy in the frame.
     s.glare.placement = ComputePlacement::cpu;
     EXPECT_FALSE(type.work_ahead({s.glare, s, samples, 20.0, 5.35, 1.5, gpu}));
+}
+
+// ---- In a frame ----------------------------------------------------------------------
+
+TEST_F(GlareFrames, FocusedEyePeaksAtTheLightAndBothEyesKeepItsEnergy) {
+    // One 100 cd light at 1 km, the 6.89 mm pupil of 0.001 cd/m² (eq 3.15).
+    // The default two-scale eye draws its core where the light is: the
+    // frame's brightest pixel is the light's own (the no-glare frame's). The
+    // k2012 preset's core, two waves out of focus (0.2 D) and stretched with
+    // the halo (blur radius 6.89 mm · 0.2 D / 2 × 10.2 = 0.40°, ~20 px), is a
+    // ring around a dark centre (at an odd number of half waves, 6 mm, the
+    // centre would be bright again). Both frames hold the light's illuminance
+    // within 1% (the window's cut is renormalised).
+    Scene scene = black_scene(GlareModel::none);
+    scene.glare.pupil_mm = pupil_diameter_mm_from_adaptation(0.001);
+    scene.lights = {light_at(glm::dvec3(0.013, -0.007, -1.0) * 1000.0)};
+    const double direct = energy(scene);
+    const ImageRGBA32F no_glare = renderer->read_hdr();
+    auto brightest = [](const ImageRGBA32F& img) {
+        std::pair<int, int> best{0, 0};
+        float v = -1;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x)
+                if (img.pixel(x, y)[1] > v) {
+                    v = img.pixel(x, y)[1];
+                    best = {x, y};
+                }
+        return best;
+    };
+    const auto light_pixel = brightest(no_glare);
+    scene.glare.model = GlareModel::wave_optics;
+    for (const EyeModel& eye : {EyeModel{}, EyeModel::k2012()}) {
+        scene.glare.eye = eye;
+        // The preset draws with the thesis's spectral method (scene_file.cpp, eye_preset).
+        scene.glare.spectral_path = eye.scale == EyeScale::two_scales ? SpectralPath::anchored : SpectralPath::rescaled;
+        const double with_glare = energy(scene);
+        const ImageRGBA32F img = renderer->read_hdr();
+        const auto peak = brightest(img);
+        const float centre = img.pixel(light_pixel.first, light_pixel.second)[1];
+        const float top = img.pixel(peak.first, peak.second)[1];
+        const bool focused = eye.scale == EyeScale::two_scales;
+        std::printf("%s eye: energy ratio %.5f, brightest pixel (%d, %d), light's pixel (%d, %d), centre / max %.3f\n",
+                    focused ? "focused" : "k2012", with_glare / direct, peak.first, peak.second, light_pixel.first,
+                    light_pixel.second, centre / top);
+        EXPECT_NEAR(with_glare / direct, 1.0, 0.01);
+        if (focused) {
+            EXPECT_EQ(peak, light_pixel);
+        } else {
+            EXPECT_LT(centre / top, 0.5);
+        }
+    }
 }
 
 }  // namespace
