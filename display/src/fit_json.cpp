@@ -167,4 +167,24 @@ DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string 
     return model;
 }
 
+bool same_fit_json(std::string_view a, std::string_view b) {
+    if (a == b) return true;
+    // Unordered objects (nlohmann::json): key order does not count. Each channel's old key renamed.
+    auto normal = [](std::string_view text) {
+        nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+        if (!j.is_object()) return j;
+        for (nlohmann::json* root : {&j, j.contains("display") ? &j["display"] : nullptr}) {
+            if (root == nullptr || !root->is_object() || !root->contains("channels")) continue;
+            for (nlohmann::json& ch : (*root)["channels"])
+                if (ch.is_object() && ch.contains("transfer") && !ch.contains("encoding")) {
+                    ch["encoding"] = ch["transfer"];
+                    ch.erase("transfer");
+                }
+        }
+        return j;
+    };
+    const nlohmann::json x = normal(a), y = normal(b);
+    return !x.is_discarded() && x == y;
+}
+
 }  // namespace atonlab::display

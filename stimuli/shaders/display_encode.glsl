@@ -6,7 +6,7 @@
 // - Channels whose encoding has knots (lut: drive, cd/m², slope; doubles) read them from the SSBO at
 //   DISPLAY_LUT_BINDING (default 7; #define it before the #include to move it),
 //   filled with gpu_display_lut(). Shaders that never meet a LUT display may leave it unbound.
-// - The inverse transfer functions run in double precision. GLSL has no double
+// - The encodings' inverse laws run in double precision. GLSL has no double
 //   exp/log/pow, so display_log/display_exp below implement them (frexp/ldexp range
 //   reduction and series good to ~1e-16); the dither is integer hashing only. The
 //   CPU and the GPU therefore agree on every code value but for a rounding tie.

@@ -93,6 +93,11 @@ TEST(FitJson, ACalibrationStoredWithTheOldKeyTransferReadsAsWithEncoding) {
         text.replace(at, 11, R"("transfer":)");
     ASSERT_EQ(text.find("encoding"), std::string::npos) << text;
     expect_same_model(m, display_model_from_fit_json(text, m.name));
+    // The session's nominal row: an old row is the same display as the one written now (no new row).
+    EXPECT_TRUE(same_fit_json(text, nominal_fit_json(m, EncodeSettings{})));
+    EXPECT_FALSE(same_fit_json(text, nominal_fit_json(DisplayModel::srgb(100.0, 0.2), EncodeSettings{})));
+    EXPECT_FALSE(same_fit_json(text, nominal_fit_json(m, EncodeSettings{10, Dither::spatiotemporal, 0})));
+    EXPECT_FALSE(same_fit_json("not json", "not json "));
     const std::string gog = R"({"peak_cd_m2":101,"black_cd_m2":0.3,"channels":[)"
                             R"({"transfer":"gog","a":0.1,"b":0.5,"k":2,"gamma":2},)"
                             R"({"transfer":"gog","a":0.1,"b":0.5,"k":8,"gamma":2},)"

@@ -1,5 +1,5 @@
 // Numerical stress tests of the display model and encoder (issue 8, display_model.h):
-// every transfer kind (sRGB, GOG, measured LUT with a flat toe, PQ) at 8, 10 and 16 bits,
+// every display encoding (sRGB, GOG, measured LUT with a flat toe, PQ) at 8, 10 and 16 bits,
 // dither on and off: the encoder is non-decreasing in the relative value from exact 0 to
 // far above peak (1e30, +inf), the decoder non-decreasing in the code, exact 0 and NaN
 // give black, above-peak gives full drive, and the inverse transfer functions never step

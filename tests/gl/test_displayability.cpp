@@ -186,7 +186,7 @@ using test::atonlab;
 using ::atonlab::test::contains;
 
 /// IEC 61966-2-1 (sRGB) decoding of a drive level V in [0, 1]: the scene's
-/// default display (docs/scene-file.md: transfer "srgb", peak 100 cd/m², black
+/// default display (docs/scene-file.md: encoding "srgb", peak 100 cd/m², black
 /// 0.1 cd/m², each channel its Rec.709 share), in double precision.
 double srgb_decode(double v) {
     return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);

@@ -27,7 +27,7 @@ st::CalibrationId record_display(st::Store& store, const s::Scene& scene, const 
     if (const auto last = store.latest_calibration(c.display_name)) {
         if (last->width_px == c.width_px && last->height_px == c.height_px && last->width_m == c.width_m &&
             last->height_m == c.height_m && last->viewing_distance_m == c.viewing_distance_m &&
-            last->fit_json == c.fit_json && last->source == c.source)
+            display::same_fit_json(last->fit_json, c.fit_json) && last->source == c.source)
             return last->id;
     }
     const std::time_t now = std::time(nullptr);

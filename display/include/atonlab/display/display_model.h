@@ -76,7 +76,7 @@ struct ChannelEncoding {
     bool follows(std::string_view encoding_name) const;
 };
 
-/// A display: per-channel transfer functions and the whole-screen peak and
+/// A display: per-channel encodings and the whole-screen peak and
 /// black (R = G = B = 1 and 0). The channels add: what the screen emits for a
 /// code triple is the sum of the three channels' luminances.
 struct DisplayModel {
@@ -145,7 +145,7 @@ struct EncodeSettings {
 /// it gives up chroma and keeps its luminance: NaN and negative channels are black,
 /// a colour with a channel above 1 moves towards the grey of its luminance, and one
 /// at or above white luminance is white. Each channel's
-/// target is then clipped to [L(0), L(1)], inverted through its transfer function
+/// target is then clipped to [L(0), L(1)], inverted through its encoding's law
 /// and quantised to `bits` with the dither offset. Codes are always in
 /// [0, 2^bits − 1]. Throws InputError for bits outside 1..16.
 /// The display's channel weights: each channel's white luminance L(1) over the sum of

@@ -39,4 +39,9 @@ std::optional<std::string> fit_json_model(std::string_view fit_json);
 /// no number display.channels[1].gamma", or an unknown encoding.
 DisplayModel display_model_from_fit_json(std::string_view fit_json, std::string name);
 
+/// Whether two fit JSON texts hold the same values, whatever their key order and whether a
+/// channel names its encoding "encoding" or by the key's old name "transfer" (a nominal row
+/// written before the rename is the same display as one written now).
+bool same_fit_json(std::string_view a, std::string_view b);
+
 }  // namespace atonlab::display
