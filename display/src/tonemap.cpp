@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -229,8 +230,16 @@ double mesopic_field_s_p_ratio() {
 }
 
 double mesopic_field_adaptation(double adaptation_cd_m2) {
-    // CIE 191:2010 MES2 for the field: m of (L_wa, S/P_field) by the standard's own solution.
-    return mesopic_luminance_cd_m2(clamp_adaptation(adaptation_cd_m2), mesopic_field_s_p_ratio()).adaptation_m;
+    // CIE 191:2010 MES2 for the field: m of (L_wa, S/P_field) by the standard's own solution. It depends
+    // on L_wa alone, which a frame's pixels share: the last one is kept per thread, not solved per pixel.
+    thread_local double last_lwa = std::numeric_limits<double>::quiet_NaN();
+    thread_local double last_m = 0.0;
+    const double lwa = clamp_adaptation(adaptation_cd_m2);
+    if (!(lwa == last_lwa)) {
+        last_m = mesopic_luminance_cd_m2(lwa, mesopic_field_s_p_ratio()).adaptation_m;
+        last_lwa = lwa;
+    }
+    return last_m;
 }
 
 double mesopic_equivalent_cd_m2(double photopic_cd_m2, double scotopic_cd_m2, double adaptation_m) {
