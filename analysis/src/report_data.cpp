@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 
+#include "atonlab/analysis/display_losses.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/common/atomic_file.h"
 #include "atonlab/store/json.h"
@@ -117,6 +118,27 @@ Json track_json(const TrackResult& t) {
                           {"reason", q.reason}};
     }
     return j;
+}
+
+/// The light a session's display took from each condition's judged lights (display_losses.h): the
+/// largest share lost at white and to display.out_of_gamut, and whether it is over the limit the
+/// session ran under; null where the record does not hold it.
+Json display_losses_json(const SessionInfo& s) {
+    const auto loss = [](const std::optional<LightLoss>& l) {
+        return l ? Json{{"share", l->share}, {"role", l->role}, {"light", l->light}, {"level", l->level}}
+                 : Json(nullptr);
+    };
+    const auto flag = [](const std::optional<bool>& b) { return b ? Json(*b) : Json(nullptr); };
+    Json out = Json::array();
+    for (const DisplayLoss& c : s.display_losses)
+        out.push_back(Json{{"condition", c.condition},
+                           {"white_loss", loss(c.white)},
+                           {"white_loss_over_warning", flag(white_over_warning(s, c))},
+                           {"gamut_loss", loss(c.gamut)},
+                           {"out_of_gamut", c.gamut ? Json(c.out_of_gamut) : Json(nullptr)},
+                           {"gamut_loss_over_limit", flag(gamut_over_limit(s, c))},
+                           {"warnings", c.warnings}});
+    return out;
 }
 
 /// A judged light as the stored scene gives it, with the glare it was drawn with.
@@ -315,6 +337,9 @@ void write_summary_json(const std::filesystem::path& file, const ReportContext& 
             o["displayable"] = *s.displayable;
             o["allowed_undisplayable"] = s.allowed_undisplayable;
             o["undisplayable_conditions"] = s.undisplayable;
+            o["display_thresholds"] = Json{{"white_loss_warning_share", or_null(s.white_loss_warning_share)},
+                                           {"max_out_of_gamut_loss", or_null(s.max_out_of_gamut_loss)}};
+            o["display_losses"] = display_losses_json(s);
         }
         o["presentation_margin"] = s.presentation_margin ? Json(*s.presentation_margin) : Json(nullptr);
         o["stops"] = s.stops;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "atonlab/analysis/display_losses.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/common/atomic_file.h"
 #include "atonlab/common/input_text.h"
@@ -357,6 +358,37 @@ std::string sessions_html(const Dataset& d, const StudyResults& r, Footnotes& no
     return h;
 }
 
+/// The light each session's display took from each condition's judged lights (display_losses.h):
+/// the largest share clipped at white and given up to display.out_of_gamut, against the limits.
+std::string display_losses_html(const Dataset& d) {
+    const auto limit = [](const std::optional<double>& v) {
+        return v ? fmt::format("{:.3g} %", 100.0 * *v) : std::string("not recorded");
+    };
+    const auto verdict = [](const std::optional<bool>& over) {
+        return !over ? std::string() : *over ? std::string(": <span class=\"bad\">over</span>") : std::string();
+    };
+    std::string rows;
+    for (const SessionInfo& s : d.sessions)
+        for (const DisplayLoss& c : s.display_losses)
+            rows += fmt::format(
+                "<tr><td>{}</td><td>{}</td><td>{}{}</td><td class=\"num\">{}</td><td>{}{}</td><td>{}</td>"
+                "<td class=\"num\">{}</td></tr>\n",
+                esc(s.key), esc(c.condition), esc(loss_text(c.white)), verdict(white_over_warning(s, c)),
+                limit(s.white_loss_warning_share), esc(loss_text(c.gamut)), verdict(gamut_over_limit(s, c)),
+                c.gamut ? esc(c.out_of_gamut) : std::string("—"), limit(s.max_out_of_gamut_loss));
+    if (rows.empty()) return {};
+    return "<h3 id=\"display-losses\">Light lost at the display</h3>\n"
+           "<p>Per condition, the largest share of a judged light's light (within the observer's window, at either "
+           "end of its level range) that its session's display clipped at its white, and that "
+           "display.out_of_gamut gave up, as <code>atonlab check</code> computed before the first trial; and the "
+           "limits the session ran under: above the warning share a match near that level may lie; above "
+           "display.max_out_of_gamut_loss a brightness match (2AFC, adjust) is refused.</p>\n"
+           "<div class=\"table-wrap\"><table>\n<tr><th>session</th><th>condition</th>"
+           "<th>lost at white</th><th>warned above</th><th>lost to out of gamut</th><th>out_of_gamut</th>"
+           "<th>refused above</th></tr>\n" +
+           rows + "</table></div>\n";
+}
+
 /// The display calibrations: their geometry, the fitted models' parameters, figures and drift.
 std::string calibration_html(const Dataset& d, const ReportContext& ctx, const std::filesystem::path& out_dir,
                              Footnotes& notes) {
@@ -513,6 +545,7 @@ void write_report_html(const std::filesystem::path& file, const ReportContext& c
 
     // --- sessions and timing
     h += sessions_html(d, r, notes);
+    h += display_losses_html(d);
     if (by_kind.count("timing"))
         h += figure_html(out_dir, *by_kind["timing"]);
     else if (!r.timing.empty() && !has_display_timing(d, r))

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "atonlab/analysis/dataset.h"
+#include "atonlab/analysis/display_losses.h"
 #include "atonlab/common/input_error.h"
 #include "atonlab/common/scene_override.h"
 #include "atonlab/store/json.h"
@@ -259,6 +260,38 @@ Dataset read_study(const std::filesystem::path& study_file, bool salvage) {
 
 namespace {
 
+/// The larger of `into` and the share at `at` of light `l` (nothing where the light has no such share).
+void keep_largest(std::optional<LightLoss>& into, const nlohmann::json& l, const char* at, double level) {
+    const std::optional<double> share = store::number_at(l, at);
+    if (!share || (into && into->share >= *share)) return;
+    into = LightLoss{*share, store::string_at(l, "/role").value_or("?"), store::string_at(l, "/light").value_or("?"),
+                     level};
+}
+
+/// Per condition of the record, the largest shares its judged lights lost at the display's white
+/// and to display.out_of_gamut, and the limits they were judged by (absent in older records).
+void read_display_losses(const nlohmann::json& j, SessionInfo& info) {
+    info.white_loss_warning_share = store::number_at(j, "/thresholds/white_loss_warning_share");
+    info.max_out_of_gamut_loss = store::number_at(j, "/thresholds/max_out_of_gamut_loss");
+    for (const nlohmann::json& c : store::array_at(j, "/conditions")) {
+        DisplayLoss loss;
+        loss.condition = store::string_at(c, "/name").value_or("?");
+        for (const nlohmann::json& e : store::array_at(c, "/ends")) {
+            const double level = store::number_at(e, "/level").value_or(0.0);
+            const double gamut_before = loss.gamut ? loss.gamut->share : -1.0;
+            for (const nlohmann::json& l : store::array_at(e, "/lights")) {
+                keep_largest(loss.white, l, "/white_loss_share", level);
+                keep_largest(loss.gamut, l, "/gamut_loss_share", level);
+            }
+            if (loss.gamut && loss.gamut->share > gamut_before)
+                loss.out_of_gamut = store::string_at(e, "/out_of_gamut").value_or("");
+        }
+        for (const nlohmann::json& w : store::array_at(c, "/warnings"))
+            if (w.is_string()) loss.warnings.push_back(w.get<std::string>());
+        info.display_losses.push_back(std::move(loss));
+    }
+}
+
 /// The session's displayability record (displayability_json): whether it could show a match, its
 /// presentation margin and its gamut choice, into `info`; a note for each departure into `d`.
 void read_displayability(const std::string& text, std::int64_t session_id, const std::string& file, SessionInfo& info,
@@ -281,6 +314,9 @@ void read_displayability(const std::string& text, std::int64_t session_id, const
             "keep-luminance: its out-of-gamut lights gave up luminance (docs/tone-mapping.md \"Out of gamut: "
             "colour or luminance\")",
             file, session_id, *info.out_of_gamut));
+    read_display_losses(j, info);
+    for (const std::string& loss : display_loss_sentences(info))
+        d.notes.push_back(fmt::format("{} session {}: {}", file, session_id, loss));
     if (info.displayable == false)
         d.notes.push_back(fmt::format(
             "{} session {} ran with --allow-undisplayable: condition(s) {} could not produce a match on its "

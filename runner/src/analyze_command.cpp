@@ -27,6 +27,7 @@
 #include <thread>
 
 #include "atonlab/analysis/dataset.h"
+#include "atonlab/analysis/display_losses.h"
 #include "atonlab/analysis/plots.h"
 #include "atonlab/analysis/report.h"
 #include "atonlab/analysis/simulation.h"
@@ -555,6 +556,8 @@ int run_analyze(const AnalyzeOptions& o) {
                 std::printf(
                     "  session %s ran with --allow-undisplayable: %s could not produce a match on its display\n",
                     s.key.c_str(), fmt::format("{}", fmt::join(s.undisplayable, ", ")).c_str());
+            for (const std::string& loss : an::display_loss_sentences(s))
+                std::printf("  session %s: %s\n", s.key.c_str(), loss.c_str());
             if (s.presentation_margin)
                 std::printf("  session %s: presentation margin %.0f %% of a refresh\n", s.key.c_str(),
                             *s.presentation_margin * 100.0);

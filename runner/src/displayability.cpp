@@ -259,7 +259,7 @@ void judge_losses(const p::Condition& c, ConditionDisplayability& cd, int white,
                     at, role_text(s), 100.0 * s.gamut_loss_share, choice, 100.0 * max_loss));
             // The other stimulus is the same at both ends: said once, at the top.
             const bool where = s.role != c.level_on ? high : near_match;
-            if (s.white_loss_share > 0.01 && where)
+            if (s.white_loss_share > kWhiteLossWarningShare && where)
                 cd.warnings.push_back(fmt::format(
                     "{} the {} is clipped at the display's white (code {}) and shows {:.1f} % less light within the "
                     "observer's window than its intensity asks for: a match near this level may lie; lower the "
@@ -391,20 +391,24 @@ std::string displayability_json(const Displayability& d, bool allowed, const std
                                   {"equal_level", c.equal_level ? Json(*c.equal_level) : Json(nullptr)},
                                   {"ends", std::move(ends)}});
     }
-    const Json j{{"display",
-                  {{"width_px", d.width_px},
-                   {"height_px", d.height_px},
-                   {"width_m", d.width_m},
-                   {"viewing_distance_m", d.viewing_distance_m},
-                   {"deg_per_px", d.deg_per_px},
-                   {"bits", d.bits},
-                   {"white_code", (1 << d.bits) - 1},
-                   {"out_of_gamut", d.out_of_gamut}}},
-                 {"window_radius_deg", d.window_radius_deg},
-                 {"displayable", d.displayable()},
-                 {"allowed_undisplayable", allowed},
-                 {"conditions", std::move(conditions)},
-                 {"presentation", presentation_json.empty() ? Json(nullptr) : Json::parse(presentation_json)}};
+    const Json j{
+        {"display",
+         {{"width_px", d.width_px},
+          {"height_px", d.height_px},
+          {"width_m", d.width_m},
+          {"viewing_distance_m", d.viewing_distance_m},
+          {"deg_per_px", d.deg_per_px},
+          {"bits", d.bits},
+          {"white_code", (1 << d.bits) - 1},
+          {"out_of_gamut", d.out_of_gamut}}},
+        {"window_radius_deg", d.window_radius_deg},
+        // The limits the shares below were judged by (W1, R5): absent in older records.
+        {"thresholds",
+         {{"white_loss_warning_share", kWhiteLossWarningShare}, {"max_out_of_gamut_loss", d.max_out_of_gamut_loss}}},
+        {"displayable", d.displayable()},
+        {"allowed_undisplayable", allowed},
+        {"conditions", std::move(conditions)},
+        {"presentation", presentation_json.empty() ? Json(nullptr) : Json::parse(presentation_json)}};
     return store::dump_json(j);
 }
 

@@ -21,7 +21,10 @@
 //    condition's line) before any trial, and creates no study file; with
 //    --allow-undisplayable it runs and records the flag in the session
 //    (sessions.displayability_json), and `atonlab analyze` says so;
-//  - `atonlab check` prints the table and exits 0 or 2, writing nothing.
+//  - `atonlab check` prints the table and exits 0 or 2, writing nothing;
+//  - a clipped, out-of-gamut light's shares reach `atonlab analyze`: summary.json's
+//    largest shares equal those check computes for the same condition, judged by
+//    the protocol's own display.max_out_of_gamut_loss, and the note gives the share.
 // The binary's tests skip where it finds no GL 4.5 context (exit status 3).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -488,6 +491,31 @@ TEST(Displayability, AClippedOrOutOfGamutLightIsWarnedOfAndRefusedAsStated) {
     const std::string html = file_bytes(dir / "report/report.html");
     EXPECT_TRUE(contains(html, "display.out_of_gamut = &quot;keep-signal-colour&quot;, not keep-luminance"))
         << analyzed.out;
+    // analyze reads the shares back: summary.json's largest shares are those `check` computes for the
+    // same condition on the same display, judged by the limits the session ran under (the protocol's 1.0).
+    double white = 0.0, gamut = 0.0;
+    for (const runner::LevelEnd* end : {&allowed.conditions[0].low, &allowed.conditions[0].high})
+        for (const runner::ShownLight& s : end->lights) {
+            white = std::max(white, s.white_loss_share);
+            gamut = std::max(gamut, s.gamut_loss_share);
+        }
+    const nlohmann::json summary = store::parse_json(file_bytes(dir / "report/summary.json"), "summary.json");
+    const nlohmann::json& losses = summary.at("sessions").at(0).at("display_losses").at(0);
+    EXPECT_NEAR(store::number_at(losses, "/white_loss/share").value_or(-1.0), white, 1e-3) << losses.dump();
+    EXPECT_NEAR(store::number_at(losses, "/gamut_loss/share").value_or(-1.0), gamut, 1e-3) << losses.dump();
+    EXPECT_EQ(store::number_at(summary, "/sessions/0/display_thresholds/max_out_of_gamut_loss"), 1.0);
+    EXPECT_EQ(store::number_at(summary, "/sessions/0/display_thresholds/white_loss_warning_share"),
+              runner::kWhiteLossWarningShare);
+    EXPECT_EQ(store::boolean_at(losses, "/gamut_loss_over_limit"), false);
+    EXPECT_EQ(store::boolean_at(losses, "/white_loss_over_warning"), white > runner::kWhiteLossWarningShare);
+    // Clipped at white by more than 1 %: one line on the console and one note, with the share.
+    if (white > runner::kWhiteLossWarningShare) {
+        const std::string said = fmt::format("loses {:.1f} % of its light at the display's white", 100.0 * white);
+        EXPECT_TRUE(contains(analyzed.out, said)) << said << "\n" << analyzed.out;
+        const std::string escaped =
+            fmt::format("loses {:.1f} % of its light at the display&#39;s white", 100.0 * white);
+        EXPECT_TRUE(contains(html, escaped)) << escaped;
+    }
 }
 
 }  // namespace

@@ -54,6 +54,9 @@ struct SimObserver {
     /// Stored as the session's SessionStart::simulation_json (a simulated
     /// session, docs/simulate.md); empty: an ordinary session.
     std::string simulation_json;
+    /// Stored as the session's SessionStart::displayability_json (the check
+    /// before the first trial, docs/running.md "Displayability"); empty: none.
+    std::string displayability_json;
 };
 
 /// A SimObserver (named arguments without designated initializers, which warn when partial).
@@ -122,6 +125,7 @@ inline store::SessionId run_simulated(const std::filesystem::path& db, const std
     start.scene_text = scene_text;
     start.scene_name = "none.scene.toml";
     start.simulation_json = obs.simulation_json;
+    start.displayability_json = obs.displayability_json;
     const store::SessionId session = s.begin_session(start);
     p::Rng rng(obs.seed);
     std::size_t n = 0;

@@ -103,6 +103,28 @@ struct Trial {
     bool is_match() const noexcept { return task == protocols::Task::Adjust && (response == "confirm" || response == "match"); }
 };
 
+/// One judged light's share of its light lost on the display, as the
+/// displayability check stored it (docs/running.md "Displayability").
+struct LightLoss {
+    double share = 0.0;  ///< of the light its intensity asks for within the observer's window
+    std::string role;    ///< "test" or "reference"
+    std::string light;   ///< the scene light's name
+    double level = 0.0;  ///< the end of the level range it was rendered at
+};
+
+/// What the displayability check stored of one condition's judged lights: the
+/// largest share lost at the display's white (W1) and to display.out_of_gamut
+/// (R5) over its lights at both ends of its level range. nullopt: the record
+/// holds no such share (written before the shares were stored).
+struct DisplayLoss {
+    std::string condition;
+    std::optional<LightLoss> white, gamut;
+    /// The choice at the end with the largest gamut loss ("keep-luminance", ...).
+    std::string out_of_gamut;
+    /// W1's warnings as `check` stored them (the judged end only), one sentence each.
+    std::vector<std::string> warnings;
+};
+
 /// A session of a study file (or of a CSV's session column).
 struct SessionInfo {
     std::string key;      ///< as Trial::session
@@ -133,6 +155,12 @@ struct SessionInfo {
     /// display.out_of_gamut as displayability_json stored it; nullopt in files from before it was stored.
     std::optional<std::string> out_of_gamut;
     std::vector<std::string> undisplayable;     ///< the conditions that could not produce a match on its display
+    /// Per condition of the record, the light lost on its display; empty without a record.
+    std::vector<DisplayLoss> display_losses;
+    /// The limits the losses were judged by when the session ran (W1's warning
+    /// share, 0.01; display.max_out_of_gamut_loss): nullopt in files from
+    /// before they were stored, where the report judges nothing by them.
+    std::optional<double> white_loss_warning_share, max_out_of_gamut_loss;
     /// The runner's stops before the session's end (sessions.stop_json;
     /// docs/running.md "Missed frames and timeouts"): how many, and the last
     /// one's reason ("missed_in_a_row", "missed_per_session") and sentence;

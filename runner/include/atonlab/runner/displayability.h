@@ -49,6 +49,11 @@
 
 namespace atonlab::runner {
 
+/// W1's limit: a judged light clipped at the display's white that loses more
+/// than this share of its window's light there is warned of. Stored with the
+/// session (displayability_json's "thresholds") so the shares can be judged later.
+inline constexpr double kWhiteLossWarningShare = 0.01;
+
 /// One judged light at one level.
 struct ShownLight {
     protocols::Role role = protocols::Role::Test;
@@ -94,9 +99,10 @@ struct ConditionDisplayability {
     /// Why the condition cannot produce a match on this display (R1-R5, with
     /// what to change), one clause each; empty when it can.
     std::vector<std::string> problems;
-    /// W1: a judged light clipped at the display's white loses more than 1 % of
-    /// its light there (the share named): the match may lie. `atonlab check`
-    /// prints them as warnings and, under --strict, refuses.
+    /// W1: a judged light clipped at the display's white loses more than
+    /// kWhiteLossWarningShare (1 %) of its light there (the share named): the
+    /// match may lie. `atonlab check` prints them as warnings and, under
+    /// --strict, refuses.
     std::vector<std::string> warnings;
     bool displayable() const noexcept { return problems.empty(); }
 };
