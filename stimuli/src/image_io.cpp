@@ -267,6 +267,7 @@ ExrImage read_exr(const std::filesystem::path& path) {
             frame.insert("Y", slice(0, 0.0));  // luminance-only: Y into R, copied to G and B below
         }
         frame.insert("A", slice(3, 1.0));
+        result.has_alpha = channels.findChannel("A") != nullptr;
         in.setFrameBuffer(frame);
         in.readPixels(window.min.y, window.max.y);
         if (!has_rgb) {

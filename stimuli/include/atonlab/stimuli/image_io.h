@@ -42,6 +42,7 @@ void write_exr(const std::filesystem::path& path, const ImageRGBA32F& image, con
 struct ExrImage {
     ImageRGBA32F image;
     ExrMetadata meta;
+    bool has_alpha = false;  ///< the file has an A channel (else A reads as 1)
 };
 /// Reads R, G, B (and A if present, else 1) of any pixel type, and the attributes above.
 ExrImage read_exr(const std::filesystem::path& path);
