@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "atonlab/display/colour.h"
 #include "atonlab/display/display_model.h"
 
 // The library's encodings, one line each (the function its file defines), in the order the
@@ -80,6 +81,25 @@ bool register_display_encoding(const DisplayEncoding& encoding) {
                                            kEncodingParameters));
     registry().push_back(&encoding);
     return true;
+}
+
+double rec709_channel_share(int channel) {
+    return rec709_rgb_to_xyz()[channel][1];
+}
+
+DisplayModel display_of_rec709_shares(const DisplayEncoding& encoding, double peak_cd_m2, double black_cd_m2,
+                                      std::string name) {
+    DisplayModel d;
+    d.name = std::move(name);
+    d.peak_cd_m2 = peak_cd_m2;
+    d.black_cd_m2 = black_cd_m2;
+    for (int c = 0; c < 3; ++c) {
+        ChannelEncoding& ch = d.channels[static_cast<std::size_t>(c)];
+        ch.encoding = &encoding;
+        ch.black_cd_m2 = rec709_channel_share(c) * black_cd_m2;
+        ch.white_cd_m2 = rec709_channel_share(c) * peak_cd_m2;
+    }
+    return d;
 }
 
 std::optional<DisplayModel> display_from_encoding(std::string_view name, double peak_cd_m2, double black_cd_m2) {

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "atonlab/display/colour.h"
 #include "atonlab/display/display_encodings.h"
 
 namespace atonlab::display {
@@ -81,18 +80,8 @@ double pq_inverse_eotf(double L_cd_m2) {
 }
 
 DisplayModel DisplayModel::pq(double peak_cd_m2, double black_cd_m2, std::string name) {
-    DisplayModel d;
-    d.name = std::move(name);
-    d.peak_cd_m2 = peak_cd_m2;
-    d.black_cd_m2 = black_cd_m2;
-    for (int c = 0; c < 3; ++c) {
-        auto& ch = d.channels[static_cast<std::size_t>(c)];
-        const double weight = rec709_rgb_to_xyz()[c][1];  // Rec.709's, from the primaries (colour.h)
-        ch.encoding = &display_encoding_pq();
-        ch.parameter[0] = weight;
-        ch.black_cd_m2 = weight * black_cd_m2;
-        ch.white_cd_m2 = weight * peak_cd_m2;
-    }
+    DisplayModel d = display_of_rec709_shares(display_encoding_pq(), peak_cd_m2, black_cd_m2, std::move(name));
+    for (int c = 0; c < 3; ++c) d.channels[static_cast<std::size_t>(c)].parameter[0] = rec709_channel_share(c);
     return d;
 }
 

@@ -52,19 +52,7 @@ const DisplayEncoding& display_encoding_srgb() {
 }
 
 DisplayModel DisplayModel::srgb(double peak_cd_m2, double black_cd_m2, std::string name) {
-    DisplayModel d;
-    d.name = std::move(name);
-    d.peak_cd_m2 = peak_cd_m2;
-    d.black_cd_m2 = black_cd_m2;
-    for (int c = 0; c < 3; ++c) {
-        auto& ch = d.channels[static_cast<std::size_t>(c)];
-        ch.encoding = &display_encoding_srgb();
-        // Rec.709 luminance weight from the primaries (colour.h), so that Σ channels = Y
-        // exactly as luminance_of_linear_rgb computes it.
-        ch.black_cd_m2 = rec709_rgb_to_xyz()[c][1] * black_cd_m2;
-        ch.white_cd_m2 = rec709_rgb_to_xyz()[c][1] * peak_cd_m2;
-    }
-    return d;
+    return display_of_rec709_shares(display_encoding_srgb(), peak_cd_m2, black_cd_m2, std::move(name));
 }
 
 }  // namespace atonlab::display

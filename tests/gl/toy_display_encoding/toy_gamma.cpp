@@ -7,7 +7,6 @@
 
 #include <cmath>
 
-#include "atonlab/display/colour.h"
 #include "atonlab/display/display_encodings.h"
 
 namespace atonlab::test {
@@ -39,17 +38,8 @@ void toy_check(const ChannelEncoding& ch, const ChannelCheck& at) {
 }
 
 DisplayModel toy_display(double peak_cd_m2, double black_cd_m2) {
-    DisplayModel d;
-    d.name = "Toy";
-    d.peak_cd_m2 = peak_cd_m2;
-    d.black_cd_m2 = black_cd_m2;
-    for (int c = 0; c < 3; ++c) {
-        auto& ch = d.channels[static_cast<std::size_t>(c)];
-        ch.encoding = display_encoding_named("toy-gamma");
-        ch.parameter[0] = 2.0;
-        ch.black_cd_m2 = rec709_rgb_to_xyz()[c][1] * black_cd_m2;
-        ch.white_cd_m2 = rec709_rgb_to_xyz()[c][1] * peak_cd_m2;
-    }
+    DisplayModel d = display_of_rec709_shares(*display_encoding_named("toy-gamma"), peak_cd_m2, black_cd_m2, "Toy");
+    for (auto& ch : d.channels) ch.parameter[0] = 2.0;
     return d;
 }
 

@@ -86,6 +86,15 @@ int display_encoding_index(const DisplayEncoding& encoding);
 /// std::logic_error for a name already taken.
 bool register_display_encoding(const DisplayEncoding& encoding);
 
+/// A display whose three channels follow `encoding`, each with its Rec.709 share
+/// (rec709_channel_share) of peak and black (cd/m²): the display from_peak_black
+/// makes, but for the encoding's own parameters, which it sets afterwards.
+DisplayModel display_of_rec709_shares(const DisplayEncoding& encoding, double peak_cd_m2, double black_cd_m2,
+                                      std::string name);
+/// Rec.709's luminance share of channel c (0 red, 1 green, 2 blue), from the primaries
+/// (colour.h), so that the three sum to Y exactly as luminance_of_linear_rgb computes it.
+double rec709_channel_share(int channel);
+
 /// The display an encoding's name makes from peak and black (the laws with
 /// from_peak_black); nullopt for an unknown name or a fitted law.
 std::optional<DisplayModel> display_from_encoding(std::string_view name, double peak_cd_m2, double black_cd_m2);
