@@ -11,22 +11,14 @@
 
 #include "atonlab/common/input_error.h"
 #include "atonlab/protocols/protocol_file.h"
+#include "protocol_file_test_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace atonlab::protocols;
 
-constexpr const char* kProtocol = R"([protocol]
-scene = "scene.toml"
-seed = 5
-
-[display]
-width_px = 800
-height_px = 600
-width_m = 0.4
-viewing_distance_m = 0.6
-
+const std::string kProtocol = std::string(protocol_file_test::kHeader) + R"(
 [defaults]
 task = "2afc"
 level_key = "light.r.intensity_cd"

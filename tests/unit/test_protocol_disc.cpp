@@ -9,21 +9,13 @@
 
 #include "atonlab/protocols/protocol.h"
 #include "atonlab/protocols/protocol_file.h"
+#include "protocol_file_test_support.h"
 
 using namespace atonlab::protocols;
 
 namespace {
 
-const std::string kProtocol = R"([protocol]
-scene = "scene.toml"
-seed = 5
-
-[display]
-width_px = 800
-height_px = 600
-width_m = 0.4
-viewing_distance_m = 0.6
-
+const std::string kProtocol = std::string(protocol_file_test::kHeader) + R"(
 [[block]]
 [[block.condition]]
 name = "glare"
